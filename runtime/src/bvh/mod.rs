@@ -1,0 +1,9 @@
+//! BVH files in and out (feature `bvh`).
+
+mod error;
+mod read;
+mod write;
+
+pub use error::{BvhError, BvhErrorKind};
+pub use read::{parse_bvh, read_bvh};
+pub use write::{to_bvh_string, write_bvh};

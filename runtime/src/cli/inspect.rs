@@ -1,0 +1,243 @@
+//! `sinmdm inspect`: what the model will see of a clip.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+
+use crate::bvh::{read_bvh, write_bvh};
+use crate::files::write_atomically;
+use crate::motion::{
+    ContactConfig, EncodeOptions, decode, encode, fk, global_poses, math, skeleton::Channel,
+};
+
+pub(super) const EXAMPLES: &str = "Examples:
+  sinmdm inspect tests/data/bvh/human_walk_cmu_131_01.bvh
+  sinmdm inspect walk.bvh --fps 30 --roundtrip walk_30fps.bvh
+  sinmdm inspect dog.bvh --contact-joints LeftHand,RightHand,LeftFoot,RightFoot";
+
+/// Arguments of `sinmdm inspect`.
+#[derive(Debug, Args)]
+pub struct InspectArgs {
+    /// The BVH clip.
+    pub clip: PathBuf,
+    /// Frame rate of the features (default: the clip's own).
+    #[arg(long)]
+    pub fps: Option<f64>,
+    /// Encode the clip to features, decode them and write the result as BVH here.
+    #[arg(long, value_name = "OUT.bvh")]
+    pub roundtrip: Option<PathBuf>,
+    /// Write every joint's global position per frame as JSON here (for checking against other tools).
+    #[arg(long, value_name = "OUT.json")]
+    pub positions: Option<PathBuf>,
+    /// Contact joints, comma-separated (default: chosen automatically).
+    #[arg(long, value_delimiter = ',')]
+    pub contact_joints: Option<Vec<String>>,
+    /// Contact speed threshold in skeleton heights per second.
+    #[arg(long, default_value_t = ContactConfig::default().speed_threshold)]
+    pub contact_speed: f64,
+}
+
+/// A plain-words guess of the file's length unit from the skeleton height.
+pub fn units_guess(height: f64) -> &'static str {
+    match height {
+        h if (0.3..=3.0).contains(&h) => "metres (a 0.3-3 m tall figure)",
+        h if (30.0..=300.0).contains(&h) => "centimetres (a 30-300 cm tall figure)",
+        h if (3.0..30.0).contains(&h) => {
+            "unknown: decimetres, inches or CMU units (about 0.056 m); the model does not care"
+        }
+        _ => "unknown; the model does not care (features are standardised)",
+    }
+}
+
+pub(super) fn run(args: &InspectArgs) -> Result<()> {
+    if let Some(fps) = args.fps
+        && !(fps.is_finite() && fps > 0.0)
+    {
+        bail!("--fps must be a positive number, got {fps}");
+    }
+    let clip = read_bvh(&args.clip)?;
+    let options = EncodeOptions {
+        fps: args.fps,
+        contacts: ContactConfig {
+            joints: args.contact_joints.clone(),
+            speed_threshold: args.contact_speed,
+            ..ContactConfig::default()
+        },
+    };
+    let encoded = encode(&clip, &options)
+        .with_context(|| format!("{}: cannot encode the clip", args.clip.display()))?;
+    let layout = &encoded.layout;
+    let skeleton = &clip.skeleton;
+    let frames = clip.frame_count();
+    let mut out = String::new();
+    let _ = writeln!(out, "clip       {}", args.clip.display());
+    let _ = writeln!(
+        out,
+        "frames     {frames} at {} fps ({:.2} s); features at {} fps: {} frames",
+        trim_float(clip.fps),
+        (frames.max(1) - 1) as f64 / clip.fps,
+        trim_float(layout.fps),
+        encoded.features.ncols()
+    );
+    let end_sites = skeleton
+        .joints
+        .iter()
+        .filter(|j| j.end_site.is_some())
+        .count();
+    let _ = writeln!(
+        out,
+        "joints     {} ({end_sites} End Sites), {} channels per frame",
+        skeleton.len(),
+        skeleton.channel_count()
+    );
+    let height = layout.skeleton_height;
+    let _ = writeln!(out, "height     {height:.3} file units");
+    let _ = writeln!(out, "units      {}", units_guess(height));
+    match &layout.root {
+        Some(root) => {
+            let axes: Vec<String> = root
+                .axes
+                .iter()
+                .map(|a| match a {
+                    crate::motion::Axis::Y => "Y".to_string(),
+                    other => format!("d{other}"),
+                })
+                .collect();
+            let s = root.start_position;
+            let _ = writeln!(
+                out,
+                "root       {} -> {} (start {:.3} {:.3} {:.3})",
+                skeleton.joints[root.joint].name,
+                axes.join(" "),
+                s[0],
+                s[1],
+                s[2]
+            );
+        }
+        None => {
+            let _ = writeln!(
+                out,
+                "root       no position channels: the clip stays in place"
+            );
+        }
+    }
+    let contacts: Vec<String> = layout
+        .contact_joints
+        .iter()
+        .zip(&encoded.contact_share)
+        .map(|(&j, share)| format!("{} {:.0}%", skeleton.joints[j].name, share * 100.0))
+        .collect();
+    let _ = writeln!(
+        out,
+        "contacts   {} (in contact while slower than {} heights/s)",
+        if contacts.is_empty() {
+            "none".to_string()
+        } else {
+            contacts.join(", ")
+        },
+        layout.contact_speed_threshold
+    );
+    let root_width = layout.root.as_ref().map_or(0, |r| r.axes.len());
+    let _ = writeln!(
+        out,
+        "features   F = {} = root {} + rotations {}x6 + positions {} + contacts {}",
+        layout.width(),
+        root_width,
+        layout.rotation_joints.len(),
+        layout.position_channels.len(),
+        layout.contact_joints.len()
+    );
+    let _ = writeln!(
+        out,
+        "\n  #  joint                      parent                     channels"
+    );
+    for (i, joint) in skeleton.joints.iter().enumerate() {
+        let parent = joint
+            .parent
+            .map_or("-", |p| skeleton.joints[p].name.as_str());
+        let channels: Vec<&str> = joint.channels.iter().map(|c| short_channel(*c)).collect();
+        let _ = writeln!(
+            out,
+            "{i:>3}  {:<26} {:<26} {}",
+            joint.name,
+            parent,
+            channels.join(" ")
+        );
+    }
+    print!("{out}");
+
+    if let Some(path) = &args.positions {
+        let json = positions_json(&clip)?;
+        write_atomically(path, json.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        println!("\npositions  written to {}", path.display());
+    }
+
+    if let Some(path) = &args.roundtrip {
+        let motion = decode(layout, encoded.features.view())?;
+        let written = motion.to_channels();
+        write_bvh(path, &written)?;
+        print!(
+            "\nroundtrip  written to {} at {} fps",
+            path.display(),
+            trim_float(layout.fps)
+        );
+        if (layout.fps - clip.fps).abs() < 1e-9 {
+            let original = global_poses(&clip.to_local());
+            let decoded = global_poses(&written.to_local());
+            let worst = original
+                .iter()
+                .zip(&decoded)
+                .flat_map(|(a, b)| a.points().zip(b.points()))
+                .map(|(p, q)| math::norm(math::sub(p, q)))
+                .fold(0.0, f64::max);
+            println!(
+                "; largest joint position error {:.2e} x height",
+                worst / height.max(1e-12)
+            );
+        } else {
+            println!();
+        }
+    }
+    Ok(())
+}
+
+/// Global joint positions of every frame as JSON: `{"fps", "joints": [names], "positions":
+/// [frame][joint][xyz]}`.
+fn positions_json(clip: &crate::motion::ChannelClip) -> Result<String> {
+    let poses = global_poses(&clip.to_local());
+    let positions: Vec<&Vec<math::Vec3>> =
+        poses.iter().map(|p: &fk::GlobalPose| &p.joints).collect();
+    let names: Vec<&str> = clip
+        .skeleton
+        .joints
+        .iter()
+        .map(|j| j.name.as_str())
+        .collect();
+    Ok(serde_json::to_string(&serde_json::json!({
+        "fps": clip.fps,
+        "joints": names,
+        "positions": positions,
+    }))?)
+}
+
+fn short_channel(c: Channel) -> &'static str {
+    match c {
+        Channel::Position(crate::motion::Axis::X) => "Xpos",
+        Channel::Position(crate::motion::Axis::Y) => "Ypos",
+        Channel::Position(crate::motion::Axis::Z) => "Zpos",
+        Channel::Rotation(crate::motion::Axis::X) => "Xrot",
+        Channel::Rotation(crate::motion::Axis::Y) => "Yrot",
+        Channel::Rotation(crate::motion::Axis::Z) => "Zrot",
+    }
+}
+
+fn trim_float(v: f64) -> String {
+    if v.fract() == 0.0 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.3}")
+    }
+}

@@ -1,0 +1,468 @@
+//! The per-frame feature vector the model learns, and the way back to a motion.
+//!
+//! Columns, in this order (each group may be empty):
+//! 1. root: for the motion root's position channels, X and Z as per-frame displacement on the
+//!    ground plane (frame 0 copies frame 1) and Y as absolute height;
+//! 2. rotations: the 6D rotation of every joint that has rotation channels, in joint order;
+//! 3. positions: the non-root position channels that vary over the clip (absolute values);
+//! 4. contacts: one 0/1 label per contact joint.
+//!
+//! Position channels that never change are static skeleton data ([`FeatureLayout::rest_translations`]),
+//! and the root's first position is kept as [`RootFeatures::start_position`], so decoding
+//! integrates the displacements back to world positions.
+
+use ndarray::{Array2, ArrayView2};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use super::clip::{ChannelClip, LocalMotion};
+use super::contacts::{ContactConfig, choose_contact_joints, contact_labels};
+use super::fk::{global_poses, skeleton_height};
+use super::math::{IDENTITY, Vec3};
+use super::resample::resample;
+use super::rotation::{mat_from_6d, mat_to_6d};
+use super::skeleton::{Axis, Channel, Skeleton};
+
+/// Errors while turning a clip into features or features into a clip.
+#[derive(Debug, Error, PartialEq)]
+pub enum MotionError {
+    /// The clip has no frames.
+    #[error("the clip has no frames")]
+    NoFrames,
+    /// A contact joint named in the configuration is not in the skeleton.
+    #[error("contact joint '{name}' is not in the skeleton (joints: {available})")]
+    UnknownContactJoint {
+        /// The name that was asked for.
+        name: String,
+        /// The skeleton's joint names, comma-separated.
+        available: String,
+    },
+    /// A target frame rate that is zero, negative or not a number.
+    #[error("frame rate must be a positive number, got {0}")]
+    BadFrameRate(f64),
+    /// A feature array whose row count does not match the layout.
+    #[error("features have {got} rows but the layout describes {expected}")]
+    WidthMismatch {
+        /// Rows the layout expects.
+        expected: usize,
+        /// Rows given.
+        got: usize,
+    },
+    /// A feature array holding NaN or infinity.
+    #[error("features contain a non-finite value at row {row}, frame {frame}")]
+    NonFinite {
+        /// Feature row.
+        row: usize,
+        /// Frame.
+        frame: usize,
+    },
+}
+
+/// The root's share of the features.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RootFeatures {
+    /// The joint that carries the clip's travel (the BVH root, or its only child when the root is
+    /// a static container such as Bandai-Namco's `joint_Root`).
+    pub joint: usize,
+    /// Its position axes, in X, Y, Z order: X and Z become displacements, Y stays absolute.
+    pub axes: Vec<Axis>,
+    /// Its local translation at frame 0, where decoding starts integrating.
+    pub start_position: Vec3,
+}
+
+/// What one feature column holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ColumnKind {
+    /// Root displacement per frame along X or Z.
+    RootDisplacement(Axis),
+    /// Root height (absolute Y).
+    RootHeight,
+    /// Component 0..6 of a joint's 6D rotation (`R00 R01 R02 R10 R11 R12`).
+    Rotation6d(u8),
+    /// A varying non-root position channel (absolute value).
+    Position(Axis),
+    /// A contact label.
+    Contact,
+}
+
+/// One feature column: which joint and what.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Column {
+    /// Joint index in the skeleton.
+    pub joint: usize,
+    /// What the column holds.
+    pub kind: ColumnKind,
+}
+
+/// Which feature column is which, plus the static data needed to decode.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FeatureLayout {
+    /// The skeleton the features belong to.
+    pub skeleton: Skeleton,
+    /// Frame rate of the feature sequence.
+    pub fps: f64,
+    /// Root features, absent when the motion root has no position channels.
+    pub root: Option<RootFeatures>,
+    /// Joints with a 6D rotation, in column order.
+    pub rotation_joints: Vec<usize>,
+    /// Varying non-root position channels, in column order.
+    pub position_channels: Vec<(usize, Axis)>,
+    /// Contact joints, in column order.
+    pub contact_joints: Vec<usize>,
+    /// Per joint: the OFFSET with constant position channels applied (the translation used when
+    /// no feature animates it).
+    pub rest_translations: Vec<Vec3>,
+    /// Contact threshold in skeleton heights per second.
+    pub contact_speed_threshold: f64,
+    /// The skeleton height the thresholds are relative to (file units).
+    pub skeleton_height: f64,
+}
+
+impl FeatureLayout {
+    /// Number of feature columns (F).
+    pub fn width(&self) -> usize {
+        self.root.as_ref().map_or(0, |r| r.axes.len())
+            + 6 * self.rotation_joints.len()
+            + self.position_channels.len()
+            + self.contact_joints.len()
+    }
+
+    /// Every column in order.
+    pub fn columns(&self) -> Vec<Column> {
+        let mut out = Vec::with_capacity(self.width());
+        if let Some(root) = &self.root {
+            for &axis in &root.axes {
+                let kind = if axis == Axis::Y {
+                    ColumnKind::RootHeight
+                } else {
+                    ColumnKind::RootDisplacement(axis)
+                };
+                out.push(Column {
+                    joint: root.joint,
+                    kind,
+                });
+            }
+        }
+        for &joint in &self.rotation_joints {
+            out.extend((0..6).map(|c| Column {
+                joint,
+                kind: ColumnKind::Rotation6d(c),
+            }));
+        }
+        for &(joint, axis) in &self.position_channels {
+            out.push(Column {
+                joint,
+                kind: ColumnKind::Position(axis),
+            });
+        }
+        for &joint in &self.contact_joints {
+            out.push(Column {
+                joint,
+                kind: ColumnKind::Contact,
+            });
+        }
+        out
+    }
+
+    /// Column indices that belong to `joint` (its rotation, varying positions, root channels and
+    /// contact label).
+    pub fn joint_columns(&self, joint: usize) -> Vec<usize> {
+        self.columns()
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.joint == joint)
+            .map(|(i, _)| i)
+            .collect()
+    }
+
+    /// A short human-readable name of a column, such as `LeftFoot.rot6d[2]`.
+    pub fn column_name(&self, column: &Column) -> String {
+        let joint = &self.skeleton.joints[column.joint].name;
+        match column.kind {
+            ColumnKind::RootDisplacement(axis) => format!("{joint}.d{axis}"),
+            ColumnKind::RootHeight => format!("{joint}.Y"),
+            ColumnKind::Rotation6d(c) => format!("{joint}.rot6d[{c}]"),
+            ColumnKind::Position(axis) => format!("{joint}.{axis}position"),
+            ColumnKind::Contact => format!("{joint}.contact"),
+        }
+    }
+}
+
+/// How a clip becomes features.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EncodeOptions {
+    /// Target frame rate; `None` keeps the clip's own.
+    pub fps: Option<f64>,
+    /// Contact joints and threshold.
+    pub contacts: ContactConfig,
+}
+
+impl Default for EncodeOptions {
+    fn default() -> Self {
+        EncodeOptions {
+            fps: Some(30.0),
+            contacts: ContactConfig::default(),
+        }
+    }
+}
+
+/// A clip turned into features.
+#[derive(Debug, Clone)]
+pub struct EncodedClip {
+    /// The column description (with the skeleton and static data).
+    pub layout: FeatureLayout,
+    /// Unnormalised features `[F, N]`.
+    pub features: Array2<f32>,
+    /// Share of frames in contact for each contact joint.
+    pub contact_share: Vec<f64>,
+}
+
+/// Relative change under which a channel counts as constant.
+const CONSTANT_TOLERANCE: f64 = 1e-9;
+
+/// Whether each channel of the clip (in channel order) changes over the clip.
+fn varying_channels(clip: &ChannelClip) -> Vec<bool> {
+    let width = clip.skeleton.channel_count();
+    let first = clip.frame(0);
+    let mut varies = vec![false; width];
+    for f in 1..clip.frame_count() {
+        for (c, (&v, &v0)) in clip.frame(f).iter().zip(first).enumerate() {
+            if (v - v0).abs() > CONSTANT_TOLERANCE * (1.0 + v0.abs()) {
+                varies[c] = true;
+            }
+        }
+    }
+    varies
+}
+
+/// The joint that carries the clip's travel: the root, or, while a joint has no varying position
+/// channel and exactly one child that has one, that child.
+fn motion_root(skeleton: &Skeleton, varying_position: &[bool]) -> usize {
+    let mut joint = 0;
+    loop {
+        if varying_position[joint] {
+            return joint;
+        }
+        match skeleton.children(joint).as_slice() {
+            [only] if varying_position[*only] => joint = *only,
+            _ => return joint,
+        }
+    }
+}
+
+/// Turns a clip into features: resampled to `options.fps`, root displacement and height, 6D
+/// rotations, varying positions and contact labels.
+pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip, MotionError> {
+    if clip.frame_count() == 0 {
+        return Err(MotionError::NoFrames);
+    }
+    let fps = options.fps.unwrap_or(clip.fps);
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(MotionError::BadFrameRate(fps));
+    }
+    let skeleton = &clip.skeleton;
+    let varies = varying_channels(clip);
+    let starts = skeleton.channel_starts();
+    let position_varies = |j: usize, axis: Axis| {
+        skeleton.joints[j]
+            .channels
+            .iter()
+            .position(|c| *c == Channel::Position(axis))
+            .is_some_and(|c| varies[starts[j] + c])
+    };
+    let any_position_varies: Vec<bool> = (0..skeleton.len())
+        .map(|j| {
+            [Axis::X, Axis::Y, Axis::Z]
+                .iter()
+                .any(|&a| position_varies(j, a))
+        })
+        .collect();
+    let root_joint = motion_root(skeleton, &any_position_varies);
+
+    let local = resample(&clip.to_local(), fps);
+    let frames = local.frame_count();
+    let joints = skeleton.len();
+
+    let first = clip.frame(0);
+    let rest_translations: Vec<Vec3> = skeleton
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(j, joint)| {
+            let mut translation = joint.offset;
+            for (c, channel) in joint.channels.iter().enumerate() {
+                if let Channel::Position(axis) = channel {
+                    translation[axis.index()] = first[starts[j] + c];
+                }
+            }
+            translation
+        })
+        .collect();
+    let root_axes: Vec<Axis> = [Axis::X, Axis::Y, Axis::Z]
+        .into_iter()
+        .filter(|a| skeleton.joints[root_joint].position_axes().contains(a))
+        .collect();
+    let root = (!root_axes.is_empty()).then(|| RootFeatures {
+        joint: root_joint,
+        axes: root_axes,
+        start_position: local.translations[root_joint],
+    });
+    let rotation_joints: Vec<usize> = (0..joints)
+        .filter(|&j| skeleton.joints[j].rotates())
+        .collect();
+    let position_channels: Vec<(usize, Axis)> = (0..joints)
+        .filter(|&j| j != root_joint || root.is_none())
+        .flat_map(|j| {
+            [Axis::X, Axis::Y, Axis::Z]
+                .into_iter()
+                .filter(move |&a| position_varies(j, a))
+                .map(move |a| (j, a))
+        })
+        .collect();
+
+    let poses = global_poses(&local);
+    let height = skeleton_height(&poses);
+    let contact_joints = match &options.contacts.joints {
+        Some(names) => names
+            .iter()
+            .map(|name| {
+                skeleton
+                    .find(name)
+                    .ok_or_else(|| MotionError::UnknownContactJoint {
+                        name: name.clone(),
+                        available: skeleton
+                            .joints
+                            .iter()
+                            .map(|j| j.name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?,
+        None => choose_contact_joints(skeleton, &poses, height, options.contacts.ground_fraction),
+    };
+
+    let layout = FeatureLayout {
+        skeleton: skeleton.clone(),
+        fps,
+        root,
+        rotation_joints,
+        position_channels,
+        contact_joints,
+        rest_translations,
+        contact_speed_threshold: options.contacts.speed_threshold,
+        skeleton_height: height,
+    };
+
+    let mut features = Array2::<f32>::zeros((layout.width(), frames));
+    let mut row = 0;
+    if let Some(root) = &layout.root {
+        for &axis in &root.axes {
+            let a = axis.index();
+            let at = |f: usize| local.translations[f * joints + root.joint][a];
+            for f in 0..frames {
+                features[[row, f]] = if axis == Axis::Y {
+                    at(f) as f32
+                } else if frames < 2 {
+                    0.0
+                } else {
+                    let g = f.max(1);
+                    (at(g) - at(g - 1)) as f32
+                };
+            }
+            row += 1;
+        }
+    }
+    for &joint in &layout.rotation_joints {
+        for f in 0..frames {
+            let six = mat_to_6d(&local.rotations[f * joints + joint]);
+            for (c, value) in six.iter().enumerate() {
+                features[[row + c, f]] = *value as f32;
+            }
+        }
+        row += 6;
+    }
+    for &(joint, axis) in &layout.position_channels {
+        for f in 0..frames {
+            features[[row, f]] = local.translations[f * joints + joint][axis.index()] as f32;
+        }
+        row += 1;
+    }
+    let mut contact_share = Vec::with_capacity(layout.contact_joints.len());
+    for &joint in &layout.contact_joints {
+        let labels = contact_labels(&poses, joint, fps, height, layout.contact_speed_threshold);
+        contact_share.push(labels.iter().map(|&l| f64::from(l)).sum::<f64>() / frames as f64);
+        for (f, label) in labels.into_iter().enumerate() {
+            features[[row, f]] = label;
+        }
+        row += 1;
+    }
+    debug_assert_eq!(row, layout.width());
+    Ok(EncodedClip {
+        layout,
+        features,
+        contact_share,
+    })
+}
+
+/// Turns features `[F, N]` back into local joint transforms. Contact labels are not needed to
+/// rebuild the pose and are ignored.
+pub fn decode(
+    layout: &FeatureLayout,
+    features: ArrayView2<'_, f32>,
+) -> Result<LocalMotion, MotionError> {
+    let (width, frames) = features.dim();
+    if width != layout.width() {
+        return Err(MotionError::WidthMismatch {
+            expected: layout.width(),
+            got: width,
+        });
+    }
+    if let Some(((row, frame), _)) = features.indexed_iter().find(|(_, v)| !v.is_finite()) {
+        return Err(MotionError::NonFinite { row, frame });
+    }
+    let joints = layout.skeleton.len();
+    let mut rotations = vec![IDENTITY; frames * joints];
+    let mut translations: Vec<Vec3> = (0..frames)
+        .flat_map(|_| layout.rest_translations.iter().copied())
+        .collect();
+    let mut row = 0;
+    if let Some(root) = &layout.root {
+        for &axis in &root.axes {
+            let a = axis.index();
+            let mut value = root.start_position[a];
+            for f in 0..frames {
+                let feature = f64::from(features[[row, f]]);
+                if axis == Axis::Y {
+                    value = feature;
+                } else if f > 0 {
+                    value += feature;
+                }
+                translations[f * joints + root.joint][a] = value;
+            }
+            row += 1;
+        }
+    }
+    let mut six = [0.0f64; 6];
+    for &joint in &layout.rotation_joints {
+        for f in 0..frames {
+            for (c, value) in six.iter_mut().enumerate() {
+                *value = f64::from(features[[row + c, f]]);
+            }
+            rotations[f * joints + joint] = mat_from_6d(&six);
+        }
+        row += 6;
+    }
+    for &(joint, axis) in &layout.position_channels {
+        for f in 0..frames {
+            translations[f * joints + joint][axis.index()] = f64::from(features[[row, f]]);
+        }
+        row += 1;
+    }
+    Ok(LocalMotion {
+        skeleton: layout.skeleton.clone(),
+        fps: layout.fps,
+        rotations,
+        translations,
+    })
+}

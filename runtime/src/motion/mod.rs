@@ -1,0 +1,24 @@
+//! The motion representation: skeletons, rotations, forward kinematics, and the feature vector
+//! the model learns (SPEC section 2).
+
+pub mod clip;
+pub mod contacts;
+pub mod features;
+pub mod fk;
+pub mod math;
+pub mod normalize;
+pub mod pose;
+pub mod resample;
+pub mod rotation;
+pub mod skeleton;
+
+pub use clip::{ChannelClip, LocalMotion, fps_from_frame_time};
+pub use contacts::ContactConfig;
+pub use features::{
+    Column, ColumnKind, EncodeOptions, EncodedClip, FeatureLayout, MotionError, RootFeatures,
+    decode, encode,
+};
+pub use fk::{GlobalPose, global_pose, global_poses, skeleton_height};
+pub use normalize::Normalizer;
+pub use pose::{Pose, poses};
+pub use skeleton::{Axis, Channel, Joint, Skeleton};

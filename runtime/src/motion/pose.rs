@@ -1,0 +1,42 @@
+//! Poses for engines: per frame, the root position and every joint's local rotation as a
+//! quaternion, without touching the file system.
+
+use super::clip::LocalMotion;
+use super::math::quat_from_mat;
+
+/// One frame of a skeleton pose, in the clip's units and its right-handed, Y-up BVH frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pose {
+    /// World position of the root joint.
+    pub root_position: [f32; 3],
+    /// Local rotation of every joint relative to its parent, as a unit quaternion `[x, y, z, w]`.
+    pub rotations: Vec<[f32; 4]>,
+    /// Local translation of every joint from its parent (the OFFSET, or the animated position
+    /// where a joint has position channels).
+    pub translations: Vec<[f32; 3]>,
+}
+
+/// One [`Pose`] per frame.
+pub fn poses(motion: &LocalMotion) -> Vec<Pose> {
+    let joints = motion.skeleton.len();
+    let narrow = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
+    (0..motion.frame_count())
+        .map(|f| {
+            let range = f * joints..(f + 1) * joints;
+            Pose {
+                root_position: narrow(motion.translations[f * joints]),
+                rotations: motion.rotations[range.clone()]
+                    .iter()
+                    .map(|m| {
+                        let [w, x, y, z] = quat_from_mat(m);
+                        [x as f32, y as f32, z as f32, w as f32]
+                    })
+                    .collect(),
+                translations: motion.translations[range]
+                    .iter()
+                    .map(|&t| narrow(t))
+                    .collect(),
+            }
+        })
+        .collect()
+}

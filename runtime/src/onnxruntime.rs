@@ -1,0 +1,153 @@
+//! Finding and loading the onnxruntime shared library (`ort` with `load-dynamic`).
+//!
+//! Search order: the `ORT_DYLIB_PATH` environment variable (the `ort` crate's own), then the
+//! project's Python virtual environment made by `scripts/setup.sh` (`.venv/.../onnxruntime/capi/`),
+//! looked for above the current directory, above the running executable and in the source tree
+//! this crate was built from.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use thiserror::Error;
+
+/// The onnxruntime version the project pins (the PyPI wheel `onnxruntime==1.31.1`).
+pub const ONNXRUNTIME_VERSION: &str = "1.31.1";
+
+/// The onnxruntime library could not be found or loaded.
+#[derive(Debug, Error, Clone)]
+pub enum RuntimeLibraryError {
+    /// No library in any searched place.
+    #[error(
+        "the onnxruntime {ONNXRUNTIME_VERSION} shared library was not found (looked in: {searched}); \
+         run `scripts/setup.sh` in the sinmdm-rs checkout, or set ORT_DYLIB_PATH to the library file"
+    )]
+    NotFound {
+        /// The places looked at.
+        searched: String,
+    },
+    /// `ORT_DYLIB_PATH` names a file that does not exist.
+    #[error("ORT_DYLIB_PATH is set to '{0}', which does not exist")]
+    EnvPathMissing(PathBuf),
+    /// The file exists but onnxruntime would not load from it.
+    #[error("could not load onnxruntime from '{path}': {message}")]
+    LoadFailed {
+        /// The library file.
+        path: PathBuf,
+        /// What the loader said.
+        message: String,
+    },
+}
+
+/// File names the library has in the PyPI wheel on each platform.
+fn library_names() -> &'static [&'static str] {
+    if cfg!(target_os = "windows") {
+        &["onnxruntime.dll"]
+    } else if cfg!(target_os = "macos") {
+        &["libonnxruntime.1.31.1.dylib", "libonnxruntime.dylib"]
+    } else {
+        &[
+            "libonnxruntime.so.1.31.1",
+            "libonnxruntime.so.1",
+            "libonnxruntime.so",
+        ]
+    }
+}
+
+/// The onnxruntime library inside a virtual environment, if present.
+fn in_venv(venv: &Path) -> Option<PathBuf> {
+    let mut site_packages = vec![venv.join("Lib").join("site-packages")];
+    if let Ok(entries) = std::fs::read_dir(venv.join("lib")) {
+        let mut pythons: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with("python"))
+            })
+            .collect();
+        pythons.sort();
+        site_packages.extend(pythons.into_iter().map(|p| p.join("site-packages")));
+    }
+    site_packages.into_iter().find_map(|sp| {
+        let capi = sp.join("onnxruntime").join("capi");
+        library_names()
+            .iter()
+            .map(|name| capi.join(name))
+            .find(|p| p.is_file())
+    })
+}
+
+/// Directories whose `.venv` may hold the library, nearest first.
+fn candidate_roots() -> Vec<PathBuf> {
+    let mut roots = Vec::new();
+    if let Ok(dir) = std::env::current_dir() {
+        roots.extend(dir.ancestors().map(Path::to_path_buf));
+    }
+    if let Ok(exe) = std::env::current_exe() {
+        roots.extend(exe.ancestors().skip(1).map(Path::to_path_buf));
+    }
+    // The checkout this crate was built in (its parent is the workspace root).
+    roots.extend(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .ancestors()
+            .map(Path::to_path_buf),
+    );
+    let mut seen = std::collections::HashSet::new();
+    roots.retain(|r| seen.insert(r.clone()));
+    roots
+}
+
+/// Where the onnxruntime shared library is, following the search order above.
+pub fn locate_library() -> Result<PathBuf, RuntimeLibraryError> {
+    if let Some(path) = std::env::var_os("ORT_DYLIB_PATH").filter(|p| !p.is_empty()) {
+        let path = PathBuf::from(path);
+        return if path.is_file() {
+            Ok(path)
+        } else {
+            Err(RuntimeLibraryError::EnvPathMissing(path))
+        };
+    }
+    let roots = candidate_roots();
+    if let Some(found) = roots.iter().find_map(|r| in_venv(&r.join(".venv"))) {
+        return Ok(found);
+    }
+    Err(RuntimeLibraryError::NotFound {
+        searched: std::iter::once("ORT_DYLIB_PATH (unset)".to_string())
+            .chain(roots.iter().map(|r| r.join(".venv").display().to_string()))
+            .collect::<Vec<_>>()
+            .join(", "),
+    })
+}
+
+/// The loaded library and the process-wide onnxruntime environment, which must outlive every
+/// session.
+struct Loaded {
+    path: PathBuf,
+    _environment: ort::environment::Environment,
+}
+
+/// Loads onnxruntime once per process (later calls return the first outcome) and returns the
+/// library's path.
+pub fn init() -> Result<PathBuf, RuntimeLibraryError> {
+    static LOADED: OnceLock<Result<Loaded, RuntimeLibraryError>> = OnceLock::new();
+    let loaded = LOADED.get_or_init(|| {
+        let path = locate_library()?;
+        let failed = |message: String| RuntimeLibraryError::LoadFailed {
+            path: path.clone(),
+            message,
+        };
+        let environment = ort::init_from(&path)
+            .map_err(|e| failed(e.to_string()))?
+            .with_name("sinmdm")
+            .with_telemetry(false)
+            .build()
+            .map_err(|e| failed(e.to_string()))?;
+        Ok(Loaded {
+            path: path.clone(),
+            _environment: environment,
+        })
+    });
+    match loaded {
+        Ok(l) => Ok(l.path.clone()),
+        Err(e) => Err(e.clone()),
+    }
+}

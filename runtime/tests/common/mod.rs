@@ -1,0 +1,45 @@
+//! Shared helpers for the integration tests: where the clips are.
+
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+/// The workspace root.
+pub fn workspace() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The clips shipped with the project.
+pub fn shipped_clips() -> Vec<PathBuf> {
+    bvh_files(workspace().join("tests/data/bvh"))
+}
+
+/// The shipped clips plus, when the team's shared data folder sits beside the checkout, every
+/// clip in it (including non-commercial ones that are never copied into the repository).
+pub fn all_clips() -> Vec<PathBuf> {
+    let mut clips = shipped_clips();
+    let shared = bvh_files(workspace().join("../shared/data/bvh"));
+    let shipped_names: Vec<_> = clips
+        .iter()
+        .map(|p| p.file_name().map(|n| n.to_owned()))
+        .collect();
+    clips.extend(
+        shared
+            .into_iter()
+            .filter(|p| !shipped_names.contains(&p.file_name().map(|n| n.to_owned()))),
+    );
+    clips
+}
+
+fn bvh_files(dir: PathBuf) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "bvh"))
+                .collect()
+        })
+        .unwrap_or_default();
+    files.sort();
+    files
+}
