@@ -111,9 +111,9 @@ mod tests {
 
     #[test]
     fn a_foot_that_stops_and_moves_is_labelled_by_its_speed() {
-        // 30 fps. The foot rests for frames 0-9, moves at 2 heights/s for frames 10-19, rests
-        // again from frame 20. With central differences the frames next to a change see half the
-        // step, so frames 9 and 20 move at 1 height/s: above the 0.15 threshold.
+        // 30 fps. The foot steps forward between frames 9 and 19 (ten steps at 2 heights/s) and
+        // rests before and after. With central differences frames 9 and 19 see one step over two
+        // frames, 1 height/s: still above the 0.15 threshold; frames 8 and 20 see no step.
         let height = 1.8;
         let mut x = 0.0;
         let mut points = Vec::new();
@@ -125,7 +125,7 @@ mod tests {
         }
         let labels = contact_labels(&points, 0, 30.0, height, 0.15);
         let expected: Vec<f32> = (0..30)
-            .map(|f| if (9..=20).contains(&f) { 0.0 } else { 1.0 })
+            .map(|f| if (9..=19).contains(&f) { 0.0 } else { 1.0 })
             .collect();
         assert_eq!(labels, expected);
     }
