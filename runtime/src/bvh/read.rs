@@ -65,8 +65,12 @@ impl<'a> Parser<'a> {
         }
     }
 
+    /// The number of the last line that holds anything.
     fn last_line(&self) -> usize {
-        self.lines.len()
+        self.lines
+            .iter()
+            .rposition(|l| !l.trim().is_empty())
+            .map_or(1, |i| i + 1)
     }
 
     fn peek(&self) -> Option<Token<'a>> {

@@ -48,6 +48,20 @@ pub enum MotionError {
         /// Rows given.
         got: usize,
     },
+    /// Resampling would make an absurdly long clip (a frame time of minutes, say).
+    #[error(
+        "resampling {frames} frames from {from_fps} fps to {to_fps} fps would give more than {limit} frames; check the clip's Frame Time"
+    )]
+    TooManyFrames {
+        /// Frames in the clip.
+        frames: usize,
+        /// The clip's rate.
+        from_fps: f64,
+        /// The target rate.
+        to_fps: f64,
+        /// The largest clip accepted.
+        limit: usize,
+    },
     /// A feature array holding NaN or infinity.
     #[error("features contain a non-finite value at row {row}, frame {frame}")]
     NonFinite {
@@ -217,6 +231,9 @@ pub struct EncodedClip {
     pub contact_share: Vec<f64>,
 }
 
+/// The longest feature sequence `encode` makes (over nine hours at 30 fps).
+pub const MAX_FRAMES: usize = 1_000_000;
+
 /// Relative change under which a channel counts as constant.
 const CONSTANT_TOLERANCE: f64 = 1e-9;
 
@@ -259,6 +276,15 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
     let fps = options.fps.unwrap_or(clip.fps);
     if !(fps.is_finite() && fps > 0.0) {
         return Err(MotionError::BadFrameRate(fps));
+    }
+    let resampled = (clip.frame_count() as f64 - 1.0) * fps / clip.fps + 1.0;
+    if !(resampled <= MAX_FRAMES as f64) {
+        return Err(MotionError::TooManyFrames {
+            frames: clip.frame_count(),
+            from_fps: clip.fps,
+            to_fps: fps,
+            limit: MAX_FRAMES,
+        });
     }
     let skeleton = &clip.skeleton;
     let varies = varying_channels(clip);
