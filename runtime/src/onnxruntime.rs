@@ -98,7 +98,15 @@ fn candidate_roots() -> Vec<PathBuf> {
 
 /// Where the onnxruntime shared library is, following the search order above.
 pub fn locate_library() -> Result<PathBuf, RuntimeLibraryError> {
-    if let Some(path) = std::env::var_os("ORT_DYLIB_PATH").filter(|p| !p.is_empty()) {
+    locate_in(std::env::var_os("ORT_DYLIB_PATH"), &candidate_roots())
+}
+
+/// The search itself: `env_path` first, then `.venv` under each root in turn.
+fn locate_in(
+    env_path: Option<std::ffi::OsString>,
+    roots: &[PathBuf],
+) -> Result<PathBuf, RuntimeLibraryError> {
+    if let Some(path) = env_path.filter(|p| !p.is_empty()) {
         let path = PathBuf::from(path);
         return if path.is_file() {
             Ok(path)
@@ -106,7 +114,6 @@ pub fn locate_library() -> Result<PathBuf, RuntimeLibraryError> {
             Err(RuntimeLibraryError::EnvPathMissing(path))
         };
     }
-    let roots = candidate_roots();
     if let Some(found) = roots.iter().find_map(|r| in_venv(&r.join(".venv"))) {
         return Ok(found);
     }
@@ -118,17 +125,18 @@ pub fn locate_library() -> Result<PathBuf, RuntimeLibraryError> {
     })
 }
 
-/// The loaded library and the process-wide onnxruntime environment, which must outlive every
-/// session.
-struct Loaded {
-    path: PathBuf,
-    _environment: ort::environment::Environment,
+/// The loaded onnxruntime: the library's path and the process-wide environment every session
+/// is created in.
+pub struct OnnxRuntime {
+    /// The shared library that was loaded.
+    pub path: PathBuf,
+    /// The onnxruntime environment (one per process).
+    pub environment: ort::environment::Environment,
 }
 
-/// Loads onnxruntime once per process (later calls return the first outcome) and returns the
-/// library's path.
-pub fn init() -> Result<PathBuf, RuntimeLibraryError> {
-    static LOADED: OnceLock<Result<Loaded, RuntimeLibraryError>> = OnceLock::new();
+/// Loads onnxruntime once per process; later calls return the first outcome.
+pub fn init() -> Result<&'static OnnxRuntime, RuntimeLibraryError> {
+    static LOADED: OnceLock<Result<OnnxRuntime, RuntimeLibraryError>> = OnceLock::new();
     let loaded = LOADED.get_or_init(|| {
         let path = locate_library()?;
         let failed = |message: String| RuntimeLibraryError::LoadFailed {
@@ -141,13 +149,52 @@ pub fn init() -> Result<PathBuf, RuntimeLibraryError> {
             .with_telemetry(false)
             .build()
             .map_err(|e| failed(e.to_string()))?;
-        Ok(Loaded {
-            path: path.clone(),
-            _environment: environment,
-        })
+        Ok(OnnxRuntime { path, environment })
     });
-    match loaded {
-        Ok(l) => Ok(l.path.clone()),
-        Err(e) => Err(e.clone()),
+    loaded.as_ref().map_err(Clone::clone)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn temp_root(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("sinmdm-ort-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn finds_the_library_in_a_project_venv() {
+        let root = temp_root("venv");
+        let capi = root.join(".venv/lib/python3.12/site-packages/onnxruntime/capi");
+        std::fs::create_dir_all(&capi).unwrap();
+        let lib = capi.join(library_names()[0]);
+        std::fs::write(&lib, b"").unwrap();
+        let elsewhere = temp_root("empty");
+        assert_eq!(
+            locate_in(None, &[elsewhere.clone(), root.clone()]).unwrap(),
+            lib
+        );
+        std::fs::remove_dir_all(root).unwrap();
+        std::fs::remove_dir_all(elsewhere).unwrap();
+    }
+
+    #[test]
+    fn the_environment_variable_wins_and_must_exist() {
+        let missing = PathBuf::from("/nonexistent/libonnxruntime.so");
+        let e = locate_in(Some(missing.clone().into()), &[]).unwrap_err();
+        assert!(matches!(e, RuntimeLibraryError::EnvPathMissing(p) if p == missing));
+    }
+
+    #[test]
+    fn not_found_says_what_to_run() {
+        let root = temp_root("none");
+        let e = locate_in(None, std::slice::from_ref(&root)).unwrap_err();
+        let message = e.to_string();
+        assert!(message.contains("scripts/setup.sh"), "{message}");
+        assert!(message.contains("ORT_DYLIB_PATH"), "{message}");
+        std::fs::remove_dir_all(root).unwrap();
     }
 }

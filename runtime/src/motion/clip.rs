@@ -34,12 +34,10 @@ pub struct ChannelClip {
 impl ChannelClip {
     /// Number of frames.
     pub fn frame_count(&self) -> usize {
-        let width = self.skeleton.channel_count();
-        if width == 0 {
-            0
-        } else {
-            self.values.len() / width
-        }
+        self.values
+            .len()
+            .checked_div(self.skeleton.channel_count())
+            .unwrap_or(0)
     }
 
     /// The values of one frame.

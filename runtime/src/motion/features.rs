@@ -278,7 +278,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         return Err(MotionError::BadFrameRate(fps));
     }
     let resampled = (clip.frame_count() as f64 - 1.0) * fps / clip.fps + 1.0;
-    if !(resampled <= MAX_FRAMES as f64) {
+    if resampled.is_nan() || resampled > MAX_FRAMES as f64 {
         return Err(MotionError::TooManyFrames {
             frames: clip.frame_count(),
             from_fps: clip.fps,

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Sets up a fresh checkout: a project-local Python virtual environment (.venv) with the pinned
+# onnxruntime wheel, whose shared library the Rust runtime loads, then a release build.
+# Safe to run again: it only reinstalls when scripts/requirements.txt changed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+python=${PYTHON:-python3}
+if ! command -v "$python" >/dev/null; then
+  echo "setup: $python not found; install Python 3.10+ or set PYTHON=/path/to/python3" >&2
+  exit 1
+fi
+if ! command -v cargo >/dev/null; then
+  echo "setup: cargo not found; install Rust from https://rustup.rs" >&2
+  exit 1
+fi
+
+if [ ! -x .venv/bin/python ]; then
+  echo "setup: creating .venv"
+  "$python" -m venv .venv
+fi
+stamp=.venv/.sinmdm-requirements
+if ! cmp -s scripts/requirements.txt "$stamp"; then
+  echo "setup: installing Python packages (onnxruntime, onnx, numpy, bvhio, pytest)"
+  .venv/bin/python -m pip install --quiet --disable-pip-version-check -r scripts/requirements.txt
+  cp scripts/requirements.txt "$stamp"
+fi
+lib=$(ls .venv/lib/python3*/site-packages/onnxruntime/capi/libonnxruntime.so.* 2>/dev/null | head -n 1 || true)
+if [ -z "$lib" ]; then
+  echo "setup: the onnxruntime wheel has no shared library in .venv; remove .venv and run again" >&2
+  exit 1
+fi
+echo "setup: onnxruntime library at $lib"
+
+echo "setup: building (release)"
+cargo build --release --workspace --quiet
+echo "setup: done"
