@@ -21,6 +21,7 @@
 pub mod bvh;
 #[cfg(feature = "cli")]
 pub mod cli;
+pub mod diffusion;
 pub mod files;
 pub mod motion;
 pub mod onnxruntime;
