@@ -204,3 +204,37 @@ fn cli_reports_bad_input_and_writes_no_partial_output() {
     assert!(String::from_utf8_lossy(&run.stderr).contains("--fps must be a positive number"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn bad_encoder_settings_are_errors() {
+    use sinmdm::motion::{ContactConfig, EncodeOptions, MotionError, encode};
+    let clip = parse_bvh(VALID, "clip.bvh").unwrap();
+    let with =
+        |contacts: ContactConfig, fps: Option<f64>| encode(&clip, &EncodeOptions { fps, contacts });
+    let unknown = ContactConfig {
+        joints: Some(vec!["LeftFoot".into()]),
+        ..ContactConfig::default()
+    };
+    match with(unknown, None).unwrap_err() {
+        MotionError::UnknownContactJoint { name, available } => {
+            assert_eq!(name, "LeftFoot");
+            assert_eq!(available, "Hips, Spine");
+        }
+        other => panic!("wrong error {other:?}"),
+    }
+    let negative = ContactConfig {
+        speed_threshold: -1.0,
+        ..ContactConfig::default()
+    };
+    assert!(matches!(
+        with(negative, None).unwrap_err(),
+        MotionError::BadContactSetting {
+            what: "speed threshold",
+            ..
+        }
+    ));
+    assert!(matches!(
+        with(ContactConfig::default(), Some(0.0)).unwrap_err(),
+        MotionError::BadFrameRate(_)
+    ));
+}

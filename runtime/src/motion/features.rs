@@ -37,6 +37,14 @@ pub enum MotionError {
         /// The skeleton's joint names, comma-separated.
         available: String,
     },
+    /// A contact threshold or ground fraction that is negative or not a number.
+    #[error("contact {what} must be a finite number >= 0, got {value}")]
+    BadContactSetting {
+        /// Which setting.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+    },
     /// A target frame rate that is zero, negative or not a number.
     #[error("frame rate must be a positive number, got {0}")]
     BadFrameRate(f64),
@@ -276,6 +284,14 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
     let fps = options.fps.unwrap_or(clip.fps);
     if !(fps.is_finite() && fps > 0.0) {
         return Err(MotionError::BadFrameRate(fps));
+    }
+    for (what, value) in [
+        ("speed threshold", options.contacts.speed_threshold),
+        ("ground fraction", options.contacts.ground_fraction),
+    ] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(MotionError::BadContactSetting { what, value });
+        }
     }
     let resampled = (clip.frame_count() as f64 - 1.0) * fps / clip.fps + 1.0;
     if resampled.is_nan() || resampled > MAX_FRAMES as f64 {
