@@ -333,6 +333,33 @@ impl<'a> Parser<'a> {
         Ok(channels)
     }
 
+    /// The next non-empty line as a `WORDS: VALUE` header; returns its line number and value.
+    fn header<'t>(
+        &self,
+        lines: &mut impl Iterator<Item = (usize, &'t str)>,
+        words: &[&str],
+        expected: &'static str,
+    ) -> Result<(usize, &'t str), BvhError> {
+        let (line, text) = lines.next().ok_or_else(|| {
+            self.error(
+                Some(self.last_line()),
+                BvhErrorKind::UnexpectedEnd {
+                    expected: expected.to_string(),
+                },
+            )
+        })?;
+        let value = header_value(text, words).ok_or_else(|| {
+            self.error(
+                Some(line),
+                BvhErrorKind::Expected {
+                    expected,
+                    found: text.to_string(),
+                },
+            )
+        })?;
+        Ok((line, value))
+    }
+
     /// The MOTION block: `Frames:`, `Frame Time:` and one line of values per frame.
     fn motion(&self, skeleton: Skeleton, first_line: usize) -> Result<ChannelClip, BvhError> {
         let mut lines = self.lines[first_line..]
@@ -341,23 +368,7 @@ impl<'a> Parser<'a> {
             .map(|(i, l)| (first_line + i + 1, l.trim()))
             .filter(|(_, l)| !l.is_empty());
 
-        let (frames_line, text) = lines.next().ok_or_else(|| {
-            self.error(
-                Some(self.last_line()),
-                BvhErrorKind::UnexpectedEnd {
-                    expected: "'Frames:'".to_string(),
-                },
-            )
-        })?;
-        let count_text = header_value(text, &["Frames"]).ok_or_else(|| {
-            self.error(
-                Some(frames_line),
-                BvhErrorKind::Expected {
-                    expected: "'Frames: N'",
-                    found: text.to_string(),
-                },
-            )
-        })?;
+        let (frames_line, count_text) = self.header(&mut lines, &["Frames"], "'Frames: N'")?;
         let announced: usize = count_text.parse().map_err(|_| {
             self.error(
                 Some(frames_line),
@@ -370,24 +381,8 @@ impl<'a> Parser<'a> {
         if announced == 0 {
             return Err(self.error(Some(frames_line), BvhErrorKind::ZeroFrames));
         }
-
-        let (time_line, text) = lines.next().ok_or_else(|| {
-            self.error(
-                Some(self.last_line()),
-                BvhErrorKind::UnexpectedEnd {
-                    expected: "'Frame Time:'".to_string(),
-                },
-            )
-        })?;
-        let time_text = header_value(text, &["Frame", "Time"]).ok_or_else(|| {
-            self.error(
-                Some(time_line),
-                BvhErrorKind::Expected {
-                    expected: "'Frame Time: SECONDS'",
-                    found: text.to_string(),
-                },
-            )
-        })?;
+        let (time_line, time_text) =
+            self.header(&mut lines, &["Frame", "Time"], "'Frame Time: SECONDS'")?;
         let frame_time = match time_text.parse::<f64>() {
             Ok(t) if t.is_finite() && t > 0.0 => t,
             _ => {

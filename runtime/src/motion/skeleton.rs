@@ -109,24 +109,22 @@ pub struct Joint {
 impl Joint {
     /// The rotation axes in the order the file lists them: `[Z, X, Y]` means `R = Rz * Rx * Ry`.
     pub fn rotation_order(&self) -> Vec<Axis> {
-        self.channels
-            .iter()
-            .filter_map(|c| match c {
-                Channel::Rotation(a) => Some(*a),
-                Channel::Position(_) => None,
-            })
-            .collect()
+        self.axes_of(|c| match c {
+            Channel::Rotation(a) => Some(a),
+            Channel::Position(_) => None,
+        })
     }
 
     /// The position axes the joint animates, in file order.
     pub fn position_axes(&self) -> Vec<Axis> {
-        self.channels
-            .iter()
-            .filter_map(|c| match c {
-                Channel::Position(a) => Some(*a),
-                Channel::Rotation(_) => None,
-            })
-            .collect()
+        self.axes_of(|c| match c {
+            Channel::Position(a) => Some(a),
+            Channel::Rotation(_) => None,
+        })
+    }
+
+    fn axes_of(&self, pick: impl Fn(Channel) -> Option<Axis>) -> Vec<Axis> {
+        self.channels.iter().filter_map(|&c| pick(c)).collect()
     }
 
     /// Whether the joint has at least one rotation channel.
