@@ -1,5 +1,21 @@
 //! # sinmdm-train
 //!
-//! Fits the single-motion QnA-UNet denoiser on one BVH clip with burn, reading the clip through
-//! the runtime crate's motion representation. The model and training loop are not built yet;
-//! this crate reserves its place in the workspace.
+//! Fits the QnA-UNet denoiser of single-motion diffusion on one BVH clip with burn (CPU `flex`
+//! backend by default; `cuda` and `wgpu` features for GPUs), and saves checkpoints that the
+//! export step turns into the `.onnx` file the runtime ships with.
+
+pub mod checkpoint;
+pub mod clip_data;
+pub mod clock;
+pub mod config;
+pub mod data;
+pub mod error;
+pub mod loss_log;
+pub mod loss_plot;
+pub mod model;
+pub mod trainer;
+
+pub use config::TrainConfig;
+pub use error::TrainError;
+pub use model::QnaUnet;
+pub use trainer::{RunEnd, StepReport, Trainer};

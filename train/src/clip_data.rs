@@ -1,0 +1,99 @@
+//! The clip a model learns: read, encoded, normalised, and fingerprinted.
+
+use std::path::Path;
+
+use ndarray::Array2;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use sinmdm::motion::{ContactConfig, EncodeOptions, FeatureLayout, Normalizer, encode};
+
+use crate::config::{DataConfig, ModelConfig};
+use crate::error::TrainError;
+
+/// What a trained model must remember about its clip (saved in every checkpoint, and later in
+/// the ONNX metadata).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ClipFacts {
+    /// File name of the clip.
+    pub name: String,
+    /// SHA-256 of the clip file, hex.
+    pub sha256: String,
+    /// Frames after resampling.
+    pub frames: usize,
+    /// Column layout and static skeleton data.
+    pub layout: FeatureLayout,
+    /// Per-feature mean and std of the clip.
+    pub normalizer: Normalizer,
+}
+
+/// A clip ready for training: its facts and normalised features `[F, N]`.
+#[derive(Debug, Clone)]
+pub struct ClipData {
+    /// The facts a checkpoint keeps.
+    pub facts: ClipFacts,
+    /// Normalised features `[F, N]`.
+    pub features: Array2<f32>,
+}
+
+/// Hex SHA-256 of bytes.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+impl ClipData {
+    /// Reads, encodes and normalises `path`; rejects a clip shorter than the receptive field.
+    pub fn load(
+        path: &Path,
+        data: &DataConfig,
+        model: &ModelConfig,
+    ) -> Result<ClipData, TrainError> {
+        let bytes = std::fs::read(path).map_err(|source| TrainError::Io {
+            what: "read the clip",
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let text = String::from_utf8_lossy(&bytes);
+        let clip = sinmdm::bvh::parse_bvh(&text, &path.display().to_string())?;
+        let options = EncodeOptions {
+            fps: data.fps,
+            contacts: ContactConfig {
+                joints: data.contact_joints.clone(),
+                speed_threshold: data.contact_speed,
+                ..ContactConfig::default()
+            },
+        };
+        let encoded = encode(&clip, &options).map_err(|source| TrainError::Motion {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let frames = encoded.features.ncols();
+        if frames < model.receptive_field() {
+            return Err(TrainError::ClipTooShort {
+                path: path.to_path_buf(),
+                frames,
+                fps: encoded.layout.fps,
+                receptive_field: model.receptive_field(),
+            });
+        }
+        let normalizer = Normalizer::fit(encoded.features.view());
+        let features = normalizer.normalize(encoded.features.view());
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Ok(ClipData {
+            facts: ClipFacts {
+                name,
+                sha256: sha256_hex(&bytes),
+                frames,
+                layout: encoded.layout,
+                normalizer,
+            },
+            features,
+        })
+    }
+}

@@ -1,0 +1,250 @@
+//! Training configuration, read from YAML with every key checked.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::TrainError;
+
+/// A whole training configuration (`configs/*.yaml`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainConfig {
+    /// The denoiser's shape.
+    pub model: ModelConfig,
+    /// The diffusion process.
+    pub diffusion: DiffusionConfig,
+    /// The optimisation.
+    pub training: TrainingConfig,
+    /// How the clip becomes features.
+    pub data: DataConfig,
+}
+
+/// The QnA-UNet's shape (SPEC §3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelConfig {
+    /// Channels C of every block (a multiple of 32, for GroupNorm(32)).
+    pub channels: usize,
+    /// Attention heads H of the QnA blocks (must divide `channels`).
+    pub heads: usize,
+    /// QnA window k in frames (odd).
+    pub window: usize,
+    /// Dropout probability inside the residual blocks, in [0, 1).
+    pub dropout: f64,
+}
+
+/// The diffusion process (SPEC §4).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiffusionConfig {
+    /// Number of diffusion steps T of the cosine schedule.
+    pub steps: usize,
+}
+
+/// The optimisation (SPEC §4).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainingConfig {
+    /// Optimiser steps.
+    pub steps: u64,
+    /// Copies of the clip per step.
+    pub batch_size: usize,
+    /// AdamW learning rate at step 0.
+    pub learning_rate: f64,
+    /// Factor applied to the learning rate after every step.
+    pub lr_decay: f64,
+    /// AdamW weight decay.
+    pub weight_decay: f64,
+    /// Smallest temporal resampling factor of the clip per step.
+    pub resample_min: f64,
+    /// Largest temporal resampling factor of the clip per step.
+    pub resample_max: f64,
+    /// Seed of the weights, timesteps, noise, resampling and dropout.
+    pub seed: u64,
+    /// Steps between checkpoints (the last step is always saved).
+    pub checkpoint_every: u64,
+}
+
+/// How the clip becomes features (SPEC §2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DataConfig {
+    /// Frame rate the clip is resampled to; `null` keeps the clip's own.
+    pub fps: Option<f64>,
+    /// Contact joints by name; `null` picks them automatically.
+    pub contact_joints: Option<Vec<String>>,
+    /// Contact speed threshold in skeleton heights per second.
+    pub contact_speed: f64,
+}
+
+impl TrainConfig {
+    /// Reads and checks a YAML file.
+    pub fn load(path: &Path) -> Result<TrainConfig, TrainError> {
+        let text = std::fs::read_to_string(path).map_err(|source| TrainError::Io {
+            what: "read the config",
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let config = Self::parse(&text).map_err(|message| TrainError::Config {
+            path: path.to_path_buf(),
+            message,
+        })?;
+        Ok(config)
+    }
+
+    /// Parses and checks YAML text; the error names the key and line.
+    pub fn parse(text: &str) -> Result<TrainConfig, String> {
+        let config: TrainConfig = serde_yaml::from_str(text).map_err(|e| e.to_string())?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// Checks every value; the error names the key.
+    pub fn validate(&self) -> Result<(), String> {
+        let m = &self.model;
+        let t = &self.training;
+        let positive = [
+            ("model.channels", m.channels as f64),
+            ("model.heads", m.heads as f64),
+            ("model.window", m.window as f64),
+            ("training.steps", t.steps as f64),
+            ("training.batch_size", t.batch_size as f64),
+            ("training.learning_rate", t.learning_rate),
+            ("training.lr_decay", t.lr_decay),
+            ("training.resample_min", t.resample_min),
+            ("training.resample_max", t.resample_max),
+            ("training.checkpoint_every", t.checkpoint_every as f64),
+            ("data.contact_speed", self.data.contact_speed),
+        ];
+        for (key, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(format!("{key} must be a positive number, got {value}"));
+            }
+        }
+        if m.channels % crate::model::NORM_GROUPS != 0 {
+            return Err(format!(
+                "model.channels must be a multiple of {} (GroupNorm groups), got {}",
+                crate::model::NORM_GROUPS,
+                m.channels
+            ));
+        }
+        if m.channels % m.heads != 0 {
+            return Err(format!(
+                "model.heads ({}) must divide model.channels ({})",
+                m.heads, m.channels
+            ));
+        }
+        if m.window % 2 == 0 {
+            return Err(format!("model.window must be odd, got {}", m.window));
+        }
+        if !(0.0..1.0).contains(&m.dropout) {
+            return Err(format!(
+                "model.dropout must be in [0, 1), got {}",
+                m.dropout
+            ));
+        }
+        if self.diffusion.steps < 2 {
+            return Err(format!(
+                "diffusion.steps must be at least 2, got {}",
+                self.diffusion.steps
+            ));
+        }
+        if t.lr_decay > 1.0 {
+            return Err(format!(
+                "training.lr_decay must be at most 1, got {}",
+                t.lr_decay
+            ));
+        }
+        if !(t.weight_decay.is_finite() && t.weight_decay >= 0.0) {
+            return Err(format!(
+                "training.weight_decay must be zero or positive, got {}",
+                t.weight_decay
+            ));
+        }
+        if t.resample_min > t.resample_max {
+            return Err(format!(
+                "training.resample_min ({}) must not exceed training.resample_max ({})",
+                t.resample_min, t.resample_max
+            ));
+        }
+        if let Some(fps) = self.data.fps
+            && !(fps.is_finite() && fps > 0.0)
+        {
+            return Err(format!(
+                "data.fps must be a positive number or null, got {fps}"
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl ModelConfig {
+    /// Frames on each side of a frame that can change its prediction: the input and output
+    /// convolutions (1 each), two k3 convolutions in each of the 3 residual blocks (2 each) and
+    /// the 3 QnA windows.
+    pub fn receptive_half_width(&self) -> usize {
+        1 + 3 * 2 + 3 * (self.window - 1) / 2 + 1
+    }
+
+    /// The receptive field in frames (23 for window 3).
+    pub fn receptive_field(&self) -> usize {
+        2 * self.receptive_half_width() + 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TINY: &str = include_str!("../../configs/tiny.yaml");
+
+    #[test]
+    fn shipped_configs_parse() {
+        for text in [
+            TINY,
+            include_str!("../../configs/cpu.yaml"),
+            include_str!("../../configs/paper.yaml"),
+        ] {
+            TrainConfig::parse(text).unwrap();
+        }
+        let paper = TrainConfig::parse(include_str!("../../configs/paper.yaml")).unwrap();
+        assert_eq!(paper.model.channels, 256);
+        assert_eq!(paper.training.batch_size, 64);
+        assert_eq!(paper.training.steps, 60_000);
+        assert_eq!(paper.model.receptive_field(), 23);
+    }
+
+    #[test]
+    fn unknown_key_is_named_with_its_line() {
+        let text = TINY.replacen("channels:", "chanels:", 1);
+        let err = TrainConfig::parse(&text).unwrap_err();
+        assert!(err.contains("unknown field `chanels`"), "{err}");
+        assert!(err.contains("line"), "{err}");
+    }
+
+    #[test]
+    fn bad_sizes_are_named() {
+        let cases = [
+            ("batch_size: 4", "batch_size: 0", "training.batch_size"),
+            ("channels: 32", "channels: 0", "model.channels"),
+            ("channels: 32", "channels: 40", "multiple of 32"),
+            (
+                "learning_rate: 2.0e-3",
+                "learning_rate: -1.0",
+                "training.learning_rate",
+            ),
+            ("window: 3", "window: 4", "model.window must be odd"),
+            ("heads: 4", "heads: 3", "model.heads"),
+        ];
+        for (from, to, expected) in cases {
+            assert!(TINY.contains(from), "tiny.yaml lacks `{from}`");
+            let err = TrainConfig::parse(&TINY.replacen(from, to, 1)).unwrap_err();
+            assert!(err.contains(expected), "{to}: {err}");
+        }
+        // A negative size is not even a number of the right type: serde names the field.
+        let err =
+            TrainConfig::parse(&TINY.replacen("batch_size: 4", "batch_size: -4", 1)).unwrap_err();
+        assert!(err.contains("batch_size"), "{err}");
+    }
+}

@@ -1,0 +1,85 @@
+//! Errors of the training crate; each names the file, key or setting at fault.
+
+use std::path::PathBuf;
+
+/// Everything that can stop a training run.
+#[derive(Debug, thiserror::Error)]
+pub enum TrainError {
+    /// A file could not be read or written.
+    #[error("could not {what} '{}': {source}", path.display())]
+    Io {
+        /// What was being done.
+        what: &'static str,
+        /// The file or folder.
+        path: PathBuf,
+        /// The system's reason.
+        source: std::io::Error,
+    },
+    /// The configuration is malformed or holds a bad value.
+    #[error("{}: {message}", path.display())]
+    Config {
+        /// The config file.
+        path: PathBuf,
+        /// What is wrong (names the key).
+        message: String,
+    },
+    /// The clip could not be read.
+    #[error(transparent)]
+    Bvh(#[from] sinmdm::bvh::BvhError),
+    /// The clip could not be turned into features.
+    #[error("{}: {source}", path.display())]
+    Motion {
+        /// The clip.
+        path: PathBuf,
+        /// The reason.
+        source: sinmdm::motion::MotionError,
+    },
+    /// The clip is shorter than what the network sees at once.
+    #[error(
+        "{}: the clip has {frames} frames at {fps} fps, fewer than the model's receptive field of {receptive_field} frames; use a longer clip or a higher data.fps",
+        path.display()
+    )]
+    ClipTooShort {
+        /// The clip.
+        path: PathBuf,
+        /// Frames after resampling.
+        frames: usize,
+        /// The training frame rate.
+        fps: f64,
+        /// The receptive field.
+        receptive_field: usize,
+    },
+    /// A checkpoint cannot be used for this run.
+    #[error("{}: {message}", path.display())]
+    Checkpoint {
+        /// The checkpoint or run folder.
+        path: PathBuf,
+        /// What does not fit.
+        message: String,
+    },
+    /// The loss stopped being a finite number.
+    #[error(
+        "the loss became {loss} at step {step}; stopped without saving. The last good checkpoint is {}",
+        last_checkpoint.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "none (no checkpoint was written yet)".into())
+    )]
+    NonFiniteLoss {
+        /// The offending loss value.
+        loss: f64,
+        /// The step it appeared at.
+        step: u64,
+        /// The newest checkpoint on disk.
+        last_checkpoint: Option<PathBuf>,
+    },
+}
+
+/// A closure turning an I/O error into [`TrainError::Io`] about `path`.
+pub(crate) fn io<'a>(
+    what: &'static str,
+    path: &'a std::path::Path,
+) -> impl FnOnce(std::io::Error) -> TrainError + 'a {
+    move |source| TrainError::Io {
+        what,
+        path: path.to_path_buf(),
+        source,
+    }
+}

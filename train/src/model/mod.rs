@@ -1,0 +1,36 @@
+//! The QnA-UNet denoiser in burn: timestep embedding, residual blocks, QnA attention.
+
+pub mod qna;
+pub mod resblock;
+pub mod timestep;
+pub mod unet;
+pub mod weights;
+
+use burn::module::{Module, ModuleVisitor, Param};
+use burn::nn::{GroupNorm, GroupNormConfig};
+use burn::tensor::{Device, Tensor};
+
+pub use unet::QnaUnet;
+
+/// Groups of every GroupNorm in the network.
+pub const NORM_GROUPS: usize = 32;
+
+/// GroupNorm(32) with epsilon 1e-5 and affine weights.
+pub(crate) fn group_norm(channels: usize, device: &Device) -> GroupNorm {
+    GroupNormConfig::new(NORM_GROUPS, channels)
+        .with_epsilon(1e-5)
+        .with_affine(true)
+        .init(device)
+}
+
+/// Draws every lazily initialised parameter now, in module order, so the weights depend only on
+/// the seed and not on the order of later tensor operations.
+pub(crate) fn materialize<M: Module>(module: &M) {
+    struct Touch;
+    impl ModuleVisitor for Touch {
+        fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+            let _ = param.val();
+        }
+    }
+    module.visit(&mut Touch);
+}

@@ -1,0 +1,420 @@
+//! The training loop: batches, loss, AdamW with a decaying learning rate, checkpoints, resume.
+
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use burn::module::Module;
+use burn::nn::loss::{MseLoss, Reduction};
+use burn::optim::{AdamWConfig, GradientsParams, ModuleOptimizer};
+use burn::tensor::{Device, Tensor, TensorData};
+
+use sinmdm::diffusion::Schedule;
+
+use crate::checkpoint::{self, CheckpointState};
+use crate::clip_data::ClipData;
+use crate::config::TrainConfig;
+use crate::data::make_batch;
+use crate::error::{TrainError, io};
+use crate::loss_log::LossLog;
+use crate::model::QnaUnet;
+
+/// Copy of the clip inside the run folder, so a run resumes without the original file.
+pub const CLIP_COPY: &str = "clip.bvh";
+/// Copy of the configuration inside the run folder.
+pub const CONFIG_COPY: &str = "config.yaml";
+/// The loss log inside the run folder.
+pub const LOSS_LOG: &str = "loss.csv";
+/// Steps averaged into `recent_loss`.
+const RECENT_STEPS: usize = 100;
+
+/// How a call to [`Trainer::run`] ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunEnd {
+    /// All configured steps are done; the final checkpoint is at the path.
+    Finished(PathBuf),
+    /// The stop flag was raised; a checkpoint of the last completed step is at the path.
+    Interrupted(PathBuf),
+}
+
+/// What the loop reports after each step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepReport {
+    /// Steps completed.
+    pub step: u64,
+    /// Steps configured.
+    pub total: u64,
+    /// This step's loss.
+    pub loss: f64,
+    /// Mean loss over the last 100 steps.
+    pub recent_loss: f64,
+    /// Learning rate used by this step.
+    pub learning_rate: f64,
+}
+
+/// A training run in a run folder.
+pub struct Trainer {
+    run: PathBuf,
+    device: Device,
+    model: Option<QnaUnet>,
+    optimizer: ModuleOptimizer,
+    schedule: Schedule,
+    clip: ClipData,
+    state: CheckpointState,
+    recent: VecDeque<f64>,
+    log: LossLog,
+    session_start: Instant,
+    elapsed_before: f64,
+    last_checkpoint: Option<PathBuf>,
+}
+
+/// The optimiser of a configuration (AdamW, epsilon 1e-8 as in PyTorch).
+pub fn new_optimizer(config: &TrainConfig) -> ModuleOptimizer {
+    AdamWConfig::new()
+        .with_weight_decay(config.training.weight_decay as f32)
+        .with_epsilon(1e-8)
+        .init()
+}
+
+/// One AdamW step on the x0-prediction MSE of `model` for the batch `(x_t, t) -> x0`. Returns
+/// the updated model and the loss; when the loss is not finite the model comes back unchanged.
+pub fn optimisation_step(
+    model: QnaUnet,
+    optimizer: &mut ModuleOptimizer,
+    x_t: Tensor<3>,
+    t: Tensor<1>,
+    x0: Tensor<3>,
+    learning_rate: f64,
+) -> (QnaUnet, f64) {
+    let prediction = model.forward(x_t, t);
+    let loss = MseLoss::new().forward(prediction, x0, Reduction::Mean);
+    let value = f64::from(loss.clone().into_scalar::<f32>());
+    if !value.is_finite() {
+        return (model, value);
+    }
+    let grads = GradientsParams::from_grads(loss.backward(), &model);
+    (optimizer.step(learning_rate, model, grads), value)
+}
+
+/// The schedule of a configuration.
+fn schedule(config: &TrainConfig) -> Schedule {
+    Schedule::cosine(config.diffusion.steps).expect("validated configuration has T >= 2")
+}
+
+/// The fields two configurations must share for a checkpoint of one to continue under the
+/// other: everything except the step count and checkpoint interval.
+fn incompatible_field(saved: &TrainConfig, asked: &TrainConfig) -> Option<String> {
+    let m = (&saved.model, &asked.model);
+    let checks: [(&str, String, String); 12] = [
+        (
+            "model.channels",
+            m.0.channels.to_string(),
+            m.1.channels.to_string(),
+        ),
+        ("model.heads", m.0.heads.to_string(), m.1.heads.to_string()),
+        (
+            "model.window",
+            m.0.window.to_string(),
+            m.1.window.to_string(),
+        ),
+        (
+            "model.dropout",
+            m.0.dropout.to_string(),
+            m.1.dropout.to_string(),
+        ),
+        (
+            "diffusion.steps",
+            saved.diffusion.steps.to_string(),
+            asked.diffusion.steps.to_string(),
+        ),
+        (
+            "training.batch_size",
+            saved.training.batch_size.to_string(),
+            asked.training.batch_size.to_string(),
+        ),
+        (
+            "training.learning_rate",
+            saved.training.learning_rate.to_string(),
+            asked.training.learning_rate.to_string(),
+        ),
+        (
+            "training.lr_decay",
+            saved.training.lr_decay.to_string(),
+            asked.training.lr_decay.to_string(),
+        ),
+        (
+            "training.weight_decay",
+            saved.training.weight_decay.to_string(),
+            asked.training.weight_decay.to_string(),
+        ),
+        (
+            "training.resample_min/max",
+            format!(
+                "{}..{}",
+                saved.training.resample_min, saved.training.resample_max
+            ),
+            format!(
+                "{}..{}",
+                asked.training.resample_min, asked.training.resample_max
+            ),
+        ),
+        (
+            "training.seed",
+            saved.training.seed.to_string(),
+            asked.training.seed.to_string(),
+        ),
+        (
+            "data",
+            format!("{:?}", saved.data),
+            format!("{:?}", asked.data),
+        ),
+    ];
+    checks
+        .into_iter()
+        .find(|(_, a, b)| a != b)
+        .map(|(key, a, b)| {
+            format!("the checkpoint was trained with {key} = {a}, the config asks for {b}")
+        })
+}
+
+impl Trainer {
+    /// Starts a new run of `config` on `clip` in the folder `run` (created if needed; it must
+    /// not already hold a run).
+    pub fn start(
+        clip: &Path,
+        config: TrainConfig,
+        run: &Path,
+        device: Device,
+    ) -> Result<Trainer, TrainError> {
+        if checkpoint::latest(run)?.is_some() || run.join(LOSS_LOG).exists() {
+            return Err(TrainError::Checkpoint {
+                path: run.to_path_buf(),
+                message: "already holds a training run; pass --resume to continue it, or choose another --out".into(),
+            });
+        }
+        let data = ClipData::load(clip, &config.data, &config.model)?;
+        std::fs::create_dir_all(run).map_err(io("create the output folder", run))?;
+        let yaml = serde_yaml::to_string(&config).expect("config serialises");
+        sinmdm::files::write_atomically(&run.join(CONFIG_COPY), yaml.as_bytes())
+            .map_err(io("write into the output folder", run))?;
+        let clip_bytes = std::fs::read(clip).map_err(io("read the clip", clip))?;
+        sinmdm::files::write_atomically(&run.join(CLIP_COPY), &clip_bytes)
+            .map_err(io("write into the output folder", run))?;
+        let log = LossLog::create(&run.join(LOSS_LOG))?;
+        device.seed(config.training.seed);
+        let features = data.features.nrows();
+        let model = QnaUnet::new(features, &config.model, &device);
+        let state = CheckpointState {
+            step: 0,
+            learning_rate: config.training.learning_rate,
+            loss: f64::NAN,
+            recent_loss: f64::NAN,
+            elapsed_seconds: 0.0,
+            parameters: model.num_params(),
+            features,
+            clip: data.facts.clone(),
+            started: crate::clock::now(),
+            config: config.clone(),
+        };
+        Ok(Trainer {
+            run: run.to_path_buf(),
+            device,
+            model: Some(model),
+            optimizer: new_optimizer(&config),
+            schedule: schedule(&config),
+            clip: data,
+            state,
+            recent: VecDeque::new(),
+            log,
+            session_start: Instant::now(),
+            elapsed_before: 0.0,
+            last_checkpoint: None,
+        })
+    }
+
+    /// Continues the run in `run` from its newest checkpoint. A `config`, when given, must
+    /// describe the same model and training (only `training.steps` and
+    /// `training.checkpoint_every` may change); a `clip`, when given, must be the same file.
+    pub fn resume(
+        run: &Path,
+        clip: Option<&Path>,
+        config: Option<TrainConfig>,
+        device: Device,
+    ) -> Result<Trainer, TrainError> {
+        let dir = checkpoint::latest(run)?.ok_or_else(|| TrainError::Checkpoint {
+            path: run.to_path_buf(),
+            message: "holds no checkpoint to resume from".into(),
+        })?;
+        let mut state = checkpoint::load_state(&dir)?;
+        if let Some(asked) = &config {
+            if let Some(message) = incompatible_field(&state.config, asked) {
+                return Err(TrainError::Checkpoint { path: dir, message });
+            }
+            state.config.training.steps = asked.training.steps;
+            state.config.training.checkpoint_every = asked.training.checkpoint_every;
+        }
+        let clip_path = match clip {
+            Some(p) => p.to_path_buf(),
+            None => run.join(CLIP_COPY),
+        };
+        let data = ClipData::load(&clip_path, &state.config.data, &state.config.model)?;
+        if data.facts.sha256 != state.clip.sha256 {
+            return Err(TrainError::Checkpoint {
+                path: clip_path,
+                message: format!(
+                    "is not the clip this run learns ({}, SHA-256 {})",
+                    state.clip.name, state.clip.sha256
+                ),
+            });
+        }
+        if data.features.nrows() != state.features {
+            return Err(TrainError::Checkpoint {
+                path: dir,
+                message: format!(
+                    "the model reads {} feature rows, the clip gives {}",
+                    state.features,
+                    data.features.nrows()
+                ),
+            });
+        }
+        let model = QnaUnet::new(state.features, &state.config.model, &device);
+        let model = checkpoint::load_model(&dir, model)?;
+        let optimizer = checkpoint::load_optimizer(&dir, new_optimizer(&state.config))?;
+        let log = LossLog::resume(&run.join(LOSS_LOG), state.step)?;
+        let elapsed_before = state.elapsed_seconds;
+        Ok(Trainer {
+            run: run.to_path_buf(),
+            device,
+            model: Some(model),
+            optimizer,
+            schedule: schedule(&state.config),
+            clip: data,
+            state,
+            recent: VecDeque::new(),
+            log,
+            session_start: Instant::now(),
+            elapsed_before,
+            last_checkpoint: Some(dir),
+        })
+    }
+
+    /// The checkpoint state as of now.
+    pub fn state(&self) -> &CheckpointState {
+        &self.state
+    }
+
+    /// The network being trained.
+    pub fn model(&self) -> &QnaUnet {
+        self.model.as_ref().expect("model present between steps")
+    }
+
+    /// The run folder.
+    pub fn run_dir(&self) -> &Path {
+        &self.run
+    }
+
+    /// Whether all configured steps are done.
+    pub fn finished(&self) -> bool {
+        self.state.step >= self.state.config.training.steps
+    }
+
+    fn elapsed(&self) -> f64 {
+        self.elapsed_before + self.session_start.elapsed().as_secs_f64()
+    }
+
+    /// Runs one optimiser step and returns its report. A non-finite loss is an error and
+    /// changes nothing.
+    pub fn step(&mut self) -> Result<StepReport, TrainError> {
+        let config = &self.state.config;
+        let step = self.state.step;
+        // The flex RNG (dropout) is reseeded every step so a resumed run draws what an
+        // uninterrupted one would.
+        self.device.seed(sinmdm::diffusion::noise::mix(
+            config.training.seed ^ step.wrapping_mul(0x9E37_79B9),
+        ));
+        let batch = make_batch(
+            self.clip.features.view(),
+            &self.schedule,
+            config.training.batch_size,
+            (config.training.resample_min, config.training.resample_max),
+            config.training.seed,
+            step,
+        );
+        let shape = [batch.batch, batch.features, batch.frames];
+        let noised = Tensor::<3>::from_data(TensorData::new(batch.noised, shape), &self.device);
+        let clean = Tensor::<3>::from_data(TensorData::new(batch.clean, shape), &self.device);
+        let t: Vec<f32> = batch.timesteps.iter().map(|&t| t as f32).collect();
+        let t = Tensor::<1>::from_data(TensorData::new(t, [batch.batch]), &self.device);
+        let model = self.model.take().expect("model present between steps");
+        let learning_rate = self.state.learning_rate;
+        let (model, value) =
+            optimisation_step(model, &mut self.optimizer, noised, t, clean, learning_rate);
+        self.model = Some(model);
+        if !value.is_finite() {
+            return Err(TrainError::NonFiniteLoss {
+                loss: value,
+                step: step + 1,
+                last_checkpoint: self.last_checkpoint.clone(),
+            });
+        }
+        self.state.step += 1;
+        self.state.learning_rate *= self.state.config.training.lr_decay;
+        self.state.loss = value;
+        self.recent.push_back(value);
+        if self.recent.len() > RECENT_STEPS {
+            self.recent.pop_front();
+        }
+        self.state.recent_loss = self.recent.iter().sum::<f64>() / self.recent.len() as f64;
+        let seconds = self.elapsed();
+        self.log
+            .push(self.state.step, value, learning_rate, seconds);
+        Ok(StepReport {
+            step: self.state.step,
+            total: self.state.config.training.steps,
+            loss: value,
+            recent_loss: self.state.recent_loss,
+            learning_rate,
+        })
+    }
+
+    /// Writes a checkpoint of the current step and flushes the loss log.
+    pub fn save(&mut self) -> Result<PathBuf, TrainError> {
+        self.log.flush()?;
+        self.state.elapsed_seconds = self.elapsed();
+        let dir = checkpoint::save(&self.run, self.model(), &self.optimizer, &self.state)?;
+        self.last_checkpoint = Some(dir.clone());
+        Ok(dir)
+    }
+
+    /// Steps until the configured count, saving every `checkpoint_every` steps and at the end.
+    /// When `stop` becomes true, saves the last completed step and returns.
+    pub fn run(
+        &mut self,
+        stop: &AtomicBool,
+        mut on_step: impl FnMut(&StepReport),
+    ) -> Result<RunEnd, TrainError> {
+        let every = self.state.config.training.checkpoint_every;
+        while !self.finished() {
+            if stop.load(Ordering::SeqCst) {
+                return Ok(RunEnd::Interrupted(self.save()?));
+            }
+            let report = self.step()?;
+            on_step(&report);
+            if report.step % every == 0 && !self.finished() {
+                self.save()?;
+            }
+        }
+        Ok(RunEnd::Finished(self.save()?))
+    }
+
+    /// The network without autodiff or dropout, for evaluation.
+    pub fn inference_model(&self) -> QnaUnet {
+        self.model().valid()
+    }
+
+    /// The loss log's path.
+    pub fn loss_log(&self) -> &Path {
+        self.log.path()
+    }
+}
