@@ -21,6 +21,7 @@ fn forward_macs_per_frame(f: usize, c: usize, heads: usize) -> usize {
 }
 
 fn main() {
+    sinmdm_train::memory::keep_freed_memory();
     let config: TrainConfig =
         TrainConfig::parse(include_str!("../../configs/paper.yaml")).expect("paper config");
     let steps_override: Option<usize> = std::env::var("SINMDM_BENCH_STEPS")

@@ -12,6 +12,7 @@ pub mod data;
 pub mod error;
 pub mod loss_log;
 pub mod loss_plot;
+pub mod memory;
 pub mod model;
 pub mod trainer;
 

@@ -87,6 +87,7 @@ fn dry_run(args: &Args) -> Result<()> {
 }
 
 fn main() -> Result<()> {
+    sinmdm_train::memory::keep_freed_memory();
     let args = Args::parse();
     if let Some(threads) = args.threads {
         if threads == 0 {

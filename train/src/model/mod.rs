@@ -1,5 +1,6 @@
 //! The QnA-UNet denoiser in burn: timestep embedding, residual blocks, QnA attention.
 
+pub mod layers;
 pub mod qna;
 pub mod resblock;
 pub mod timestep;
@@ -7,7 +8,7 @@ pub mod unet;
 pub mod weights;
 
 use burn::module::{Module, ModuleVisitor, Param};
-use burn::nn::{GroupNorm, GroupNormConfig};
+
 use burn::tensor::{Device, Tensor};
 
 pub use unet::QnaUnet;
@@ -15,12 +16,9 @@ pub use unet::QnaUnet;
 /// Groups of every GroupNorm in the network.
 pub const NORM_GROUPS: usize = 32;
 
-/// GroupNorm(32) with epsilon 1e-5 and affine weights.
-pub(crate) fn group_norm(channels: usize, device: &Device) -> GroupNorm {
-    GroupNormConfig::new(NORM_GROUPS, channels)
-        .with_epsilon(1e-5)
-        .with_affine(true)
-        .init(device)
+/// GroupNorm(32) with epsilon 1e-5 and affine weights, over `[B, N, C]`.
+pub(crate) fn group_norm(channels: usize, device: &Device) -> layers::ChannelNorm {
+    layers::ChannelNorm::new(NORM_GROUPS, channels, 1e-5, device)
 }
 
 /// Draws every lazily initialised parameter now, in module order, so the weights depend only on

@@ -1,13 +1,11 @@
 //! The learned-query local attention block (QnA) of SPEC §3.
 
 use burn::module::{Module, Param};
-use burn::nn::GroupNorm;
-use burn::nn::conv::{Conv1d, Conv1dConfig};
-use burn::tensor::module::conv1d;
-use burn::tensor::ops::ConvOptions;
+use burn::tensor::ops::PadMode;
 use burn::tensor::{Device, Distribution, Tensor};
 
 use super::group_norm;
+use super::layers::{ChannelNorm, FrameConv};
 
 /// Scores more than this far below the sequence maximum are raised to it before `exp`, so a
 /// window never sums to zero. Within one window such a gap means a weight ratio under 1e-26.
@@ -16,15 +14,15 @@ pub const SCORE_FLOOR: f64 = -60.0;
 /// `x + proj(window-softmax(q . key(GN(x))) * value(GN(x)))` with a learned relative-position bias.
 #[derive(Module, Debug)]
 pub struct QnaBlock {
-    norm: GroupNorm,
+    norm: ChannelNorm,
     /// The learned query `[C]`.
     query: Param<Tensor<1>>,
     /// Key projection `[C_out, C_in]` (`k = W x + b`).
     key_weight: Param<Tensor<2>>,
     /// Key bias `[C]`.
     key_bias: Param<Tensor<1>>,
-    value: Conv1d,
-    proj: Conv1d,
+    value: FrameConv,
+    proj: FrameConv,
     /// Relative-position bias `[H, k]`; index `j` is the neighbour at offset `j - (k - 1) / 2`.
     rpe: Param<Tensor<2>>,
     heads: usize,
@@ -42,8 +40,8 @@ impl QnaBlock {
             query: Param::from_tensor(Tensor::random([channels], normal, device)),
             key_weight: Param::from_tensor(Tensor::random([channels, channels], normal, device)),
             key_bias: Param::from_tensor(Tensor::zeros([channels], device)),
-            value: Conv1dConfig::new(channels, channels, 1).init(device),
-            proj: Conv1dConfig::new(channels, channels, 1).init(device),
+            value: FrameConv::new(channels, channels, 1, device),
+            proj: FrameConv::new(channels, channels, 1, device),
             rpe: Param::from_tensor(Tensor::zeros([heads, window], device)),
             heads,
             window,
@@ -55,68 +53,63 @@ impl QnaBlock {
         let channels = self.query.dims()[0];
         let width = channels / self.heads;
         let q = self.query.val().reshape([self.heads, width]);
-        let norm = q.clone().powi_scalar(2).sum_dim(1).sqrt().clamp_min(1e-12);
+        let norm = q.clone().square().sum_dim(1).sqrt().clamp_min(1e-12);
         q / norm / (width as f64).sqrt()
     }
 
-    /// Attention scores `[B, H, N]`: `s_h[n] = <q_h, (W x[:, n] + b)_h>`, computed through the
-    /// equivalent `C -> H` projection (the same numbers, a quarter of the work for H = 4).
+    /// Attention scores `[B, N, H]`: `s_h[n] = <q_h, (W x[n] + b)_h>`, computed through the
+    /// equivalent `C -> H` projection (the same numbers, a fraction of the work).
     fn scores(&self, x: Tensor<3>) -> Tensor<3> {
-        let [batch, channels, frames] = x.dims();
+        let [batch, frames, channels] = x.dims();
         let heads = self.heads;
         let width = channels / heads;
         let q = self.head_queries();
         let weight = (self.key_weight.val().reshape([heads, width, channels])
             * q.clone().reshape([heads, width, 1]))
         .sum_dim(1)
-        .reshape([heads, channels]);
+        .reshape([heads, channels])
+        .transpose();
         let bias = (self.key_bias.val().reshape([heads, width]) * q)
             .sum_dim(1)
-            .reshape([1, heads, 1]);
-        let scores = weight
-            .unsqueeze::<3>()
-            .expand([batch, heads, channels])
-            .matmul(x);
-        debug_assert_eq!(scores.dims(), [batch, heads, frames]);
-        scores + bias
+            .reshape([1, heads]);
+        (x.reshape([batch * frames, channels]).matmul(weight) + bias)
+            .reshape([batch, frames, heads])
     }
 
-    /// `x` `[B, C, N]` to `[B, C, N]`.
+    /// `sum_j w[h, j] t[n + j - (k-1)/2]` over frames (dim 1) of `t` `[B, N, H, X]`, zero outside.
+    fn window_sum(&self, t: Tensor<4>, bias: &Tensor<2>) -> Tensor<4> {
+        let frames = t.dims()[1];
+        let pad = (self.window - 1) / 2;
+        let padded = t.pad([(0, 0), (pad, pad), (0, 0), (0, 0)], PadMode::Constant(0.0));
+        (0..self.window)
+            .map(|j| {
+                padded.clone().narrow(1, j, frames)
+                    * bias.clone().narrow(1, j, 1).reshape([1, 1, self.heads, 1])
+            })
+            .reduce(|a, b| a + b)
+            .expect("window >= 1")
+    }
+
+    /// `x` `[B, N, C]` to `[B, N, C]`.
     pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
-        let [batch, channels, frames] = x.dims();
+        let [batch, frames, channels] = x.dims();
         let heads = self.heads;
         let width = channels / heads;
-        let window = self.window;
-        let pad = (window - 1) / 2;
         let normed = self.norm.forward(x.clone());
         let scores = self.scores(normed.clone());
-        let top = scores.clone().max_dim(2);
-        let weights = (scores - top).clamp_min(SCORE_FLOOR).exp();
-        let values = self.value.forward(normed);
-        let weighted = (values.reshape([batch, heads, width, frames])
-            * weights.clone().reshape([batch, heads, 1, frames]))
-        .reshape([batch, channels, frames]);
+        let top = scores.clone().max_dim(1);
+        let weights = (scores - top)
+            .clamp_min(SCORE_FLOOR)
+            .exp()
+            .reshape([batch, frames, heads, 1]);
+        let values = self
+            .value
+            .forward(normed)
+            .reshape([batch, frames, heads, width]);
         let bias = self.rpe.val().exp();
-        let channel_bias = bias
-            .clone()
-            .reshape([heads, 1, 1, window])
-            .expand([heads, width, 1, window])
-            .reshape([channels, 1, window]);
-        let numerator = conv1d(
-            weighted,
-            channel_bias,
-            None,
-            ConvOptions::new([1], [pad], [1], channels),
-        );
-        let denominator = conv1d(
-            weights,
-            bias.reshape([heads, 1, window]),
-            None,
-            ConvOptions::new([1], [pad], [1], heads),
-        );
-        let attended = (numerator.reshape([batch, heads, width, frames])
-            / denominator.reshape([batch, heads, 1, frames]))
-        .reshape([batch, channels, frames]);
+        let numerator = self.window_sum(values * weights.clone(), &bias);
+        let denominator = self.window_sum(weights, &bias);
+        let attended = (numerator / denominator).reshape([batch, frames, channels]);
         x + self.proj.forward(attended)
     }
 }
@@ -168,8 +161,10 @@ mod tests {
             }
             out
         };
+        let transpose =
+            |w: &[f32]| -> Vec<f32> { (0..c * c).map(|k| w[(k % c) * c + k / c]).collect() };
         let keys = linear(get("key_weight"), get("key_bias"), &xn);
-        let values = linear(get("value.weight"), get("value.bias"), &xn);
+        let values = linear(&transpose(get("value.weight")), get("value.bias"), &xn);
         let query = get("query");
         let rpe = get("rpe");
         let mut attended = vec![0.0; c * n];
@@ -201,7 +196,7 @@ mod tests {
                 }
             }
         }
-        let projected = linear(get("proj.weight"), get("proj.bias"), &attended);
+        let projected = linear(&transpose(get("proj.weight")), get("proj.bias"), &attended);
         x64.iter().zip(projected).map(|(a, b)| a + b).collect()
     }
 
@@ -212,12 +207,14 @@ mod tests {
         let (c, h) = (64, 4);
         for (window, n) in [(3, 1), (3, 2), (3, 9), (5, 4), (5, 13), (3, 700)] {
             let block = perturb(QnaBlock::new(c, h, window, &device), 0.3);
+            // x is [2, C, N] for the naive code; the block takes [2, N, C].
             let x: Vec<f32> = (0..2 * c * n)
                 .map(|i| ((i as f32 * 0.731).sin() * 2.0 + (i % 7) as f32 * 0.1))
                 .collect();
             let input = Tensor::<3>::from_data(TensorData::new(x.clone(), [2, c, n]), &device);
             let got = block
-                .forward(input)
+                .forward(input.swap_dims(1, 2))
+                .swap_dims(1, 2)
                 .into_data()
                 .try_to_vec::<f32>()
                 .unwrap();

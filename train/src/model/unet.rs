@@ -1,13 +1,11 @@
 //! The one-level QnA-UNet denoiser of SPEC §3.
 
 use burn::module::Module;
-use burn::nn::GroupNorm;
-use burn::nn::conv::{Conv1d, Conv1dConfig};
-use burn::nn::{Initializer, PaddingConfig1d};
 use burn::tensor::activation::silu;
 use burn::tensor::{Device, Tensor};
 
 use super::group_norm;
+use super::layers::{ChannelNorm, FrameConv};
 use super::qna::QnaBlock;
 use super::resblock::ResBlock;
 use super::timestep::TimestepEmbedding;
@@ -17,15 +15,15 @@ use crate::config::ModelConfig;
 #[derive(Module, Debug)]
 pub struct QnaUnet {
     time: TimestepEmbedding,
-    input: Conv1d,
+    input: FrameConv,
     block1: ResBlock,
     attention1: QnaBlock,
     block2: ResBlock,
     attention2: QnaBlock,
     block3: ResBlock,
     attention3: QnaBlock,
-    out_norm: GroupNorm,
-    output: Conv1d,
+    out_norm: ChannelNorm,
+    output: FrameConv,
 }
 
 impl QnaUnet {
@@ -34,13 +32,10 @@ impl QnaUnet {
     pub fn new(features: usize, config: &ModelConfig, device: &Device) -> Self {
         let c = config.channels;
         let emb = 4 * c;
-        let padding = PaddingConfig1d::Explicit(1, 1);
         let qna = || QnaBlock::new(c, config.heads, config.window, device);
         let net = QnaUnet {
             time: TimestepEmbedding::new(c, device),
-            input: Conv1dConfig::new(features, c, 3)
-                .with_padding(padding.clone())
-                .init(device),
+            input: FrameConv::new(features, c, 3, device),
             block1: ResBlock::new(c, c, emb, config.dropout, device),
             attention1: qna(),
             block2: ResBlock::new(c, c, emb, config.dropout, device),
@@ -48,10 +43,7 @@ impl QnaUnet {
             block3: ResBlock::new(2 * c, c, emb, config.dropout, device),
             attention3: qna(),
             out_norm: group_norm(c, device),
-            output: Conv1dConfig::new(c, features, 3)
-                .with_padding(padding)
-                .with_initializer(Initializer::Zeros)
-                .init(device),
+            output: FrameConv::zeros(c, features, 3, device),
         };
         super::materialize(&net);
         net
@@ -60,7 +52,8 @@ impl QnaUnet {
     /// `x_t` `[B, F, N]` and `t` `[B]` (integer steps as floats) to the predicted `x0` `[B, F, N]`.
     pub fn forward(&self, x_t: Tensor<3>, t: Tensor<1>) -> Tensor<3> {
         let emb = self.time.forward(t);
-        let h0 = self.input.forward(x_t);
+        // Internally [B, N, C]: every layer is then a matrix product over B * N rows.
+        let h0 = self.input.forward(x_t.swap_dims(1, 2));
         let h1 = self
             .attention1
             .forward(self.block1.forward(h0.clone(), emb.clone()));
@@ -69,7 +62,9 @@ impl QnaUnet {
             .forward(self.block2.forward(h1, emb.clone()));
         let h3 = self
             .attention3
-            .forward(self.block3.forward(Tensor::cat(vec![h2, h0], 1), emb));
-        self.output.forward(silu(self.out_norm.forward(h3)))
+            .forward(self.block3.forward(Tensor::cat(vec![h2, h0], 2), emb));
+        self.output
+            .forward(silu(self.out_norm.forward(h3)))
+            .swap_dims(1, 2)
     }
 }
