@@ -25,3 +25,5 @@ pub mod diffusion;
 pub mod files;
 pub mod motion;
 pub mod onnxruntime;
+#[cfg(feature = "render")]
+pub mod render;

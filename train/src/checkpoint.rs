@@ -131,7 +131,14 @@ pub fn latest(run: &Path) -> Result<Option<PathBuf>, TrainError> {
                 })
             }
         }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e)
+            if matches!(
+                e.kind(),
+                std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+            ) =>
+        {
+            Ok(None)
+        }
         Err(source) => Err(TrainError::Io {
             what: "read",
             path: file,
@@ -167,7 +174,28 @@ pub fn load_state(dir: &Path) -> Result<CheckpointState, TrainError> {
 /// Loads a checkpoint's weights into `model` (which must have the checkpoint's shape).
 pub fn load_model(dir: &Path, model: QnaUnet) -> Result<QnaUnet, TrainError> {
     let file = dir.join(MODEL_FILE);
-    model.try_load_file(&file).map_err(record(&file))
+    model.try_load_file(&file).map_err(|e| {
+        let text = e.to_string();
+        let mismatches: Vec<&str> = text
+            .split('"')
+            .filter(|part| part.contains("shape mismatch"))
+            .collect();
+        let message = match mismatches.as_slice() {
+            [] => text,
+            [first, rest @ ..] => format!(
+                "the weights do not fit this model: {first}{}",
+                if rest.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (and {} more)", rest.len())
+                }
+            ),
+        };
+        TrainError::Checkpoint {
+            path: file.clone(),
+            message,
+        }
+    })
 }
 
 /// Loads a checkpoint's optimiser state.

@@ -122,20 +122,20 @@ impl TrainConfig {
                 return Err(format!("{key} must be a positive number, got {value}"));
             }
         }
-        if m.channels % crate::model::NORM_GROUPS != 0 {
+        if !m.channels.is_multiple_of(crate::model::NORM_GROUPS) {
             return Err(format!(
                 "model.channels must be a multiple of {} (GroupNorm groups), got {}",
                 crate::model::NORM_GROUPS,
                 m.channels
             ));
         }
-        if m.channels % m.heads != 0 {
+        if !m.channels.is_multiple_of(m.heads) {
             return Err(format!(
                 "model.heads ({}) must divide model.channels ({})",
                 m.heads, m.channels
             ));
         }
-        if m.window % 2 == 0 {
+        if m.window.is_multiple_of(2) {
             return Err(format!("model.window must be odd, got {}", m.window));
         }
         if !(0.0..1.0).contains(&m.dropout) {

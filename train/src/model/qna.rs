@@ -209,7 +209,7 @@ mod tests {
             let block = perturb(QnaBlock::new(c, h, window, &device), 0.3);
             // x is [2, C, N] for the naive code; the block takes [2, N, C].
             let x: Vec<f32> = (0..2 * c * n)
-                .map(|i| ((i as f32 * 0.731).sin() * 2.0 + (i % 7) as f32 * 0.1))
+                .map(|i| (i as f32 * 0.731).sin() * 2.0 + (i % 7) as f32 * 0.1)
                 .collect();
             let input = Tensor::<3>::from_data(TensorData::new(x.clone(), [2, c, n]), &device);
             let got = block

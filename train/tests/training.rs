@@ -1,0 +1,303 @@
+//! Training runs on a real clip: the loss falls, interrupted runs resume exactly, and bad input
+//! stops with an error that names the problem.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use burn::tensor::Device;
+use sinmdm_train::model::weights::named_tensors;
+use sinmdm_train::{RunEnd, TrainConfig, TrainError, Trainer};
+
+/// burn's CPU RNG is process-wide: runs in this file take turns.
+static RNG: Mutex<()> = Mutex::new(());
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+fn walk() -> PathBuf {
+    root().join("tests/data/bvh/human_walk_cmu_131_01.bvh")
+}
+
+fn tiny() -> TrainConfig {
+    TrainConfig::load(&root().join("configs/tiny.yaml")).unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sinmdm-train-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn losses(run: &Path) -> Vec<(u64, String)> {
+    std::fs::read_to_string(run.join("loss.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let mut parts = l.split(',');
+            (
+                parts.next().unwrap().parse().unwrap(),
+                parts.next().unwrap().to_string(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn loss_falls_to_under_half_of_its_start() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let run = scratch("falls");
+    let mut trainer = Trainer::start(&walk(), tiny(), &run, Device::flex().autodiff()).unwrap();
+    let end = trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
+    assert!(matches!(end, RunEnd::Finished(_)));
+    let values: Vec<f64> = losses(&run)
+        .iter()
+        .map(|(_, l)| l.parse().unwrap())
+        .collect();
+    assert_eq!(values.len(), 300);
+    let start = values[..10].iter().sum::<f64>() / 10.0;
+    let end = values[values.len() - 50..].iter().sum::<f64>() / 50.0;
+    assert!(end < 0.5 * start, "loss went from {start} to {end}");
+    std::fs::remove_dir_all(&run).unwrap();
+}
+
+#[test]
+fn stopped_and_resumed_run_reproduces_the_uninterrupted_one() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let mut config = tiny();
+    config.training.steps = 60;
+    config.training.checkpoint_every = 25;
+    config.model.dropout = 0.3; // exercise the reseeded dropout stream too
+    let whole = scratch("whole");
+    let mut trainer =
+        Trainer::start(&walk(), config.clone(), &whole, Device::flex().autodiff()).unwrap();
+    trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
+    let whole_weights = named_tensors(trainer.model());
+
+    let parts = scratch("parts");
+    let stop = AtomicBool::new(false);
+    let mut first = Trainer::start(&walk(), config, &parts, Device::flex().autodiff()).unwrap();
+    let end = first
+        .run(&stop, |r| {
+            if r.step == 37 {
+                stop.store(true, Ordering::SeqCst);
+            }
+        })
+        .unwrap();
+    assert!(matches!(end, RunEnd::Interrupted(_)), "{end:?}");
+    assert_eq!(first.state().step, 37);
+    drop(first);
+    let mut second = Trainer::resume(&parts, None, None, Device::flex().autodiff()).unwrap();
+    assert_eq!(second.state().step, 37);
+    second.run(&AtomicBool::new(false), |_| {}).unwrap();
+
+    assert_eq!(losses(&whole), losses(&parts));
+    assert_eq!(whole_weights, named_tensors(second.model()));
+    std::fs::remove_dir_all(&whole).unwrap();
+    std::fs::remove_dir_all(&parts).unwrap();
+}
+
+#[test]
+fn ctrl_c_saves_and_resume_finishes_like_an_uninterrupted_run() {
+    let bin = env!("CARGO_BIN_EXE_sinmdm-train");
+    let config = scratch("ctrlc-config.yaml");
+    let text = std::fs::read_to_string(root().join("configs/tiny.yaml"))
+        .unwrap()
+        .replace("steps: 300", "steps: 400");
+    std::fs::write(&config, text).unwrap();
+    let train = |out: &Path, resume: bool| {
+        let mut cmd = Command::new(bin);
+        if resume {
+            cmd.arg("--resume");
+        } else {
+            cmd.arg(walk());
+        }
+        cmd.arg("--config").arg(&config).arg("--out").arg(out);
+        cmd
+    };
+    let whole = scratch("ctrlc-whole");
+    assert!(train(&whole, false).output().unwrap().status.success());
+
+    let parts = scratch("ctrlc-parts");
+    let mut child = train(&parts, false)
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    while !parts.join("latest").exists() {
+        assert!(std::time::Instant::now() < deadline, "no first checkpoint");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // SAFETY: sends SIGINT to the child process we spawned.
+    unsafe {
+        libc::kill(child.id() as i32, libc::SIGINT);
+    }
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "the run should stop on Ctrl-C");
+    let saved = losses(&parts).len();
+    assert!((100..400).contains(&saved), "saved after {saved} steps");
+    let resumed = train(&parts, true).output().unwrap();
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    assert_eq!(losses(&whole), losses(&parts));
+    assert!(parts.join("loss.png").is_file());
+    for dir in [whole, parts] {
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+    std::fs::remove_file(config).unwrap();
+}
+
+#[test]
+fn non_finite_loss_stops_and_keeps_the_last_good_checkpoint() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let mut config = tiny();
+    config.training.learning_rate = 1e30;
+    config.training.checkpoint_every = 1;
+    let run = scratch("nan");
+    let mut trainer = Trainer::start(&walk(), config, &run, Device::flex().autodiff()).unwrap();
+    let err = trainer.run(&AtomicBool::new(false), |_| {}).unwrap_err();
+    let TrainError::NonFiniteLoss {
+        step,
+        last_checkpoint,
+        ..
+    } = &err
+    else {
+        panic!("unexpected error {err}");
+    };
+    let kept = last_checkpoint
+        .clone()
+        .expect("a checkpoint before the bad step");
+    assert!(
+        kept.ends_with(format!("step-{:08}", step - 1)),
+        "{}",
+        kept.display()
+    );
+    assert!(err.to_string().contains("last good checkpoint"), "{err}");
+    let resumed = Trainer::resume(&run, None, None, Device::flex().autodiff()).unwrap();
+    assert_eq!(resumed.state().step, step - 1);
+    assert!(resumed.state().loss.is_finite());
+    std::fs::remove_dir_all(&run).unwrap();
+}
+
+#[test]
+fn bad_input_gets_an_error_that_names_it() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let device = || Device::flex().autodiff();
+    // A clip shorter than the receptive field: the fox, cut to 10 frames.
+    let fox =
+        std::fs::read_to_string(root().join("tests/data/bvh/fox_survey_khronos.bvh")).unwrap();
+    let motion = fox.find("MOTION").unwrap();
+    let frames: Vec<&str> = fox[motion..].lines().skip(3).take(10).collect();
+    let short = scratch("short.bvh");
+    std::fs::write(
+        &short,
+        format!(
+            "{}MOTION\nFrames: 10\nFrame Time: 0.0416667\n{}\n",
+            &fox[..motion],
+            frames.join("\n")
+        ),
+    )
+    .unwrap();
+    let err = Trainer::start(&short, tiny(), &scratch("short-run"), device())
+        .err()
+        .unwrap();
+    assert!(
+        matches!(err, TrainError::ClipTooShort { frames: 12, .. }),
+        "{err}"
+    );
+    assert!(
+        err.to_string().contains("receptive field of 23 frames"),
+        "{err}"
+    );
+
+    // An output folder that cannot be made: below a regular file.
+    let err = Trainer::start(&walk(), tiny(), &short.join("run"), device())
+        .err()
+        .unwrap();
+    assert!(
+        err.to_string()
+            .contains("could not create the output folder"),
+        "{err}"
+    );
+    std::fs::remove_file(&short).unwrap();
+
+    // A checkpoint of another model shape.
+    let run = scratch("shape");
+    let mut config = tiny();
+    config.training.steps = 2;
+    let mut trainer = Trainer::start(&walk(), config.clone(), &run, device()).unwrap();
+    trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
+    let mut wider = config.clone();
+    wider.model.channels = 64;
+    let err = Trainer::resume(&run, None, Some(wider), device())
+        .err()
+        .unwrap();
+    assert!(
+        err.to_string()
+            .contains("model.channels = 32, the config asks for 64"),
+        "{err}"
+    );
+    // Starting over in a folder that already holds a run.
+    let err = Trainer::start(&walk(), config, &run, device())
+        .err()
+        .unwrap();
+    assert!(err.to_string().contains("pass --resume"), "{err}");
+    // Resuming with another clip.
+    let hop = root().join("tests/data/bvh/human_hop_cmu_131_03.bvh");
+    let err = Trainer::resume(&run, Some(&hop), None, device())
+        .err()
+        .unwrap();
+    assert!(
+        err.to_string().contains("is not the clip this run learns"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&run).unwrap();
+}
+
+#[test]
+fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
+    let bin = env!("CARGO_BIN_EXE_sinmdm-train");
+    let out = Command::new(bin)
+        .arg(walk())
+        .args(["--config"])
+        .arg(root().join("configs/paper.yaml"))
+        .arg("--dry-run")
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    // F = 191 for this skeleton: 5,262,546 + 17 * (2 * 3 * 256 + 1).
+    assert!(text.contains("parameters      5288675"), "{text}");
+    assert!(text.contains("receptive field 23 frames"), "{text}");
+
+    let bad = scratch("bad.yaml");
+    let text = std::fs::read_to_string(root().join("configs/tiny.yaml"))
+        .unwrap()
+        .replace("heads: 4", "heads: 4\n  hedas: 2");
+    std::fs::write(&bad, text).unwrap();
+    let out = Command::new(bin)
+        .arg(walk())
+        .arg("--config")
+        .arg(&bad)
+        .arg("--out")
+        .arg(scratch("never"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("unknown field `hedas`") && err.contains("bad.yaml"),
+        "{err}"
+    );
+    assert!(!scratch("never").exists());
+    std::fs::remove_file(bad).unwrap();
+}
