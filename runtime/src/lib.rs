@@ -23,6 +23,7 @@ pub mod bvh;
 pub mod cli;
 pub mod diffusion;
 pub mod files;
+pub mod model_file;
 pub mod motion;
 pub mod onnxruntime;
 #[cfg(feature = "render")]

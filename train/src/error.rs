@@ -57,6 +57,9 @@ pub enum TrainError {
         /// What does not fit.
         message: String,
     },
+    /// The model could not be exported.
+    #[error("export failed: {0}")]
+    Export(String),
     /// The loss stopped being a finite number.
     #[error(
         "the loss became {loss} at step {step}; stopped without saving. The last good checkpoint is {}",

@@ -10,6 +10,7 @@ pub mod clock;
 pub mod config;
 pub mod data;
 pub mod error;
+pub mod export;
 pub mod loss_log;
 pub mod loss_plot;
 pub mod memory;
