@@ -1,6 +1,6 @@
 //! The exported ONNX graph computes what the burn network computes, in real onnxruntime.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Mutex;
 use std::sync::atomic::AtomicBool;
 
@@ -12,19 +12,13 @@ use sinmdm_train::model::QnaUnet;
 use sinmdm_train::model::weights::perturb;
 use sinmdm_train::{TrainConfig, Trainer};
 
+mod common;
+use common::root;
+
 static RNG: Mutex<()> = Mutex::new(());
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sinmdm-export-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    common::scratch("export", name)
 }
 
 fn input(b: usize, f: usize, n: usize) -> (Vec<f32>, Vec<i64>) {

@@ -11,14 +11,10 @@ use sinmdm_train::model::weights::named_tensors;
 use sinmdm_train::{RunEnd, TrainConfig, TrainError, Trainer};
 
 /// burn's CPU RNG is process-wide: runs in this file take turns.
-static RNG: Mutex<()> = Mutex::new(());
+mod common;
+use common::root;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
+static RNG: Mutex<()> = Mutex::new(());
 
 fn walk() -> PathBuf {
     root().join("tests/data/bvh/human_walk_cmu_131_01.bvh")
@@ -29,9 +25,7 @@ fn tiny() -> TrainConfig {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sinmdm-train-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    common::scratch("train", name)
 }
 
 fn losses(run: &Path) -> Vec<(u64, String)> {
