@@ -138,7 +138,9 @@ mod tests {
         let stretched = resample_cubic(clip.view(), 12);
         for j in 3..9 {
             let source = (j as f32 + 0.5) * 0.5 - 0.5;
-            assert!((stretched[[0, j]] - source).abs() < 1e-5, "{j}");
+            // a = -0.75 is not exactly linear-preserving; it stays within a few hundredths.
+            assert!((stretched[[0, j]] - source).abs() < 0.05, "{j}");
+            assert!(stretched[[0, j]] > stretched[[0, j - 1]]);
             assert!((stretched[[1, j]] - 3.0).abs() < 1e-6);
         }
     }
