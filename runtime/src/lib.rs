@@ -22,9 +22,12 @@ pub mod bvh;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod diffusion;
+pub mod features_file;
 pub mod files;
+pub mod model;
 pub mod model_file;
 pub mod motion;
 pub mod onnxruntime;
 #[cfg(feature = "render")]
 pub mod render;
+pub mod tasks;

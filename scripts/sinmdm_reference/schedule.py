@@ -58,3 +58,8 @@ class Schedule:
     def posterior_std(self, k):
         var = self.posterior_variance(min(1, len(self.betas) - 1) if k == 0 else k)
         return math.exp(0.5 * math.log(var))
+
+    def q_sample_coefficients(self, k):
+        """(sqrt(abar_k), sqrt(1 - abar_k))."""
+        abar = self.alphas_cumprod[k]
+        return math.sqrt(abar), math.sqrt(1.0 - abar)

@@ -1,7 +1,10 @@
 //! The `sinmdm` command line (feature `cli`): argument parsing and printing; the work is done by
 //! the library.
 
+mod info;
 mod inspect;
+mod sampling;
+mod tasks;
 
 use clap::{Parser, Subcommand};
 
@@ -21,6 +24,27 @@ pub enum Command {
     /// encode/decode round trip.
     #[command(after_help = inspect::EXAMPLES)]
     Inspect(inspect::InspectArgs),
+    /// New motion from a model: one sample or a crowd, of any length.
+    #[command(after_help = tasks::GENERATE_EXAMPLES)]
+    Generate(tasks::GenerateArgs),
+    /// Keep spans of a reference clip and generate the motion between them.
+    #[command(after_help = tasks::INBETWEEN_EXAMPLES)]
+    Inbetween(tasks::InbetweenArgs),
+    /// Generate new motion before and/or after a reference clip.
+    #[command(after_help = tasks::EXPAND_EXAMPLES)]
+    Expand(tasks::ExpandArgs),
+    /// Keep chosen joints (a body part) and/or the root motion of a reference, generate the rest.
+    #[command(after_help = tasks::COMPOSE_EXAMPLES)]
+    Compose(tasks::ComposeArgs),
+    /// Style transfer: a content clip's low frequencies in the style the model learned.
+    #[command(after_help = tasks::HARMONIZE_EXAMPLES)]
+    Harmonize(tasks::HarmonizeArgs),
+    /// Print what a model file holds: network, skeleton, features, training facts.
+    #[command(after_help = info::INFO_EXAMPLES)]
+    Info(info::InfoArgs),
+    /// Write a clip's features in a model's layout as JSON (input of the Python reference).
+    #[command(after_help = info::ENCODE_EXAMPLES)]
+    Encode(info::EncodeArgs),
 }
 
 /// Runs the command line; returns the process exit status.
@@ -28,6 +52,13 @@ pub fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Inspect(args) => inspect::run(&args),
+        Command::Generate(args) => tasks::generate(&args),
+        Command::Inbetween(args) => tasks::inbetween(&args),
+        Command::Expand(args) => tasks::expand(&args),
+        Command::Compose(args) => tasks::compose(&args),
+        Command::Harmonize(args) => tasks::harmonize(&args),
+        Command::Info(args) => info::info(&args),
+        Command::Encode(args) => info::encode(&args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -70,6 +70,9 @@ pub enum MotionError {
         /// The largest clip accepted.
         limit: usize,
     },
+    /// A clip whose skeleton is not the one the features are laid out for.
+    #[error("the clip's skeleton differs from the model's: {0}")]
+    SkeletonMismatch(String),
     /// A feature array holding NaN or infinity.
     #[error("features contain a non-finite value at row {row}, frame {frame}")]
     NonFinite {
@@ -322,7 +325,6 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
     let root_joint = motion_root(skeleton, &any_position_varies);
 
     let local = resample(&clip.to_local(), fps);
-    let frames = local.frame_count();
     let joints = skeleton.len();
 
     let first = clip.frame(0);
@@ -396,6 +398,25 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         skeleton_height: height,
     };
 
+    let (features, contact_share) = fill_features(&layout, &local, &poses);
+    Ok(EncodedClip {
+        layout,
+        features,
+        contact_share,
+    })
+}
+
+/// Writes the columns of `layout` for `local` (already at the layout's frame rate, `poses` its
+/// global poses); returns the features and each contact joint's share of frames in contact.
+fn fill_features(
+    layout: &FeatureLayout,
+    local: &LocalMotion,
+    poses: &[super::fk::GlobalPose],
+) -> (Array2<f32>, Vec<f64>) {
+    let frames = local.frame_count();
+    let joints = layout.skeleton.len();
+    let fps = layout.fps;
+    let height = layout.skeleton_height;
     let mut features = Array2::<f32>::zeros((layout.width(), frames));
     let mut row = 0;
     if let Some(root) = &layout.root {
@@ -432,7 +453,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
     }
     let mut contact_share = Vec::with_capacity(layout.contact_joints.len());
     for &joint in &layout.contact_joints {
-        let labels = contact_labels(&poses, joint, fps, height, layout.contact_speed_threshold);
+        let labels = contact_labels(poses, joint, fps, height, layout.contact_speed_threshold);
         contact_share.push(labels.iter().map(|&l| f64::from(l)).sum::<f64>() / frames as f64);
         for (f, label) in labels.into_iter().enumerate() {
             features[[row, f]] = label;
@@ -440,11 +461,31 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         row += 1;
     }
     debug_assert_eq!(row, layout.width());
-    Ok(EncodedClip {
-        layout,
-        features,
-        contact_share,
-    })
+    (features, contact_share)
+}
+
+/// Encodes a clip of the same skeleton in an existing layout (a model's): resampled to the
+/// layout's frame rate, with the layout's columns, contact joints and contact threshold, so the
+/// result lines up with the features the model was trained on.
+pub fn encode_for(clip: &ChannelClip, layout: &FeatureLayout) -> Result<Array2<f32>, MotionError> {
+    if clip.frame_count() == 0 {
+        return Err(MotionError::NoFrames);
+    }
+    if let Some(problem) = layout.skeleton.difference(&clip.skeleton) {
+        return Err(MotionError::SkeletonMismatch(problem));
+    }
+    let resampled = (clip.frame_count() as f64 - 1.0) * layout.fps / clip.fps + 1.0;
+    if resampled.is_nan() || resampled > MAX_FRAMES as f64 {
+        return Err(MotionError::TooManyFrames {
+            frames: clip.frame_count(),
+            from_fps: clip.fps,
+            to_fps: layout.fps,
+            limit: MAX_FRAMES,
+        });
+    }
+    let local = resample(&clip.to_local(), layout.fps);
+    let poses = global_poses(&local);
+    Ok(fill_features(layout, &local, &poses).0)
 }
 
 /// Turns features `[F, N]` back into local joint transforms. Contact labels are not needed to

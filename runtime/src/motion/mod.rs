@@ -16,7 +16,7 @@ pub use clip::{ChannelClip, LocalMotion, fps_from_frame_time};
 pub use contacts::ContactConfig;
 pub use features::{
     Column, ColumnKind, EncodeOptions, EncodedClip, FeatureLayout, MotionError, RootFeatures,
-    decode, encode,
+    decode, encode, encode_for,
 };
 pub use fk::{GlobalPose, global_pose, global_poses, skeleton_height};
 pub use normalize::Normalizer;

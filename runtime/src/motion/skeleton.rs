@@ -197,11 +197,50 @@ impl Skeleton {
 
     /// Whether `other` has the same joint names, parents and channel lists (offsets may differ).
     pub fn same_structure(&self, other: &Skeleton) -> bool {
-        self.joints.len() == other.joints.len()
-            && self
-                .joints
-                .iter()
-                .zip(&other.joints)
-                .all(|(a, b)| a.name == b.name && a.parent == b.parent && a.channels == b.channels)
+        self.difference(other).is_none()
+    }
+
+    /// The first structural difference between `self` (the expected skeleton) and `other`, in
+    /// words: joint count, a joint's name, parent or channel list. Offsets may differ.
+    pub fn difference(&self, other: &Skeleton) -> Option<String> {
+        if self.joints.len() != other.joints.len() {
+            return Some(format!(
+                "it has {} joints where {} are expected",
+                other.joints.len(),
+                self.joints.len()
+            ));
+        }
+        let parent_name = |s: &Skeleton, p: Option<usize>| {
+            p.map_or("none (root)".to_string(), |p| {
+                format!("'{}'", s.joints[p].name)
+            })
+        };
+        for (i, (a, b)) in self.joints.iter().zip(&other.joints).enumerate() {
+            if a.name != b.name {
+                return Some(format!(
+                    "joint {i} is '{}' where '{}' is expected",
+                    b.name, a.name
+                ));
+            }
+            if a.parent != b.parent {
+                return Some(format!(
+                    "joint '{}' has parent {} where {} is expected",
+                    a.name,
+                    parent_name(other, b.parent),
+                    parent_name(self, a.parent)
+                ));
+            }
+            if a.channels != b.channels {
+                let list =
+                    |c: &[Channel]| c.iter().map(|c| c.bvh_name()).collect::<Vec<_>>().join(" ");
+                return Some(format!(
+                    "joint '{}' has channels [{}] where [{}] are expected",
+                    a.name,
+                    list(&b.channels),
+                    list(&a.channels)
+                ));
+            }
+        }
+        None
     }
 }

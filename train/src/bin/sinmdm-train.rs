@@ -41,6 +41,10 @@ struct Args {
     /// CPU threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Write the trained model as ONNX here when training finishes (same as running
+    /// `sinmdm-export RUN -o FILE` afterwards).
+    #[arg(long, value_name = "MODEL.onnx")]
+    export: Option<PathBuf>,
     /// Compute device: cpu, or cuda / wgpu when built with that feature.
     #[arg(long, default_value = "cpu")]
     device: String,
@@ -104,6 +108,20 @@ fn main() -> Result<()> {
     let Some(out) = &args.out else {
         bail!("--out is required: the run folder for checkpoints and logs");
     };
+    if let Some(file) = &args.export {
+        let dir = file.parent().filter(|p| !p.as_os_str().is_empty());
+        if let Some(dir) = dir {
+            std::fs::create_dir_all(dir).with_context(|| {
+                format!("--export: cannot create the folder '{}'", dir.display())
+            })?;
+        }
+        if file.is_dir() {
+            bail!(
+                "--export '{}' is a folder; give a file name such as model.onnx",
+                file.display()
+            );
+        }
+    }
     let device = device(&args.device)?.autodiff();
     let config = args.config.as_deref().map(TrainConfig::load).transpose()?;
     let mut trainer = if args.resume {
@@ -177,6 +195,10 @@ fn main() -> Result<()> {
                 dir.display(),
                 png.display()
             );
+            if let Some(file) = &args.export {
+                sinmdm_train::export::export_checkpoint(&dir, file)?;
+                eprintln!("model {}", file.display());
+            }
             Ok(())
         }
         RunEnd::Interrupted(dir) => {

@@ -1,0 +1,135 @@
+//! `sinmdm info` and `sinmdm encode`: what a model file holds, and a clip in a model's layout.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use ndarray::Axis;
+
+use super::sampling::reference_features;
+use crate::features_file::write_features;
+use crate::model::{Model, ModelOptions};
+use crate::model_file::ModelMetadata;
+
+pub(super) const INFO_EXAMPLES: &str = "Examples:
+  sinmdm info onnx-models/walk.onnx
+  sinmdm info onnx-models/walk.onnx --json > walk_metadata.json";
+
+pub(super) const ENCODE_EXAMPLES: &str = "Examples:
+  sinmdm encode walk.bvh -m onnx-models/walk.onnx -o walk_features.json";
+
+/// Arguments of `sinmdm info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// The model file.
+    pub model: PathBuf,
+    /// Print the metadata as JSON instead of a summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `sinmdm encode`.
+#[derive(Debug, Args)]
+pub struct EncodeArgs {
+    /// The BVH clip (same skeleton as the model).
+    pub clip: PathBuf,
+    /// The model whose feature layout to use.
+    #[arg(short, long, value_name = "MODEL.onnx")]
+    pub model: PathBuf,
+    /// The features JSON to write.
+    #[arg(short, long, value_name = "OUT.json")]
+    pub output: PathBuf,
+}
+
+/// A readable summary of a model's metadata.
+pub fn describe(path: &std::path::Path, m: &ModelMetadata) -> String {
+    let mut s = String::new();
+    let n = &m.network;
+    let l = &m.layout;
+    let t = &m.training;
+    let _ = writeln!(s, "model        {}", path.display());
+    let _ = writeln!(
+        s,
+        "network      QnA-UNet, {} features, {} channels, {} heads, window {}, receptive field {} frames, {} parameters",
+        n.features, n.channels, n.heads, n.window, n.receptive_field, n.parameters
+    );
+    let _ = writeln!(
+        s,
+        "diffusion    {} steps, {} schedule, predicts {}",
+        m.diffusion.steps, m.diffusion.schedule, m.diffusion.prediction
+    );
+    let _ = writeln!(
+        s,
+        "skeleton     {} joints (root '{}'), height {:.3} file units",
+        l.skeleton.len(),
+        l.skeleton.joints.first().map_or("", |j| j.name.as_str()),
+        l.skeleton_height
+    );
+    let _ = writeln!(s, "frame rate   {} fps", l.fps);
+    if let Some(root) = &l.root {
+        let _ = writeln!(
+            s,
+            "root motion  joint '{}', axes {:?}, starts at {:?}",
+            l.skeleton.joints[root.joint].name, root.axes, root.start_position
+        );
+    }
+    let contacts: Vec<&str> = l
+        .contact_joints
+        .iter()
+        .map(|&j| l.skeleton.joints[j].name.as_str())
+        .collect();
+    let _ = writeln!(
+        s,
+        "contacts     {} (speed threshold {} heights/s)",
+        if contacts.is_empty() {
+            "none".to_string()
+        } else {
+            contacts.join(", ")
+        },
+        l.contact_speed_threshold
+    );
+    let _ = writeln!(
+        s,
+        "features     {} root, {} rotation joints x 6, {} position channels, {} contact labels",
+        l.root.as_ref().map_or(0, |r| r.axes.len()),
+        l.rotation_joints.len(),
+        l.position_channels.len(),
+        l.contact_joints.len()
+    );
+    let _ = writeln!(
+        s,
+        "trained on   {} ({} frames, sha256 {})",
+        t.clip, t.clip_frames, t.clip_sha256
+    );
+    let _ = writeln!(
+        s,
+        "training     {} steps in {:.0} s, final loss {:.4e} (mean of last 100: {:.4e}), started {}",
+        t.steps, t.seconds, t.final_loss, t.recent_loss, t.started
+    );
+    let _ = writeln!(s, "exported     {}", t.exported);
+    let _ = writeln!(s, "config       {}", t.config);
+    s
+}
+
+pub(super) fn info(args: &InfoArgs) -> Result<()> {
+    let model = Model::open(&args.model, &ModelOptions { threads: Some(1) })?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(model.metadata())?);
+    } else {
+        print!("{}", describe(&args.model, model.metadata()));
+    }
+    Ok(())
+}
+
+pub(super) fn encode(args: &EncodeArgs) -> Result<()> {
+    let model = Model::open(&args.model, &ModelOptions { threads: Some(1) })?;
+    let features = reference_features(&model, &args.clip)?;
+    write_features(
+        &args.output,
+        &model.metadata().layout,
+        features.insert_axis(Axis(0)).view(),
+    )?;
+    eprintln!("wrote {}", args.output.display());
+    Ok(())
+}

@@ -1,0 +1,211 @@
+//! What every generating subcommand shares: the model, seed, steps, crowd size, output files
+//! and the progress bar.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use ndarray::Array2;
+
+use crate::bvh::{read_bvh, to_bvh_string};
+use crate::features_file::write_features;
+use crate::files::write_atomically;
+use crate::model::{Model, ModelOptions};
+use crate::motion::encode_for;
+use crate::tasks::{self, Generated, Request, Span, Task};
+
+/// Default respaced sampling steps of the command line (see the README for the measurement).
+pub const DEFAULT_STEPS: &str = "100";
+
+/// Options shared by `generate`, `inbetween`, `expand`, `compose` and `harmonize`.
+#[derive(Debug, Args)]
+pub struct SamplingArgs {
+    /// The trained model (.onnx written by sinmdm-export).
+    #[arg(short, long, value_name = "MODEL.onnx")]
+    pub model: PathBuf,
+    /// Output BVH file. With --count above 1, samples go to NAME_000.bvh, NAME_001.bvh, ...
+    #[arg(short, long, value_name = "OUT.bvh")]
+    pub output: PathBuf,
+    /// Samples to make in one batched run (a crowd).
+    #[arg(long, default_value_t = 1)]
+    pub count: usize,
+    /// Seed of the noise: the same model, seed and arguments give the same motion, in this
+    /// program and in the Python reference.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Denoising steps: a number S of respaced steps (1..=T), or `all` for the model's full T.
+    #[arg(long, default_value = DEFAULT_STEPS, value_name = "S|all")]
+    pub steps: String,
+    /// Threads for the network (default: every core).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Also write the raw features of every sample as JSON here.
+    #[arg(long, value_name = "OUT.json")]
+    pub features_json: Option<PathBuf>,
+    /// Do not show the progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+impl SamplingArgs {
+    /// `None` for all steps.
+    pub fn steps(&self) -> Result<Option<usize>> {
+        if self.steps.eq_ignore_ascii_case("all") {
+            return Ok(None);
+        }
+        match self.steps.parse::<usize>() {
+            Ok(s) => Ok(Some(s)),
+            Err(_) => bail!(
+                "--steps must be a whole number of steps or 'all', got '{}'",
+                self.steps
+            ),
+        }
+    }
+
+    /// Opens the model with the requested threads.
+    pub fn open_model(&self) -> Result<Model> {
+        if self.threads == Some(0) {
+            bail!("--threads must be at least 1");
+        }
+        Ok(Model::open(
+            &self.model,
+            &ModelOptions {
+                threads: self.threads,
+            },
+        )?)
+    }
+
+    /// The BVH file of sample `index` of `count`.
+    pub fn output_path(&self, index: usize, count: usize) -> PathBuf {
+        if count == 1 {
+            return self.output.clone();
+        }
+        let stem = self
+            .output
+            .file_stem()
+            .map_or("sample".into(), |s| s.to_string_lossy().into_owned());
+        let ext = self
+            .output
+            .extension()
+            .map_or("bvh".into(), |e| e.to_string_lossy().into_owned());
+        self.output
+            .with_file_name(format!("{stem}_{index:03}.{ext}"))
+    }
+}
+
+/// A frame position given as frames (`120`) or seconds (`4s`, `1.5s`).
+pub fn parse_position(text: &str, fps: f64) -> Result<usize> {
+    let text = text.trim();
+    if let Some(seconds) = text.strip_suffix('s') {
+        let s: f64 = seconds
+            .parse()
+            .with_context(|| format!("'{text}' is not a number of seconds"))?;
+        if !(s.is_finite() && s >= 0.0) {
+            bail!("'{text}': seconds must be 0 or more");
+        }
+        Ok((s * fps).round() as usize)
+    } else {
+        text.parse::<usize>().with_context(|| {
+            format!("'{text}' is not a frame number (use a whole number, or seconds as '2.5s')")
+        })
+    }
+}
+
+/// A span `START:END` (END exclusive, empty = `frames`), each part frames or seconds.
+pub fn parse_span(text: &str, fps: f64, frames: usize) -> Result<Span> {
+    let (a, b) = text
+        .split_once(':')
+        .with_context(|| format!("span '{text}' must look like START:END, e.g. 0:60 or 0s:2s"))?;
+    let start = if a.trim().is_empty() {
+        0
+    } else {
+        parse_position(a, fps).with_context(|| format!("in span '{text}'"))?
+    };
+    let end = if b.trim().is_empty() {
+        frames
+    } else {
+        parse_position(b, fps).with_context(|| format!("in span '{text}'"))?
+    };
+    Ok(Span::new(start, end))
+}
+
+/// Reads a BVH clip of the model's skeleton as raw features in the model's layout.
+pub fn reference_features(model: &Model, clip: &Path) -> Result<Array2<f32>> {
+    let channels = read_bvh(clip)?;
+    encode_for(&channels, &model.metadata().layout).with_context(|| {
+        format!(
+            "{}: cannot use it with model {}",
+            clip.display(),
+            model.path().display()
+        )
+    })
+}
+
+/// Checks that every output file can be written, before any work is done.
+fn check_writable(paths: &[PathBuf]) -> Result<()> {
+    for path in paths {
+        if path.is_dir() {
+            bail!("output '{}' is a folder; give a file name", path.display());
+        }
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("cannot create output folder '{}'", dir.display()))?;
+        let probe = dir.join(format!(".sinmdm-probe-{}", std::process::id()));
+        std::fs::write(&probe, b"")
+            .with_context(|| format!("cannot write in output folder '{}'", dir.display()))?;
+        let _ = std::fs::remove_file(&probe);
+    }
+    Ok(())
+}
+
+/// Runs a task with the shared options: checks the request and the outputs, samples with a
+/// progress bar, and writes every BVH (and the features JSON) atomically.
+pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Generated> {
+    let request = Request {
+        task,
+        count: args.count,
+        seed: args.seed,
+        steps: args.steps()?,
+    };
+    let plan = tasks::plan(model.metadata(), &request)?;
+    let mut outputs: Vec<PathBuf> = (0..args.count)
+        .map(|i| args.output_path(i, args.count))
+        .collect();
+    outputs.extend(args.features_json.iter().cloned());
+    check_writable(&outputs)?;
+
+    let bar = if args.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(plan.schedule.len() as u64)
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:30} {pos}/{len} steps, {per_sec}, ETA {eta} ({msg})",
+        )
+        .expect("valid template"),
+    );
+    bar.set_message(format!("{} x {} frames", args.count, plan.frames));
+    let generated = tasks::run(model, &request, &mut |done, _| {
+        bar.set_position(done as u64)
+    })?;
+    bar.finish_and_clear();
+
+    for i in 0..generated.count() {
+        let path = args.output_path(i, generated.count());
+        let motion = generated
+            .motion(i)
+            .with_context(|| format!("sample {i} could not be decoded"))?;
+        write_atomically(&path, to_bvh_string(&motion.to_channels()).as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.features_json {
+        write_features(path, generated.layout(), generated.features.view())?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(generated)
+}

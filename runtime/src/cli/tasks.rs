@@ -1,0 +1,211 @@
+//! The generating subcommands: `generate`, `inbetween`, `expand`, `compose`, `harmonize`.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use clap::Args;
+
+use super::sampling::{SamplingArgs, parse_position, parse_span, reference_features, run_task};
+use crate::tasks::{
+    EXPAND_RAMP, HARMONIZE_FACTOR, HARMONIZE_FREE_SHARE, INBETWEEN_RAMP, Task, joints_by_name,
+    subtree,
+};
+
+pub(super) const GENERATE_EXAMPLES: &str = "Examples:
+  sinmdm generate -m onnx-models/walk.onnx -o out/walk.bvh
+  sinmdm generate -m onnx-models/walk.onnx --seconds 20 -o out/long.bvh
+  sinmdm generate -m onnx-models/walk.onnx --count 8 --seed 7 -o out/crowd.bvh   # crowd_000..007.bvh
+  sinmdm generate -m onnx-models/walk.onnx --steps all -o out/full.bvh           # all 1000 steps";
+
+pub(super) const INBETWEEN_EXAMPLES: &str = "Examples:
+  sinmdm inbetween -m onnx-models/walk.onnx --reference walk.bvh --keep 0:60 --keep 180: -o out/inbetween.bvh
+  sinmdm inbetween -m onnx-models/walk.onnx --reference walk.bvh --keep 0s:2s --keep 6s: -o out/ib.bvh --count 4";
+
+pub(super) const EXPAND_EXAMPLES: &str = "Examples:
+  sinmdm expand -m onnx-models/walk.onnx --reference walk.bvh --prefix 2s --suffix 2s -o out/expanded.bvh
+  sinmdm expand -m onnx-models/walk.onnx --reference walk.bvh --suffix 300 -o out/longer.bvh";
+
+pub(super) const COMPOSE_EXAMPLES: &str = "Examples:
+  sinmdm compose -m onnx-models/walk.onnx --reference walk.bvh --part LeftUpLeg --part RightUpLeg --root -o out/new_upper_body.bvh
+  sinmdm compose -m onnx-models/walk.onnx --reference walk.bvh --joints Head,Neck --frames 0:120 -o out/c.bvh";
+
+pub(super) const HARMONIZE_EXAMPLES: &str = "Examples:
+  sinmdm harmonize -m onnx-models/hop.onnx --content walk.bvh -o out/walk_in_hop_style.bvh
+  sinmdm harmonize -m onnx-models/hop.onnx --content walk.bvh --factor 4 --free-share 0.05 -o out/t.bvh";
+
+/// Arguments of `sinmdm generate`.
+#[derive(Debug, Args)]
+pub struct GenerateArgs {
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// Frames per sample (default: twice the training clip).
+    #[arg(long, conflicts_with = "seconds")]
+    frames: Option<usize>,
+    /// Length per sample in seconds, at the model's frame rate.
+    #[arg(long)]
+    seconds: Option<f64>,
+}
+
+/// Arguments of `sinmdm inbetween`.
+#[derive(Debug, Args)]
+pub struct InbetweenArgs {
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// The clip whose spans are kept (same skeleton as the model).
+    #[arg(long, value_name = "CLIP.bvh")]
+    reference: PathBuf,
+    /// A span of the reference to keep, START:END (END exclusive; empty END = the end), in frames
+    /// or seconds (`2s`). Repeat for several; the gaps between them are generated.
+    #[arg(long, required = true, value_name = "START:END")]
+    keep: Vec<String>,
+    /// Soft border inside each kept span, in frames.
+    #[arg(long, default_value_t = INBETWEEN_RAMP)]
+    ramp: usize,
+}
+
+/// Arguments of `sinmdm expand`.
+#[derive(Debug, Args)]
+pub struct ExpandArgs {
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// The clip to expand (same skeleton as the model).
+    #[arg(long, value_name = "CLIP.bvh")]
+    reference: PathBuf,
+    /// New motion before the clip, in frames or seconds (`2s`).
+    #[arg(long, default_value = "0")]
+    prefix: String,
+    /// New motion after the clip, in frames or seconds (`2s`).
+    #[arg(long, default_value = "0")]
+    suffix: String,
+    /// Soft border inside the clip, in frames.
+    #[arg(long, default_value_t = EXPAND_RAMP)]
+    ramp: usize,
+}
+
+/// Arguments of `sinmdm compose`.
+#[derive(Debug, Args)]
+pub struct ComposeArgs {
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// The clip the chosen joints come from (same skeleton as the model).
+    #[arg(long, value_name = "CLIP.bvh")]
+    reference: PathBuf,
+    /// Joints taken from the reference, comma-separated names.
+    #[arg(long, value_delimiter = ',')]
+    joints: Vec<String>,
+    /// A body part taken from the reference: the named joint and every joint below it
+    /// (e.g. `LeftUpLeg` for the left leg, `Spine` for the upper body). Repeat for several.
+    #[arg(long, value_name = "JOINT")]
+    part: Vec<String>,
+    /// Take the root's travel and height from the reference.
+    #[arg(long)]
+    root: bool,
+    /// Frame spans where the reference is kept, START:END in frames or seconds (default: all).
+    #[arg(long, value_name = "START:END")]
+    frames: Vec<String>,
+    /// Soft border at the ends of --frames spans, in frames.
+    #[arg(long, default_value_t = INBETWEEN_RAMP)]
+    ramp: usize,
+}
+
+/// Arguments of `sinmdm harmonize`.
+#[derive(Debug, Args)]
+pub struct HarmonizeArgs {
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// The content clip (same skeleton as the model, which was trained on the style clip).
+    #[arg(long, value_name = "CLIP.bvh")]
+    content: PathBuf,
+    /// Down-sampling factor of the low-pass that carries the content.
+    #[arg(long, default_value_t = HARMONIZE_FACTOR)]
+    factor: usize,
+    /// Share of the final steps run without the content's low frequencies.
+    #[arg(long, default_value_t = HARMONIZE_FREE_SHARE)]
+    free_share: f64,
+}
+
+pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
+    let mut model = args.sampling.open_model()?;
+    let meta = model.metadata();
+    let frames = match (args.frames, args.seconds) {
+        (Some(f), _) => f,
+        (None, Some(s)) => {
+            if !(s.is_finite() && s > 0.0) {
+                bail!("--seconds must be a positive number, got {s}");
+            }
+            (s * meta.layout.fps).round() as usize
+        }
+        (None, None) => 2 * meta.training.clip_frames,
+    };
+    run_task(&args.sampling, &mut model, Task::Generate { frames })?;
+    Ok(())
+}
+
+pub(super) fn inbetween(args: &InbetweenArgs) -> Result<()> {
+    let mut model = args.sampling.open_model()?;
+    let reference = reference_features(&model, &args.reference)?;
+    let fps = model.metadata().layout.fps;
+    let keep = args
+        .keep
+        .iter()
+        .map(|s| parse_span(s, fps, reference.ncols()))
+        .collect::<Result<Vec<_>>>()?;
+    let task = Task::Inbetween {
+        reference,
+        keep,
+        ramp: args.ramp,
+    };
+    run_task(&args.sampling, &mut model, task)?;
+    Ok(())
+}
+
+pub(super) fn expand(args: &ExpandArgs) -> Result<()> {
+    let mut model = args.sampling.open_model()?;
+    let reference = reference_features(&model, &args.reference)?;
+    let fps = model.metadata().layout.fps;
+    let task = Task::Expand {
+        reference,
+        prefix: parse_position(&args.prefix, fps)?,
+        suffix: parse_position(&args.suffix, fps)?,
+        ramp: args.ramp,
+    };
+    run_task(&args.sampling, &mut model, task)?;
+    Ok(())
+}
+
+pub(super) fn compose(args: &ComposeArgs) -> Result<()> {
+    let mut model = args.sampling.open_model()?;
+    let reference = reference_features(&model, &args.reference)?;
+    let layout = &model.metadata().layout;
+    let fps = layout.fps;
+    let mut joints = joints_by_name(layout, &args.joints)?;
+    for top in joints_by_name(layout, &args.part)? {
+        joints.extend(subtree(layout, top));
+    }
+    let spans = args
+        .frames
+        .iter()
+        .map(|s| parse_span(s, fps, reference.ncols()))
+        .collect::<Result<Vec<_>>>()?;
+    let task = Task::Compose {
+        reference,
+        joints,
+        root: args.root,
+        spans,
+        ramp: args.ramp,
+    };
+    run_task(&args.sampling, &mut model, task)?;
+    Ok(())
+}
+
+pub(super) fn harmonize(args: &HarmonizeArgs) -> Result<()> {
+    let mut model = args.sampling.open_model()?;
+    let content = reference_features(&model, &args.content)?;
+    let task = Task::Harmonize {
+        content,
+        factor: args.factor,
+        free_share: args.free_share,
+    };
+    run_task(&args.sampling, &mut model, task)?;
+    Ok(())
+}

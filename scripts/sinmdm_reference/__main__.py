@@ -1,0 +1,118 @@
+"""Command line of the Python reference, mirroring `sinmdm`:
+
+    python -m sinmdm_reference generate  --model M.onnx --frames N [--count C] [--seed S] [--steps S|all] -o OUT.json
+    python -m sinmdm_reference inbetween --model M.onnx --reference REF.json --keep 0:60 --keep 180: -o OUT.json
+    python -m sinmdm_reference expand    --model M.onnx --reference REF.json --prefix 2s --suffix 60 -o OUT.json
+    python -m sinmdm_reference compose   --model M.onnx --reference REF.json --part LeftUpLeg --root -o OUT.json
+    python -m sinmdm_reference harmonize --model M.onnx --content REF.json [--factor 2] [--free-share 0.02] -o OUT.json
+
+References are features files (`sinmdm encode CLIP.bvh -m M.onnx -o REF.json`); the output is
+the unnormalised features of every sample, the same file `sinmdm ... --features-json` writes.
+"""
+
+import argparse
+import sys
+
+import numpy as np
+
+from . import tasks
+from .features import read_features, write_features
+from .model import Model, ModelError
+from .sampler import sample
+
+
+def _steps(text):
+    return None if text.lower() == "all" else int(text)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="sinmdm_reference", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    def common(p):
+        p.add_argument("-m", "--model", required=True)
+        p.add_argument("-o", "--output", required=True, help="features JSON to write")
+        p.add_argument("--count", type=int, default=1)
+        p.add_argument("--seed", type=int, default=0)
+        p.add_argument("--steps", default="100", help="respaced steps S, or 'all'")
+        p.add_argument("--threads", type=int, default=None)
+        return p
+
+    g = common(sub.add_parser("generate"))
+    g.add_argument("--frames", type=int)
+    g.add_argument("--seconds", type=float)
+    ib = common(sub.add_parser("inbetween"))
+    ib.add_argument("--reference", required=True)
+    ib.add_argument("--keep", action="append", required=True)
+    ib.add_argument("--ramp", type=int, default=tasks.INBETWEEN_RAMP)
+    ex = common(sub.add_parser("expand"))
+    ex.add_argument("--reference", required=True)
+    ex.add_argument("--prefix", default="0")
+    ex.add_argument("--suffix", default="0")
+    ex.add_argument("--ramp", type=int, default=tasks.EXPAND_RAMP)
+    co = common(sub.add_parser("compose"))
+    co.add_argument("--reference", required=True)
+    co.add_argument("--joints", default="")
+    co.add_argument("--part", action="append", default=[])
+    co.add_argument("--root", action="store_true")
+    co.add_argument("--frames", action="append", default=[])
+    co.add_argument("--ramp", type=int, default=tasks.INBETWEEN_RAMP)
+    ha = common(sub.add_parser("harmonize"))
+    ha.add_argument("--content", required=True)
+    ha.add_argument("--factor", type=int, default=tasks.HARMONIZE_FACTOR)
+    ha.add_argument("--free-share", type=float, default=tasks.HARMONIZE_FREE_SHARE)
+    args = parser.parse_args(argv)
+
+    try:
+        model = Model(args.model, args.threads)
+        fps = model.layout["fps"]
+        inpainting = harmonization = None
+
+        def reference(path):
+            feats, _ = read_features(path)
+            return feats[0]
+
+        if args.command == "generate":
+            if args.frames is not None:
+                frames = args.frames
+            elif args.seconds is not None:
+                frames = int(np.floor(args.seconds * fps + 0.5))
+            else:
+                frames = 2 * model.metadata["training"]["clip_frames"]
+        elif args.command == "inbetween":
+            ref = reference(args.reference)
+            keep = [tasks.parse_span(s, fps, ref.shape[1]) for s in args.keep]
+            frames, inpainting = tasks.plan_inbetween(model, ref, keep, args.ramp)
+        elif args.command == "expand":
+            ref = reference(args.reference)
+            frames, inpainting = tasks.plan_expand(
+                model, ref, tasks.parse_position(args.prefix, fps), tasks.parse_position(args.suffix, fps), args.ramp)
+        elif args.command == "compose":
+            ref = reference(args.reference)
+            layout = model.layout
+            names = [n for n in args.joints.split(",") if n]
+            joints = tasks.joints_by_name(layout, names)
+            for top in tasks.joints_by_name(layout, args.part):
+                joints += tasks.subtree(layout, top)
+            spans = [tasks.parse_span(s, fps, ref.shape[1]) for s in args.frames]
+            frames, inpainting = tasks.plan_compose(model, ref, joints, args.root, spans, args.ramp)
+        else:
+            ref = reference(args.content)
+            frames, harmonization = tasks.plan_harmonize(model, ref, args.factor, args.free_share)
+        if not 1 <= args.count <= tasks.MAX_COUNT:
+            raise tasks.TaskError(f"--count must be between 1 and {tasks.MAX_COUNT}")
+        if not 1 <= frames <= tasks.MAX_FRAMES:
+            raise tasks.TaskError(f"a sample of {frames} frames is not possible")
+        schedule = tasks.schedule_for(model, _steps(args.steps))
+        x = sample(model, schedule, args.count, frames, args.seed, inpainting, harmonization)
+        write_features(args.output, model.layout, model.denormalize(x))
+    except (ModelError, tasks.TaskError, ValueError, OSError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    print(f"wrote {args.output}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,78 @@
+"""Ancestral DDPM sampling with mask blending and harmonization (runtime/src/diffusion/sampler.rs).
+
+Every array operation is float32, in the same order as the Rust loop; coefficients are float64
+rounded once to float32.
+"""
+
+import numpy as np
+
+from .noise import HARMONIZE_STREAM_BASE, INITIAL_NOISE_STREAM, normals
+
+
+def downsample(x, factor):
+    """Average of each group of `factor` frames along the last axis (the last group may be shorter)."""
+    n = x.shape[-1]
+    m = -(-n // factor)
+    out = np.empty(x.shape[:-1] + (m,), dtype=np.float32)
+    for j in range(m):
+        group = x[..., j * factor : min((j + 1) * factor, n)]
+        total = np.zeros(x.shape[:-1], dtype=np.float32)
+        for i in range(group.shape[-1]):
+            total = total + group[..., i]
+        out[..., j] = total / np.float32(group.shape[-1])
+    return out
+
+
+def upsample(z, factor, n):
+    """Linear interpolation to n frames: frame i reads u = (i + 0.5) / factor - 0.5, clamped."""
+    m = z.shape[-1]
+    out = np.empty(z.shape[:-1] + (n,), dtype=np.float32)
+    for i in range(n):
+        u = min(max((i + 0.5) / factor - 0.5, 0.0), float(m - 1))
+        i0 = int(np.floor(u))
+        i1 = min(i0 + 1, m - 1)
+        w = np.float32(u - i0)
+        out[..., i] = z[..., i0] * (np.float32(1.0) - w) + z[..., i1] * w
+    return out
+
+
+def low_pass(x, factor):
+    return upsample(downsample(x, factor), factor, x.shape[-1])
+
+
+def _noise(seed, stream, shape):
+    return normals(seed, stream, int(np.prod(shape))).reshape(shape)
+
+
+def sample(model, schedule, batch, frames, seed, inpainting=None, harmonization=None, progress=None):
+    """Normalised features [B, F, N].
+
+    inpainting: (reference [F, N], mask [F, N]) normalised; harmonization: (content [F, N],
+    factor, free_share)."""
+    shape = (batch, model.features, frames)
+    steps = len(schedule.timesteps)
+    free = int(np.floor(harmonization[2] * steps + 0.5)) if harmonization else 0
+    one = np.float32(1.0)
+    x = _noise(seed, INITIAL_NOISE_STREAM, shape)
+    for step in range(steps):
+        k = steps - 1 - step
+        t = np.full(batch, schedule.timesteps[k], dtype=np.int64)
+        x0 = model.denoise(x, t)
+        if inpainting is not None:
+            y, m = inpainting
+            x0 = x0 * (one - m) + y * m
+        c0, ct = schedule.posterior_mean_coefficients(k)
+        x = np.float32(c0) * x0 + np.float32(ct) * x
+        if k > 0:
+            sigma = np.float32(schedule.posterior_std(k))
+            x = x + sigma * _noise(seed, step + 1, shape)
+        if harmonization is not None and step < steps - free:
+            content, factor, _ = harmonization
+            a, s = schedule.q_sample_coefficients(k - 1) if k > 0 else (1.0, 0.0)
+            noisy = np.float32(a) * content + np.float32(s) * _noise(seed, HARMONIZE_STREAM_BASE + step + 1, shape)
+            ours = low_pass(x, factor)
+            theirs = low_pass(noisy, factor)
+            x = x - ours + theirs
+        if progress:
+            progress(step + 1, steps)
+    return x
