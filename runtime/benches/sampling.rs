@@ -22,7 +22,14 @@ fn peak_memory_mib() -> Option<f64> {
 }
 
 /// Mean seconds of one bare onnxruntime call on a fresh session of the same file.
-fn bare_step_seconds(path: &str, threads: usize, b: usize, f: usize, n: usize, calls: usize) -> f64 {
+fn bare_step_seconds(
+    path: &str,
+    threads: usize,
+    b: usize,
+    f: usize,
+    n: usize,
+    calls: usize,
+) -> f64 {
     let rt = sinmdm::onnxruntime::init().expect("onnxruntime");
     let mut session = Session::builder(&rt.environment)
         .and_then(|s| Ok(s.with_intra_threads(threads)?))
@@ -76,7 +83,9 @@ fn main() {
         model.metadata().network.parameters,
         size as f64 / 1e6
     );
-    println!("| batch | steps | bare ort s/call | loop s/step | overhead | s/sample run | peak MiB |");
+    println!(
+        "| batch | steps | bare ort s/call | loop s/step | overhead | s/sample run | peak MiB |"
+    );
     println!("|---|---|---|---|---|---|---|");
     for &(batch, steps) in &[(1, 1000), (1, 100), (16, 100), (16, 1000)] {
         if batch == 16 && steps == 1000 && std::env::var("SINMDM_BENCH_LONG").is_err() {
@@ -90,7 +99,10 @@ fn main() {
             Schedule::respaced(1000, steps).unwrap()
         };
         let _warm = model
-            .denoise(Array3::<f32>::zeros((batch, f, frames)).view(), &vec![1; batch])
+            .denoise(
+                Array3::<f32>::zeros((batch, f, frames)).view(),
+                &vec![1; batch],
+            )
             .unwrap();
         let start = Instant::now();
         let out = sample(

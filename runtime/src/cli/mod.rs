@@ -3,6 +3,7 @@
 
 mod info;
 mod inspect;
+mod render;
 mod sampling;
 mod tasks;
 
@@ -39,6 +40,9 @@ pub enum Command {
     /// Style transfer: a content clip's low frequencies in the style the model learned.
     #[command(after_help = tasks::HARMONIZE_EXAMPLES)]
     Harmonize(tasks::HarmonizeArgs),
+    /// Draw BVH clips as stick figures: an animated GIF, or a PNG contact sheet.
+    #[command(after_help = render::EXAMPLES)]
+    Render(render::RenderArgs),
     /// Print what a model file holds: network, skeleton, features, training facts.
     #[command(after_help = info::INFO_EXAMPLES)]
     Info(info::InfoArgs),
@@ -58,6 +62,7 @@ pub fn main() -> std::process::ExitCode {
         Command::Compose(args) => tasks::compose(&args),
         Command::Harmonize(args) => tasks::harmonize(&args),
         Command::Info(args) => info::info(&args),
+        Command::Render(args) => render::run(&args),
         Command::Encode(args) => info::encode(&args),
     };
     match result {

@@ -12,7 +12,10 @@ use crate::features_file::write_features;
 use crate::files::write_atomically;
 use crate::model::{Model, ModelOptions};
 use crate::motion::encode_for;
+use crate::render::{Camera, Figure};
 use crate::tasks::{self, Generated, Request, Span, Task};
+
+use super::render::write_picture;
 
 /// Default respaced sampling steps of the command line (see the README for the measurement).
 pub const DEFAULT_STEPS: &str = "100";
@@ -42,6 +45,10 @@ pub struct SamplingArgs {
     /// Also write the raw features of every sample as JSON here.
     #[arg(long, value_name = "OUT.json")]
     pub features_json: Option<PathBuf>,
+    /// Also draw what was made: an animated .gif of all samples side by side, or a .png contact
+    /// sheet; parts kept from a reference are drawn in red.
+    #[arg(long, value_name = "OUT.gif|OUT.png")]
+    pub render: Option<PathBuf>,
     /// Do not show the progress bar.
     #[arg(long)]
     pub quiet: bool,
@@ -175,6 +182,7 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         .map(|i| args.output_path(i, args.count))
         .collect();
     outputs.extend(args.features_json.iter().cloned());
+    outputs.extend(args.render.iter().cloned());
     check_writable(&outputs)?;
 
     let bar = if args.quiet {
@@ -206,6 +214,33 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
     if let Some(path) = &args.features_json {
         write_features(path, generated.layout(), generated.features.view())?;
         eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.render {
+        let layout = generated.layout();
+        let kept = plan.guidance.inpainting.as_ref().map(|inpaint| {
+            (0..plan.frames)
+                .map(|frame| {
+                    (0..layout.skeleton.len())
+                        .map(|joint| {
+                            let columns = layout.joint_columns(joint);
+                            !columns.is_empty()
+                                && columns.iter().all(|&c| inpaint.mask[[c, frame]] >= 1.0)
+                        })
+                        .collect()
+                })
+                .collect::<Vec<Vec<bool>>>()
+        });
+        let mut figures = Vec::new();
+        for i in 0..generated.count() {
+            let mut figure = Figure::new(
+                &generated.motion(i)?,
+                format!("sample {i}"),
+                layout.contact_speed_threshold,
+            );
+            figure.kept = kept.clone();
+            figures.push(figure);
+        }
+        write_picture(path, &figures, Camera::Follow, 320, 8)?;
     }
     Ok(generated)
 }

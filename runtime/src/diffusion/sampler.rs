@@ -170,9 +170,8 @@ pub fn sample<D: Denoiser>(
                 scope.spawn(|| noise(seed, HARMONIZE_STREAM_BASE + step as u64 + 1, shape))
             });
             let x0 = denoiser.denoise(x.view(), &t);
-            let join = |h: std::thread::ScopedJoinHandle<'_, Array3<f32>>| {
-                h.join().expect("noise thread")
-            };
+            let join =
+                |h: std::thread::ScopedJoinHandle<'_, Array3<f32>>| h.join().expect("noise thread");
             (x0, eps.map(join), harmonize_eps.map(join))
         });
         let mut x0 = x0?;
