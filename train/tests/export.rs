@@ -117,3 +117,37 @@ fn onnxruntime_matches_burn_for_any_batch_and_length() {
     assert!(weights_of(&model).contains_key("attention1.rpe"));
     std::fs::remove_dir_all(&run).unwrap();
 }
+
+/// A one-step run of configs/tiny.yaml with `channels`; returns its newest checkpoint folder.
+fn one_step_run(name: &str, channels: usize) -> PathBuf {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let mut config: TrainConfig = TrainConfig::load(&root().join("configs/tiny.yaml")).unwrap();
+    config.training.steps = 1;
+    config.model.channels = channels;
+    let run = scratch(name);
+    let clip = root().join("tests/data/bvh/fox_survey_khronos.bvh");
+    let mut trainer = Trainer::start(&clip, config, &run, Device::flex().autodiff()).unwrap();
+    trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
+    sinmdm_train::checkpoint::resolve(&run).unwrap()
+}
+
+#[test]
+fn a_checkpoint_with_weights_of_another_shape_is_refused() {
+    let small = one_step_run("small", 32);
+    let large = one_step_run("large", 64);
+    std::fs::copy(large.join("model.bpk"), small.join("model.bpk")).unwrap();
+    let out = small.join("model.onnx");
+    let e = sinmdm_train::export::export_checkpoint(&small, &out).unwrap_err();
+    let message = e.to_string();
+    assert!(
+        message.contains("the weights do not fit this model"),
+        "{message}"
+    );
+    assert!(message.contains("model.bpk"), "{message}");
+    assert!(!out.exists(), "a file was written");
+    let e = sinmdm_train::export::export_checkpoint(&root().join("configs"), &out).unwrap_err();
+    assert!(e.to_string().contains("configs"), "{e}");
+    for run in [small, large] {
+        std::fs::remove_dir_all(run.parent().unwrap().parent().unwrap()).unwrap();
+    }
+}
