@@ -61,3 +61,21 @@ def test_runs_with_dynamic_batch_and_length(model_file):
         (x0,) = session.run(["x0"], {"x_t": x, "t": t})
         assert x0.shape == (b, f, n)
         assert np.isfinite(x0).all()
+
+
+def test_train_export_flag_and_info(tmp_path):
+    """`sinmdm-train --export` writes the model at the end of training; `sinmdm info` reads it."""
+    if not TRAIN.exists():
+        pytest.skip("build the workspace in release first (scripts/setup.sh)")
+    config = tmp_path / "tiny.yaml"
+    config.write_text((ROOT / "configs" / "tiny.yaml").read_text().replace("steps: 300", "steps: 3"))
+    clip = ROOT / "tests" / "data" / "bvh" / "human_walk_cmu_131_01.bvh"
+    out = tmp_path / "models" / "walk.onnx"
+    subprocess.run([TRAIN, clip, "--config", config, "--out", tmp_path / "run", "--export", out],
+                   check=True, capture_output=True)
+    onnx.checker.check_model(onnx.load(str(out)), full_check=True)
+    info = subprocess.run([ROOT / "target" / "release" / "sinmdm", "info", out],
+                          capture_output=True, text=True, check=True).stdout
+    assert "QnA-UNet, 191 features, 32 channels, 4 heads, window 3, receptive field 23 frames" in info
+    assert "trained on   human_walk_cmu_131_01.bvh (249 frames" in info
+    assert "training     3 steps" in info
