@@ -197,7 +197,7 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         .expect("valid template"),
     );
     bar.set_message(format!("{} x {} frames", args.count, plan.frames));
-    let generated = tasks::run(model, &request, &mut |done, _| {
+    let generated = tasks::run_plan(model, &plan, request.count, request.seed, &mut |done, _| {
         bar.set_position(done as u64)
     })?;
     bar.finish_and_clear();

@@ -441,12 +441,23 @@ pub fn run(
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Generated, TaskError> {
     let plan = plan(model.metadata(), request)?;
+    run_plan(model, &plan, request.count, request.seed, progress)
+}
+
+/// Samples `count` motions of a plan already made by [`plan`] for this model.
+pub fn run_plan(
+    model: &mut Model,
+    plan: &Plan,
+    count: usize,
+    seed: u64,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Generated, TaskError> {
     let normalized = sample(
         model,
         &plan.schedule,
-        request.count,
+        count,
         plan.frames,
-        request.seed,
+        seed,
         &plan.guidance,
         progress,
     )?;
