@@ -278,6 +278,20 @@ fn motion_root(skeleton: &Skeleton, varying_position: &[bool]) -> usize {
     }
 }
 
+/// Refuses a resampling to `fps` that would make more than [`MAX_FRAMES`] frames.
+fn check_resampled_length(clip: &ChannelClip, fps: f64) -> Result<(), MotionError> {
+    let resampled = (clip.frame_count() as f64 - 1.0) * fps / clip.fps + 1.0;
+    if resampled.is_nan() || resampled > MAX_FRAMES as f64 {
+        return Err(MotionError::TooManyFrames {
+            frames: clip.frame_count(),
+            from_fps: clip.fps,
+            to_fps: fps,
+            limit: MAX_FRAMES,
+        });
+    }
+    Ok(())
+}
+
 /// Turns a clip into features: resampled to `options.fps`, root displacement and height, 6D
 /// rotations, varying positions and contact labels.
 pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip, MotionError> {
@@ -296,15 +310,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
             return Err(MotionError::BadContactSetting { what, value });
         }
     }
-    let resampled = (clip.frame_count() as f64 - 1.0) * fps / clip.fps + 1.0;
-    if resampled.is_nan() || resampled > MAX_FRAMES as f64 {
-        return Err(MotionError::TooManyFrames {
-            frames: clip.frame_count(),
-            from_fps: clip.fps,
-            to_fps: fps,
-            limit: MAX_FRAMES,
-        });
-    }
+    check_resampled_length(clip, fps)?;
     let skeleton = &clip.skeleton;
     let varies = varying_channels(clip);
     let starts = skeleton.channel_starts();
@@ -474,15 +480,7 @@ pub fn encode_for(clip: &ChannelClip, layout: &FeatureLayout) -> Result<Array2<f
     if let Some(problem) = layout.skeleton.difference(&clip.skeleton) {
         return Err(MotionError::SkeletonMismatch(problem));
     }
-    let resampled = (clip.frame_count() as f64 - 1.0) * layout.fps / clip.fps + 1.0;
-    if resampled.is_nan() || resampled > MAX_FRAMES as f64 {
-        return Err(MotionError::TooManyFrames {
-            frames: clip.frame_count(),
-            from_fps: clip.fps,
-            to_fps: layout.fps,
-            limit: MAX_FRAMES,
-        });
-    }
+    check_resampled_length(clip, layout.fps)?;
     let local = resample(&clip.to_local(), layout.fps);
     let poses = global_poses(&local);
     Ok(fill_features(layout, &local, &poses).0)
