@@ -157,10 +157,10 @@ impl Projection {
     }
 }
 
-fn projection(figure: &Figure, frame: usize, options: &RenderOptions, left: usize) -> Projection {
+fn projection(figure: &Figure, frame: usize, options: &RenderOptions) -> Projection {
     let (right, up) = view_axes();
     let (w, h) = (options.panel_width as f64, options.panel_height as f64);
-    let origin = (left as f64 + w / 2.0, h * 0.78);
+    let origin = (w / 2.0, h * 0.78);
     match options.camera {
         Camera::Follow => Projection {
             centre: figure.root_ground(frame),
@@ -268,18 +268,15 @@ pub fn render_frame(figures: &[Figure], frame: usize, options: &RenderOptions) -
         }
         let f = frame.min(figure.frames() - 1);
         let left = i * options.panel_width;
-        let view = projection(figure, f, options, left);
+        // Each panel is drawn on its own canvas, so nothing spills into its neighbours.
+        let view = projection(figure, f, options);
         let mut panel = Canvas::new(options.panel_width, options.panel_height, BACKGROUND);
-        let local = Projection {
-            origin: (view.origin.0 - left as f64, view.origin.1),
-            ..view
-        };
-        draw_grid(&mut panel, figure, &local);
+        draw_grid(&mut panel, figure, &view);
         draw_figure(
             &mut panel,
             figure,
             f,
-            &local,
+            &view,
             FIGURE_COLOURS[i % FIGURE_COLOURS.len()],
             thickness,
         );
@@ -308,19 +305,17 @@ pub fn contact_sheet(figures: &[Figure], count: usize, options: &RenderOptions) 
     let mut sheet = Canvas::new(w * count, h * figures.len().max(1), BACKGROUND);
     for (row, figure) in figures.iter().enumerate() {
         let n = figure.frames().max(1);
+        // Only the first tile of a row carries the label.
+        let mut unlabelled = figure.clone();
+        unlabelled.label.clear();
         for k in 0..count {
             let frame = if count == 1 {
                 0
             } else {
                 k * (n - 1) / (count - 1)
             };
-            let mut one = figure.clone();
-            one.label = if k == 0 {
-                figure.label.clone()
-            } else {
-                String::new()
-            };
-            let tile = render_frame(std::slice::from_ref(&one), frame, options);
+            let tile_figure = if k == 0 { figure } else { &unlabelled };
+            let tile = render_frame(std::slice::from_ref(tile_figure), frame, options);
             for y in 0..h {
                 let from = y * w * 3;
                 let to = ((row * h + y) * sheet.width + k * w) * 3;
@@ -334,7 +329,7 @@ pub fn contact_sheet(figures: &[Figure], count: usize, options: &RenderOptions) 
 /// Projected height in pixels of the figure at `frame` (highest to lowest drawn point) under
 /// the renders' camera: for tests and framing checks.
 pub fn projected_height(figure: &Figure, frame: usize, options: &RenderOptions) -> f64 {
-    let view = projection(figure, frame, options, 0);
+    let view = projection(figure, frame, options);
     let ys: Vec<f64> = figure.poses[frame]
         .points()
         .map(|p| view.to_screen(p).1)
