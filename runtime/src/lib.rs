@@ -22,6 +22,7 @@ pub mod bvh;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod diffusion;
+pub mod eval;
 pub mod features_file;
 pub mod files;
 pub mod model;

@@ -1,6 +1,7 @@
 //! The `sinmdm` command line (feature `cli`): argument parsing and printing; the work is done by
 //! the library.
 
+mod eval;
 mod info;
 mod inspect;
 mod render;
@@ -43,6 +44,9 @@ pub enum Command {
     /// Draw BVH clips as stick figures: an animated GIF, or a PNG contact sheet.
     #[command(after_help = render::EXAMPLES)]
     Render(render::RenderArgs),
+    /// Score a model: generate samples and measure coverage and diversity against its clip.
+    #[command(after_help = eval::EXAMPLES)]
+    Eval(eval::EvalArgs),
     /// Print what a model file holds: network, skeleton, features, training facts.
     #[command(after_help = info::INFO_EXAMPLES)]
     Info(info::InfoArgs),
@@ -61,6 +65,7 @@ pub fn main() -> std::process::ExitCode {
         Command::Expand(args) => tasks::expand(&args),
         Command::Compose(args) => tasks::compose(&args),
         Command::Harmonize(args) => tasks::harmonize(&args),
+        Command::Eval(args) => eval::run(&args),
         Command::Info(args) => info::info(&args),
         Command::Render(args) => render::run(&args),
         Command::Encode(args) => info::encode(&args),

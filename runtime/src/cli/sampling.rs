@@ -57,16 +57,7 @@ pub struct SamplingArgs {
 impl SamplingArgs {
     /// `None` for all steps.
     pub fn steps(&self) -> Result<Option<usize>> {
-        if self.steps.eq_ignore_ascii_case("all") {
-            return Ok(None);
-        }
-        match self.steps.parse::<usize>() {
-            Ok(s) => Ok(Some(s)),
-            Err(_) => bail!(
-                "--steps must be a whole number of steps or 'all', got '{}'",
-                self.steps
-            ),
-        }
+        parse_steps(&self.steps)
     }
 
     /// Opens the model with the requested threads.
@@ -97,6 +88,17 @@ impl SamplingArgs {
             .map_or("bvh".into(), |e| e.to_string_lossy().into_owned());
         self.output
             .with_file_name(format!("{stem}_{index:03}.{ext}"))
+    }
+}
+
+/// `--steps`: a number of respaced steps, or `all` (`None`) for the model's full T.
+pub fn parse_steps(text: &str) -> Result<Option<usize>> {
+    if text.eq_ignore_ascii_case("all") {
+        return Ok(None);
+    }
+    match text.parse::<usize>() {
+        Ok(s) => Ok(Some(s)),
+        Err(_) => bail!("--steps must be a whole number of steps or 'all', got '{text}'"),
     }
 }
 
@@ -148,8 +150,25 @@ pub fn reference_features(model: &Model, clip: &Path) -> Result<Array2<f32>> {
     })
 }
 
+/// A progress bar over sampling steps (hidden with `quiet`; indicatif hides it off a terminal).
+pub fn progress_bar(quiet: bool, steps: usize, message: String) -> indicatif::ProgressBar {
+    let bar = if quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(steps as u64)
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:30} {pos}/{len} steps, {per_sec}, ETA {eta} ({msg})",
+        )
+        .expect("valid template"),
+    );
+    bar.set_message(message);
+    bar
+}
+
 /// Checks that every output file can be written, before any work is done.
-fn check_writable(paths: &[PathBuf]) -> Result<()> {
+pub fn check_writable(paths: &[PathBuf]) -> Result<()> {
     for path in paths {
         if path.is_dir() {
             bail!("output '{}' is a folder; give a file name", path.display());
@@ -185,18 +204,11 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
     outputs.extend(args.render.iter().cloned());
     check_writable(&outputs)?;
 
-    let bar = if args.quiet {
-        indicatif::ProgressBar::hidden()
-    } else {
-        indicatif::ProgressBar::new(plan.schedule.len() as u64)
-    };
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:30} {pos}/{len} steps, {per_sec}, ETA {eta} ({msg})",
-        )
-        .expect("valid template"),
+    let bar = progress_bar(
+        args.quiet,
+        plan.schedule.len(),
+        format!("{} x {} frames", args.count, plan.frames),
     );
-    bar.set_message(format!("{} x {} frames", args.count, plan.frames));
     let generated = tasks::run_plan(model, &plan, request.count, request.seed, &mut |done, _| {
         bar.set_position(done as u64)
     })?;

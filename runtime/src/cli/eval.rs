@@ -1,0 +1,213 @@
+//! `sinmdm eval`: samples a model and scores the samples against its training clip.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use ndarray::{Array2, Axis};
+use serde::Serialize;
+
+use super::sampling::{
+    DEFAULT_STEPS, check_writable, parse_steps, progress_bar, reference_features,
+};
+use crate::eval::{COVERAGE_WINDOW, Report, evaluate, metric_features};
+use crate::files::write_atomically;
+use crate::model::{Model, ModelOptions};
+use crate::tasks::{self, Request, Task};
+
+pub(super) const EXAMPLES: &str = "Examples:
+  sinmdm eval -m onnx-models/human_walk_cmu.onnx --clip tests/data/bvh/human_walk_cmu_131_01.bvh
+  sinmdm eval -m walk.onnx --clip walk.bvh --samples 20 --steps all --json out/walk_eval.json
+
+Samples are twice the clip's length by default, as in the published benchmark. The table is
+Markdown, ready for a model card.";
+
+/// Arguments of `sinmdm eval`.
+#[derive(Debug, Args)]
+pub struct EvalArgs {
+    /// The trained model.
+    #[arg(short, long, value_name = "MODEL.onnx")]
+    model: PathBuf,
+    /// The clip to score against: the model's training clip.
+    #[arg(long, value_name = "CLIP.bvh")]
+    clip: PathBuf,
+    /// Samples to generate (one batched run).
+    #[arg(long, default_value_t = 20)]
+    samples: usize,
+    /// Frames per sample (default: twice the clip).
+    #[arg(long)]
+    frames: Option<usize>,
+    /// Denoising steps: a number S of respaced steps, or `all`.
+    #[arg(long, default_value = DEFAULT_STEPS, value_name = "S|all")]
+    steps: String,
+    /// Seed of the samples.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Threads for the network and the metrics (default: every core).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Also write the scores (with every sample's) as JSON here.
+    #[arg(long, value_name = "OUT.json")]
+    json: Option<PathBuf>,
+    /// Do not show the progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// The JSON file `--json` writes.
+#[derive(Debug, Serialize)]
+struct EvalFile<'a> {
+    format: &'static str,
+    version: u32,
+    model: String,
+    clip: String,
+    model_training_steps: u64,
+    samples: usize,
+    frames: usize,
+    steps: String,
+    seed: u64,
+    sampling_seconds: f64,
+    report: &'a Report,
+}
+
+/// The scores as a Markdown table, with the paper's figures on its own benchmark beside them.
+pub fn report_table(report: &Report) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "| metric | mean | std | SinMDM paper (Mixamo) |");
+    let _ = writeln!(s, "|---|---|---|---|");
+    let rows = [
+        ("coverage (%) ↑", report.coverage, 1, "94.3"),
+        ("global diversity ↑", report.global_diversity, 3, "1.42"),
+        ("local diversity ↑", report.local_diversity, 3, "1.00"),
+        ("inter diversity ↑", report.inter_diversity, 3, "0.13"),
+    ];
+    for (name, stat, digits, paper) in rows {
+        let _ = writeln!(
+            s,
+            "| {name} | {:.digits$} | {:.digits$} | {paper} |",
+            stat.mean, stat.std
+        );
+    }
+    let _ = writeln!(
+        s,
+        "| intra diversity diff ↓ | {:.3} | | 0.03 |",
+        report.intra_diversity_diff
+    );
+    let _ = writeln!(s, "| harmonic mean ↑ | {:.3} | | |", report.harmonic_mean);
+    s
+}
+
+fn display(path: &Path) -> String {
+    path.display().to_string()
+}
+
+pub(super) fn run(args: &EvalArgs) -> Result<()> {
+    if args.samples == 0 {
+        bail!("--samples must be at least 1");
+    }
+    if args.threads == Some(0) {
+        bail!("--threads must be at least 1");
+    }
+    let steps = parse_steps(&args.steps)?;
+    check_writable(&args.json.iter().cloned().collect::<Vec<_>>())?;
+    let mut model = Model::open(
+        &args.model,
+        &ModelOptions {
+            threads: args.threads,
+        },
+    )?;
+    let clip = reference_features(&model, &args.clip)?;
+    let clip_frames = clip.len_of(Axis(1));
+    let frames = args.frames.unwrap_or(2 * clip_frames);
+    if frames < COVERAGE_WINDOW {
+        bail!("--frames must be at least {COVERAGE_WINDOW} (the coverage window), got {frames}");
+    }
+    let training = model.metadata().training.clone();
+    let trained_on = Path::new(&training.clip);
+    if args.clip.file_name() != trained_on.file_name() || clip_frames != training.clip_frames {
+        eprintln!(
+            "note: the model was trained on {} ({} frames); scoring against {} ({} frames)",
+            training.clip,
+            training.clip_frames,
+            args.clip.display(),
+            clip_frames
+        );
+    }
+
+    let request = Request {
+        task: Task::Generate { frames },
+        count: args.samples,
+        seed: args.seed,
+        steps,
+    };
+    let plan = tasks::plan(model.metadata(), &request)?;
+    let bar = progress_bar(
+        args.quiet,
+        plan.schedule.len(),
+        format!("{} x {} frames", args.samples, frames),
+    );
+    let started = Instant::now();
+    let generated = tasks::run_plan(
+        &mut model,
+        &plan,
+        args.samples,
+        args.seed,
+        &mut |done, _| bar.set_position(done as u64),
+    )?;
+    let sampling_seconds = started.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    let layout = generated.layout();
+    let clip_metric = metric_features(layout, clip.view());
+    let samples: Vec<Array2<f64>> = generated
+        .features
+        .outer_iter()
+        .map(|sample| metric_features(layout, sample))
+        .collect();
+    let threads = args.threads.unwrap_or_else(|| {
+        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    });
+    let started = Instant::now();
+    let report = evaluate(clip_metric.view(), &samples, threads)
+        .with_context(|| format!("cannot score against {}", args.clip.display()))?;
+    let scoring_seconds = started.elapsed().as_secs_f64();
+
+    let steps_text = steps.map_or("all".to_string(), |s| s.to_string());
+    println!(
+        "model {} ({} training steps), clip {} ({} frames at {} fps)",
+        args.model.display(),
+        training.steps,
+        args.clip.display(),
+        clip_frames,
+        layout.fps
+    );
+    println!(
+        "{} samples x {} frames, {} steps, seed {}: sampled in {:.1} s, scored in {:.1} s",
+        args.samples, frames, steps_text, args.seed, sampling_seconds, scoring_seconds
+    );
+    println!();
+    print!("{}", report_table(&report));
+
+    if let Some(path) = &args.json {
+        let file = EvalFile {
+            format: "sinmdm-eval",
+            version: 1,
+            model: display(&args.model),
+            clip: display(&args.clip),
+            model_training_steps: training.steps,
+            samples: args.samples,
+            frames,
+            steps: steps_text,
+            seed: args.seed,
+            sampling_seconds,
+            report: &report,
+        };
+        let text = serde_json::to_string_pretty(&file)?;
+        write_atomically(path, text.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,400 @@
+//! Quality metrics of generated motion against the training clip (the single-motion benchmark
+//! of GANimator and SinMDM).
+//!
+//! Every metric compares frames by the Euclidean distance of their *metric features*: all 6D
+//! joint rotations and the contact labels, unnormalised (root motion and position channels are
+//! left out, as in the published benchmark). With the default window sizes:
+//!
+//! | metric | what it measures | better |
+//! |---|---|---|
+//! | coverage (%) | share of the clip's 30-frame windows whose nearest window in a sample is closer than 2.0 per frame | higher |
+//! | global diversity | cost per frame of the cheapest cut of a sample into >= 30-frame pieces of the clip ([`patched_nearest_neighbour`]) | higher |
+//! | local diversity | mean over a sample's 15-frame windows of the per-frame distance to the nearest clip window | higher |
+//! | inter diversity | Frobenius distance between consecutive samples, divided by their frames | higher |
+//! | intra diversity difference | \|mean Frobenius distance / 15 between two 15-frame windows of a sample, minus the same for the clip\| | lower |
+//!
+//! Two choices differ from the published scripts, both to remove noise rather than change what is
+//! measured: coverage counts every window of the clip (the scripts skip the last one), and the
+//! intra diversity is the mean over *all* pairs of window positions (its expectation) instead of
+//! one random pair per sample.
+//!
+//! The harmonic mean folds the five into one number. Each score is mapped to `[0, 1]` by a
+//! maximum that means "as far as the coverage threshold": coverage by 100, global and local
+//! diversity by the threshold 2.0 (a per-frame distance), inter diversity by
+//! `2.0 / sqrt(frames)` and the intra difference by `2.0 / sqrt(15)` (a Frobenius distance over
+//! `n` frames is the root-mean-square per-frame distance divided by `sqrt(n)`). Scores above
+//! their maximum count as the maximum; the lower-is-better intra difference counts as
+//! `1 - difference / maximum`.
+
+mod patched_nn;
+mod window_match;
+
+use ndarray::{Array2, ArrayView2, Axis};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::motion::{ColumnKind, FeatureLayout};
+
+pub use patched_nn::patched_nearest_neighbour;
+pub use window_match::DiagonalSums;
+
+/// Window of the coverage metric and shortest piece of the global diversity, in frames.
+pub const COVERAGE_WINDOW: usize = 30;
+/// Per-frame distance under which a clip window counts as covered.
+pub const COVERAGE_THRESHOLD: f64 = 2.0;
+/// Window of the local and intra diversity, in frames.
+pub const LOCAL_WINDOW: usize = 15;
+
+/// Problems that keep metrics from being computed.
+#[derive(Debug, Error, PartialEq)]
+pub enum EvalError {
+    /// No samples were given.
+    #[error("no samples to evaluate")]
+    NoSamples,
+    /// A motion is shorter than a metric's window.
+    #[error("the {what} has {frames} frames; the metrics need at least {needed}")]
+    TooShort {
+        /// Which motion.
+        what: String,
+        /// Its frames.
+        frames: usize,
+        /// The least accepted.
+        needed: usize,
+    },
+    /// Motions of different feature widths.
+    #[error("sample {index} has {got} metric features per frame, the clip {expected}")]
+    WidthMismatch {
+        /// The sample.
+        index: usize,
+        /// The clip's width.
+        expected: usize,
+        /// The sample's width.
+        got: usize,
+    },
+}
+
+/// The metric features of a motion: rows are frames, columns every 6D rotation component and
+/// every contact label of `layout`, from features `[F, N]` in file units.
+pub fn metric_features(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> Array2<f64> {
+    let columns: Vec<usize> = layout
+        .columns()
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| matches!(c.kind, ColumnKind::Rotation6d(_) | ColumnKind::Contact))
+        .map(|(i, _)| i)
+        .collect();
+    let frames = features.len_of(Axis(1));
+    Array2::from_shape_fn((frames, columns.len()), |(n, c)| {
+        f64::from(features[[columns[c], n]])
+    })
+}
+
+/// Share (0..=1) of the clip's `window`-frame windows whose best match in `sample` is closer
+/// than `threshold` per frame.
+pub fn coverage(sample_vs_clip: &DiagonalSums, window: usize, threshold: f64) -> f64 {
+    let nearest = sample_vs_clip.nearest_b_windows(window);
+    if nearest.is_empty() {
+        return 0.0;
+    }
+    nearest.iter().filter(|&&d| d < threshold).count() as f64 / nearest.len() as f64
+}
+
+/// Mean over the sample's `window`-frame windows of the per-frame distance to the nearest clip
+/// window.
+pub fn local_diversity(sample_vs_clip: &DiagonalSums, window: usize) -> f64 {
+    mean(&sample_vs_clip.nearest_a_windows(window))
+}
+
+/// Frobenius distance between two motions of the same size, divided by their frames.
+pub fn inter_diversity(a: ArrayView2<'_, f64>, b: ArrayView2<'_, f64>) -> f64 {
+    assert_eq!(a.dim(), b.dim(), "motions of different sizes");
+    let sq: f64 = a.iter().zip(b.iter()).map(|(p, q)| (p - q) * (p - q)).sum();
+    sq.sqrt() / a.nrows() as f64
+}
+
+/// Mean over all ordered pairs of `window`-frame windows of a motion of their Frobenius distance
+/// divided by `window`.
+pub fn intra_diversity(motion: ArrayView2<'_, f64>, window: usize) -> f64 {
+    let frames = motion.nrows();
+    if window == 0 || frames < window {
+        return 0.0;
+    }
+    let squared = DiagonalSums::new(motion, motion, true);
+    let starts = frames - window + 1;
+    let mut total = 0.0;
+    for p in 0..starts {
+        for q in 0..starts {
+            total += squared.window(p, q, window).max(0.0).sqrt();
+        }
+    }
+    total / (starts * starts) as f64 / window as f64
+}
+
+fn mean(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        0.0
+    } else {
+        values.iter().sum::<f64>() / values.len() as f64
+    }
+}
+
+fn std_dev(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let m = mean(values);
+    (values.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / values.len() as f64).sqrt()
+}
+
+/// The metrics of one sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SampleScores {
+    /// Coverage in percent.
+    pub coverage: f64,
+    /// Global diversity (patched nearest neighbour cost per frame).
+    pub global_diversity: f64,
+    /// Local diversity.
+    pub local_diversity: f64,
+    /// Inter diversity to the previous sample (the last one for the first).
+    pub inter_diversity: f64,
+    /// The sample's intra diversity (before taking the difference to the clip's).
+    pub intra_diversity: f64,
+}
+
+/// Mean and population standard deviation over samples.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Stat {
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation.
+    pub std: f64,
+}
+
+impl Stat {
+    fn of(values: &[f64]) -> Stat {
+        Stat {
+            mean: mean(values),
+            std: std_dev(values),
+        }
+    }
+}
+
+/// The benchmark's table for a set of samples.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// Coverage in percent (higher is better).
+    pub coverage: Stat,
+    /// Global diversity (higher is better, unless coverage drops).
+    pub global_diversity: Stat,
+    /// Local diversity (higher is better, unless coverage drops).
+    pub local_diversity: Stat,
+    /// Inter diversity (higher is better).
+    pub inter_diversity: Stat,
+    /// |mean intra diversity of the samples - the clip's| (lower is better).
+    pub intra_diversity_diff: f64,
+    /// The clip's own intra diversity.
+    pub clip_intra_diversity: f64,
+    /// Harmonic mean of the five normalised scores, in `[0, 1]` (higher is better).
+    pub harmonic_mean: f64,
+    /// Frames per sample.
+    pub sample_frames: usize,
+    /// Frames of the clip.
+    pub clip_frames: usize,
+    /// Each sample's scores.
+    pub per_sample: Vec<SampleScores>,
+}
+
+/// The five scores mapped to `[0, 1]` (see the module documentation), in table order.
+pub fn normalised_scores(report: &Report) -> [f64; 5] {
+    let unit = |value: f64, max: f64| (value / max).clamp(0.0, 1.0);
+    let frames = report.sample_frames.max(1) as f64;
+    [
+        unit(report.coverage.mean, 100.0),
+        unit(report.global_diversity.mean, COVERAGE_THRESHOLD),
+        unit(report.local_diversity.mean, COVERAGE_THRESHOLD),
+        unit(
+            report.inter_diversity.mean,
+            COVERAGE_THRESHOLD / frames.sqrt(),
+        ),
+        1.0 - unit(
+            report.intra_diversity_diff,
+            COVERAGE_THRESHOLD / (LOCAL_WINDOW as f64).sqrt(),
+        ),
+    ]
+}
+
+/// Harmonic mean of values in `[0, 1]`; 0 when any is 0.
+pub fn harmonic_mean(values: &[f64]) -> f64 {
+    if values.is_empty() || values.iter().any(|&v| v <= 0.0) {
+        return 0.0;
+    }
+    values.len() as f64 / values.iter().map(|v| 1.0 / v).sum::<f64>()
+}
+
+/// Scores of one sample against the clip (without the inter diversity).
+fn score_sample(sample: ArrayView2<'_, f64>, clip: ArrayView2<'_, f64>) -> SampleScores {
+    let sums = DiagonalSums::new(sample, clip, false);
+    SampleScores {
+        coverage: 100.0 * coverage(&sums, COVERAGE_WINDOW, COVERAGE_THRESHOLD),
+        global_diversity: patched_nearest_neighbour(&sums, COVERAGE_WINDOW).unwrap_or(f64::NAN),
+        local_diversity: local_diversity(&sums, LOCAL_WINDOW),
+        inter_diversity: 0.0,
+        intra_diversity: intra_diversity(sample, LOCAL_WINDOW),
+    }
+}
+
+/// Evaluates samples (metric features, rows = frames, all the same length) against the clip,
+/// spreading the samples over `threads` threads.
+pub fn evaluate(
+    clip: ArrayView2<'_, f64>,
+    samples: &[Array2<f64>],
+    threads: usize,
+) -> Result<Report, EvalError> {
+    if samples.is_empty() {
+        return Err(EvalError::NoSamples);
+    }
+    if clip.nrows() < COVERAGE_WINDOW {
+        return Err(EvalError::TooShort {
+            what: "clip".into(),
+            frames: clip.nrows(),
+            needed: COVERAGE_WINDOW,
+        });
+    }
+    for (index, sample) in samples.iter().enumerate() {
+        if sample.ncols() != clip.ncols() {
+            return Err(EvalError::WidthMismatch {
+                index,
+                expected: clip.ncols(),
+                got: sample.ncols(),
+            });
+        }
+        if sample.nrows() < COVERAGE_WINDOW || sample.nrows() != samples[0].nrows() {
+            return Err(EvalError::TooShort {
+                what: format!("sample {index}"),
+                frames: sample.nrows(),
+                needed: COVERAGE_WINDOW.max(samples[0].nrows()),
+            });
+        }
+    }
+
+    let threads = threads.clamp(1, samples.len());
+    let mut per_sample = vec![None; samples.len()];
+    std::thread::scope(|scope| {
+        let chunk = samples.len().div_ceil(threads);
+        for (block, out) in samples.chunks(chunk).zip(per_sample.chunks_mut(chunk)) {
+            scope.spawn(move || {
+                for (sample, slot) in block.iter().zip(out.iter_mut()) {
+                    *slot = Some(score_sample(sample.view(), clip));
+                }
+            });
+        }
+    });
+    let mut per_sample: Vec<SampleScores> = per_sample
+        .into_iter()
+        .map(|s| s.expect("every sample scored"))
+        .collect();
+    let count = samples.len();
+    for i in 0..count {
+        let previous = &samples[(i + count - 1) % count];
+        per_sample[i].inter_diversity = inter_diversity(samples[i].view(), previous.view());
+    }
+
+    let pick = |f: fn(&SampleScores) -> f64| per_sample.iter().map(f).collect::<Vec<f64>>();
+    let clip_intra = intra_diversity(clip, LOCAL_WINDOW);
+    let mut report = Report {
+        coverage: Stat::of(&pick(|s| s.coverage)),
+        global_diversity: Stat::of(&pick(|s| s.global_diversity)),
+        local_diversity: Stat::of(&pick(|s| s.local_diversity)),
+        inter_diversity: Stat::of(&pick(|s| s.inter_diversity)),
+        intra_diversity_diff: (mean(&pick(|s| s.intra_diversity)) - clip_intra).abs(),
+        clip_intra_diversity: clip_intra,
+        harmonic_mean: 0.0,
+        sample_frames: samples[0].nrows(),
+        clip_frames: clip.nrows(),
+        per_sample,
+    };
+    report.harmonic_mean = harmonic_mean(&normalised_scores(&report));
+    Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn motion(frames: usize, width: usize, seed: u64) -> Array2<f64> {
+        let mut state = seed ^ 0x51_7cc1_b727_220a;
+        Array2::from_shape_fn((frames, width), |_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        })
+    }
+
+    #[test]
+    fn intra_diversity_matches_every_pair_written_out() {
+        let m = motion(24, 3, 1);
+        let w = 5;
+        let mut total = 0.0;
+        let mut pairs = 0;
+        for p in 0..=24 - w {
+            for q in 0..=24 - w {
+                let a = m.slice(ndarray::s![p..p + w, ..]);
+                let b = m.slice(ndarray::s![q..q + w, ..]);
+                total += inter_diversity(a, b);
+                pairs += 1;
+            }
+        }
+        assert!((intra_diversity(m.view(), w) - total / pairs as f64).abs() < 1e-12);
+    }
+
+    #[test]
+    fn inter_diversity_is_frobenius_over_frames() {
+        let a = Array2::zeros((4, 2));
+        let b = Array2::from_elem((4, 2), 1.0);
+        // sqrt(8) / 4
+        assert!((inter_diversity(a.view(), b.view()) - 8f64.sqrt() / 4.0).abs() < 1e-15);
+        assert_eq!(inter_diversity(b.view(), b.view()), 0.0);
+    }
+
+    #[test]
+    fn harmonic_mean_of_known_values() {
+        assert!((harmonic_mean(&[1.0, 0.5]) - 2.0 / 3.0).abs() < 1e-15);
+        assert_eq!(harmonic_mean(&[1.0, 0.0, 1.0]), 0.0);
+        assert_eq!(harmonic_mean(&[0.25; 5]), 0.25);
+    }
+
+    #[test]
+    fn coverage_counts_windows_under_the_threshold() {
+        // Clip: 40 frames at 0. Sample: 40 frames, the first 35 at 0, the rest far away.
+        let clip = Array2::zeros((40, 1));
+        let mut sample = Array2::zeros((40, 1));
+        sample.slice_mut(ndarray::s![35.., ..]).fill(100.0);
+        let sums = DiagonalSums::new(sample.view(), clip.view(), false);
+        assert_eq!(coverage(&sums, 30, 2.0), 1.0);
+        // A sample far from every clip frame covers nothing.
+        let far = Array2::from_elem((40, 1), 3.0);
+        let sums = DiagonalSums::new(far.view(), clip.view(), false);
+        assert_eq!(coverage(&sums, 30, 2.0), 0.0);
+        // 1.9 per frame is under 2.0.
+        let near = Array2::from_elem((40, 1), 1.9);
+        let sums = DiagonalSums::new(near.view(), clip.view(), false);
+        assert_eq!(coverage(&sums, 30, 2.0), 1.0);
+    }
+
+    #[test]
+    fn errors_name_the_problem() {
+        let clip = motion(50, 2, 1);
+        assert_eq!(evaluate(clip.view(), &[], 1), Err(EvalError::NoSamples));
+        let short = motion(10, 2, 2);
+        assert!(matches!(
+            evaluate(short.view(), std::slice::from_ref(&clip), 1),
+            Err(EvalError::TooShort { .. })
+        ));
+        let wide = motion(50, 3, 3);
+        assert!(matches!(
+            evaluate(clip.view(), &[wide], 1),
+            Err(EvalError::WidthMismatch { index: 0, .. })
+        ));
+    }
+}
