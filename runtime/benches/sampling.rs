@@ -6,11 +6,11 @@
 
 use std::time::Instant;
 
-use ndarray::Array3;
+use ndarray::{Array3, ArrayView3};
 use ort::session::Session;
 use ort::value::Tensor;
 use sinmdm::diffusion::Schedule;
-use sinmdm::diffusion::sampler::{Guidance, sample};
+use sinmdm::diffusion::sampler::{Denoiser, Guidance, sample};
 use sinmdm::model::{Model, ModelOptions};
 
 /// Peak resident memory of this process in MiB (Linux `VmHWM`), if known.
@@ -21,36 +21,73 @@ fn peak_memory_mib() -> Option<f64> {
     Some(kib / 1024.0)
 }
 
-/// Mean seconds of one bare onnxruntime call on a fresh session of the same file.
-fn bare_step_seconds(
-    path: &str,
-    threads: usize,
+/// A plain onnxruntime session on the same file, fed the same shapes as the sampler.
+struct BareSession {
+    session: Session,
     b: usize,
     f: usize,
     n: usize,
-    calls: usize,
-) -> f64 {
-    let rt = sinmdm::onnxruntime::init().expect("onnxruntime");
-    let mut session = Session::builder(&rt.environment)
-        .and_then(|s| Ok(s.with_intra_threads(threads)?))
-        .and_then(|s| Ok(s.with_intra_op_spinning(false)?))
-        .and_then(|mut s| s.commit_from_file(path))
-        .expect("session");
-    let x = vec![0.1f32; b * f * n];
-    let t = vec![500i64; b];
-    let mut run = || {
-        let xs = Tensor::from_array(([b, f, n], x.clone().into_boxed_slice())).unwrap();
-        let ts = Tensor::from_array(([b], t.clone().into_boxed_slice())).unwrap();
-        let out = session.run(ort::inputs!["x_t" => xs, "t" => ts]).unwrap();
+}
+
+impl BareSession {
+    fn open(path: &str, threads: usize, b: usize, f: usize, n: usize) -> BareSession {
+        let rt = sinmdm::onnxruntime::init().expect("onnxruntime");
+        let session = Session::builder(&rt.environment)
+            .and_then(|s| Ok(s.with_intra_threads(threads)?))
+            .and_then(|s| Ok(s.with_intra_op_spinning(false)?))
+            .and_then(|mut s| s.commit_from_file(path))
+            .expect("session");
+        let mut bare = BareSession { session, b, f, n };
+        bare.call();
+        bare
+    }
+
+    /// One call, including building the input tensors and reading the output, as the loop does.
+    fn call(&mut self) {
+        let (b, f, n) = (self.b, self.f, self.n);
+        let xs =
+            Tensor::from_array(([b, f, n], vec![0.1f32; b * f * n].into_boxed_slice())).unwrap();
+        let ts = Tensor::from_array(([b], vec![500i64; b].into_boxed_slice())).unwrap();
+        let out = self
+            .session
+            .run(ort::inputs!["x_t" => xs, "t" => ts])
+            .unwrap();
         let (_, v) = out["x0"].try_extract_tensor::<f32>().unwrap();
         std::hint::black_box(v[0]);
-    };
-    run();
-    let start = Instant::now();
-    for _ in 0..calls {
-        run();
     }
-    start.elapsed().as_secs_f64() / calls as f64
+
+    /// Mean seconds per call over `calls` calls.
+    fn seconds_per_call(&mut self, calls: usize) -> f64 {
+        let start = Instant::now();
+        for _ in 0..calls {
+            self.call();
+        }
+        start.elapsed().as_secs_f64() / calls as f64
+    }
+}
+
+/// The model, timing the time spent inside onnxruntime.
+struct Timed<'a> {
+    model: &'a mut Model,
+    inside: f64,
+}
+
+impl Denoiser for Timed<'_> {
+    type Error = sinmdm::model::ModelError;
+    fn features(&self) -> usize {
+        self.model.features()
+    }
+    fn denoise(&mut self, x_t: ArrayView3<'_, f32>, t: &[i64]) -> Result<Array3<f32>, Self::Error> {
+        let start = Instant::now();
+        let out = self.model.denoise(x_t, t);
+        self.inside += start.elapsed().as_secs_f64();
+        out
+    }
+}
+
+fn median(values: &mut [f64]) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values[values.len() / 2]
 }
 
 fn main() {
@@ -83,16 +120,34 @@ fn main() {
         model.metadata().network.parameters,
         size as f64 / 1e6
     );
+    for batch in [1, 16] {
+        let mut buffer = vec![0.0f32; batch * f * frames];
+        let start = Instant::now();
+        for stream in 0..50 {
+            sinmdm::diffusion::noise::fill_normals(1, stream, &mut buffer);
+        }
+        println!(
+            "noise for one step of batch {batch} ({} normals): {:.3} ms on one thread",
+            buffer.len(),
+            start.elapsed().as_secs_f64() / 50.0 * 1e3
+        );
+    }
+    // Bare calls and whole sampling runs alternate, so a slow spell of the machine hits both;
+    // the overhead is the median over rounds of (loop time per step / bare time per call - 1).
+    let rounds: usize = std::env::var("SINMDM_BENCH_ROUNDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5);
     println!(
-        "| batch | steps | bare ort s/call | loop s/step | overhead | s/sample run | peak MiB |"
+        "| batch | steps | bare ort s/call | loop s/step | overhead, median (range) of {rounds} rounds | time outside ort | s/sample run | peak MiB |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     for &(batch, steps) in &[(1, 1000), (1, 100), (16, 100), (16, 1000)] {
         if batch == 16 && steps == 1000 && std::env::var("SINMDM_BENCH_LONG").is_err() {
             continue;
         }
         let calls = steps.min(100);
-        let bare = bare_step_seconds(&path, threads, batch, f, frames, calls);
+        let mut bare_session = BareSession::open(&path, threads, batch, f, frames);
         let schedule = if steps == 1000 {
             Schedule::cosine(1000).unwrap()
         } else {
@@ -104,26 +159,48 @@ fn main() {
                 &vec![1; batch],
             )
             .unwrap();
-        let start = Instant::now();
-        let out = sample(
-            &mut model,
-            &schedule,
-            batch,
-            frames,
-            1,
-            &Guidance::default(),
-            &mut |_, _| {},
-        )
-        .unwrap();
-        let total = start.elapsed().as_secs_f64();
-        std::hint::black_box(out[[0, 0, 0]]);
-        let per_step = total / steps as f64;
+        let (mut bares, mut loops, mut overheads, mut totals, mut outside) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..rounds {
+            let bare = bare_session.seconds_per_call(calls);
+            let mut timed = Timed {
+                model: &mut model,
+                inside: 0.0,
+            };
+            let start = Instant::now();
+            let out = sample(
+                &mut timed,
+                &schedule,
+                batch,
+                frames,
+                1,
+                &Guidance::default(),
+                &mut |_, _| {},
+            )
+            .unwrap();
+            let total = start.elapsed().as_secs_f64();
+            std::hint::black_box(out[[0, 0, 0]]);
+            let per_step = total / steps as f64;
+            bares.push(bare);
+            loops.push(per_step);
+            overheads.push(per_step / bare - 1.0);
+            totals.push(total);
+            outside.push((total - timed.inside) / timed.inside);
+        }
+        let (lo, hi) = overheads
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
         println!(
-            "| {batch} | {steps} | {:.2} ms | {:.2} ms | {:+.1} % | {:.2} s | {:.0} |",
-            bare * 1e3,
-            per_step * 1e3,
-            (per_step / bare - 1.0) * 100.0,
-            total,
+            "| {batch} | {steps} | {:.2} ms | {:.2} ms | {:+.1} % ({:+.1} to {:+.1}) | {:.1} % | {:.2} s | {:.0} |",
+            median(&mut bares) * 1e3,
+            median(&mut loops) * 1e3,
+            median(&mut overheads) * 100.0,
+            lo * 100.0,
+            hi * 100.0,
+            median(&mut outside) * 100.0,
+            median(&mut totals),
             peak_memory_mib().unwrap_or(f64::NAN)
         );
     }

@@ -34,3 +34,20 @@ def test_schedule_telescopes_and_respaces():
     c0, ct = full.posterior_mean_coefficients(500)
     abar, prev = full.alphas_cumprod[500], full.alphas_cumprod[499]
     assert abs(c0 + ct * math.sqrt(abar) - math.sqrt(prev)) < 1e-12
+
+
+def test_sin_cos_turn_is_within_one_ulp_and_normals_match_libm_after_the_cast():
+    u = noise.uniforms(3, 4, 1_000_000)
+    x = 2.0 * np.pi * u
+    sin, cos = noise.sin_cos_turn(x)
+    ulps = lambda a, b: np.abs(a.view(np.int64) - b.view(np.int64))  # noqa: E731
+    assert ulps(sin, np.sin(x)).max() <= 1
+    assert ulps(cos, np.cos(x)).max() <= 1
+    v = noise.uniforms(5, 6, 1_000_000)
+    assert ulps(noise.ln_unit(v), np.log(v)).max() <= 1
+    assert noise.ln_unit(np.array([1.0]))[0] == 0.0
+    pairs = noise.uniforms(11, 2, 2_000_000).reshape(-1, 2)
+    r = np.sqrt(-2.0 * np.log(pairs[:, 0]))
+    angle = 2.0 * np.pi * pairs[:, 1]
+    libm = np.stack([r * np.cos(angle), r * np.sin(angle)], axis=1).reshape(-1).astype(np.float32)
+    assert np.array_equal(noise.normals(11, 2, 2_000_000), libm)

@@ -94,6 +94,7 @@ def test_rust_and_python_agree(case, references):
     assert a.shape == b.shape
     assert np.abs(a).max() > 0.1, "outputs are trivially small"
     diff = float(np.abs(a - b).max())
+    print(f"{case}: max abs diff {diff}")
     # Generation chains every network call, so it also checks that Python and Rust
     # onnxruntime give the same forward pass (the export contract asks for 1e-6).
     limit = 1e-6 if case.startswith("generate") else 1e-4

@@ -4,6 +4,14 @@
 //! Word `i` of a stream is the splitmix64 finaliser of `base + (i + 1) * GOLDEN`, where
 //! `base = seed ^ (stream * STREAM_MIX)`, all in wrapping `u64`. Words become uniforms in (0, 1],
 //! and pairs of uniforms become normals by Box-Muller in `f64`, cast to `f32`.
+//!
+//! The Box-Muller logarithm, sine and cosine are not the platform's libm: [`ln_unit`] and
+//! [`sin_cos_turn`] evaluate the classic fdlibm polynomials with plain `f64` operations in a fixed
+//! order and no branches, a block of pairs at a time. That is several times faster (sampling draws
+//! one normal per feature value per step) and, since IEEE arithmetic and `sqrt` are exact to the
+//! bit, the Python reference gets the same `f64` values with numpy on any platform, whatever its
+//! libm. Both functions are within 1 ulp of glibc's, and the `f32` normals equal those of the
+//! libm formula (checked on millions of draws).
 
 /// Stream 0: `x_T` of the whole batch, row-major `[B, F, N]`. Stream `k` (1..=S) is the noise of
 /// sampling step `k`.
@@ -34,17 +42,129 @@ pub fn uniform(word: u64) -> f64 {
     ((word >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
+// Quarter turn pi/2 in three parts (33 + 33 + 53 bits), and the fdlibm kernel coefficients of
+// sin and cos on [-pi/4, pi/4].
+const TWO_OVER_PI: f64 = std::f64::consts::FRAC_2_PI;
+const HALF_PI_1: f64 = 1.5707963267341256;
+const HALF_PI_2: f64 = 6.077100506303966e-11;
+const HALF_PI_3: f64 = 2.0222662487959506e-21;
+const SIN: [f64; 6] = [
+    -0.16666666666666632,
+    0.00833333333332249,
+    -0.0001984126982985795,
+    2.7557313707070068e-06,
+    -2.5050760253406863e-08,
+    1.58969099521155e-10,
+];
+
+const COS: [f64; 6] = [
+    0.0416666666666666,
+    -0.001388888888887411,
+    2.480158728947673e-05,
+    -2.7557314351390663e-07,
+    2.087572321298175e-09,
+    -1.1359647557788195e-11,
+];
+
+/// `(sin x, cos x)` for `0 <= x <= 2 pi` (the Box-Muller angle), within 1 ulp, branch-free.
+///
+/// `x` is reduced to `y = x - q pi/2` with `|y| <= pi/4` (`q` exact, so each product with a part
+/// of pi/2 is exact), the kernels give `sin y` and `cos y`, and the quadrant `q mod 4` swaps and
+/// negates them: `(s, c), (c, -s), (-s, -c), (-c, s)`. The Python reference repeats every
+/// operation in the same order.
+#[inline]
+pub fn sin_cos_turn(x: f64) -> (f64, f64) {
+    let quadrant = (x * TWO_OVER_PI + 0.5) as i64;
+    let q = quadrant as f64;
+    let y = ((x - q * HALF_PI_1) - q * HALF_PI_2) - q * HALF_PI_3;
+    let z = y * y;
+    let s_tail = SIN[1] + z * (SIN[2] + z * (SIN[3] + z * (SIN[4] + z * SIN[5])));
+    let s = y + z * y * (SIN[0] + z * s_tail);
+    let c_tail =
+        z * (COS[0] + z * (COS[1] + z * (COS[2] + z * (COS[3] + z * (COS[4] + z * COS[5])))));
+    let half_z = 0.5 * z;
+    let w = 1.0 - half_z;
+    let c = w + (((1.0 - w) - half_z) + z * c_tail);
+    // Odd quadrants swap sine and cosine; quadrants 2 and 3 negate the sine, 1 and 2 the cosine.
+    let swap = ((quadrant & 1) as u64).wrapping_neg();
+    let (s_bits, c_bits) = (s.to_bits(), c.to_bits());
+    let sin_bits = (s_bits & !swap) | (c_bits & swap);
+    let cos_bits = (c_bits & !swap) | (s_bits & swap);
+    let sin_sign = (((quadrant >> 1) & 1) as u64) << 63;
+    let cos_sign = ((((quadrant + 1) >> 1) & 1) as u64) << 63;
+    (
+        f64::from_bits(sin_bits ^ sin_sign),
+        f64::from_bits(cos_bits ^ cos_sign),
+    )
+}
+
+// ln 2 in two parts (the first with trailing zero bits, so multiples of it are exact) and the
+// fdlibm coefficients of log((1 + s) / (1 - s)) = 2 s + s^3 (Lg1 + s^2 (Lg2 + ...)).
+const LN2_HI: f64 = 0.6931471803691238;
+const LN2_LO: f64 = 1.9082149292705877e-10;
+const LOG: [f64; 7] = [
+    0.6666666666666735,
+    0.3999999999940942,
+    0.2857142874366239,
+    0.22222198432149784,
+    0.1818357216161805,
+    0.15313837699209373,
+    0.14798198605116586,
+];
+
+/// `ln u` for `0 < u <= 1` (a Box-Muller uniform), within 1 ulp, branch-free.
+///
+/// `u = m 2^e` with `m` in `(sqrt(2)/2, sqrt(2)]`; with `f = m - 1` and `s = f / (2 + f)`,
+/// `ln m = f - (f^2/2 - s (f^2/2 + R(s^2)))` for fdlibm's polynomial `R`, and
+/// `ln u = e ln2_hi - ((f^2/2 - (s (f^2/2 + R) + e ln2_lo)) - f)`. The Python reference repeats
+/// every operation in the same order.
+#[inline]
+pub fn ln_unit(u: f64) -> f64 {
+    let bits = u.to_bits();
+    let exponent = ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let mantissa = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+    // Mantissas above sqrt(2) are halved (exactly) and the exponent raised.
+    let big = (mantissa > std::f64::consts::SQRT_2) as u64;
+    let m = f64::from_bits(mantissa.to_bits() - (big << 52));
+    let e = (exponent + big as i64) as f64;
+    let f = m - 1.0;
+    let s = f / (2.0 + f);
+    let z = s * s;
+    let w = z * z;
+    let t1 = w * (LOG[1] + w * (LOG[3] + w * LOG[5]));
+    let t2 = z * (LOG[0] + w * (LOG[2] + w * (LOG[4] + w * LOG[6])));
+    let r = t2 + t1;
+    let half_f2 = 0.5 * f * f;
+    e * LN2_HI - ((half_f2 - (s * (half_f2 + r) + e * LN2_LO)) - f)
+}
+
+/// Pairs of normals made per block: small fixed arrays the compiler turns into vector code.
+const BLOCK: usize = 8;
+
 /// Fills `out` with normals `0..out.len()` of stream `stream` under `seed`.
 pub fn fill_normals(seed: u64, stream: u64, out: &mut [f32]) {
-    for (pair, chunk) in out.chunks_mut(2).enumerate() {
-        let p = pair as u64;
-        let u0 = uniform(word(seed, stream, 2 * p));
-        let u1 = uniform(word(seed, stream, 2 * p + 1));
-        let r = (-2.0 * u0.ln()).sqrt();
-        let (sin, cos) = (std::f64::consts::TAU * u1).sin_cos();
-        chunk[0] = (r * cos) as f32;
-        if let Some(second) = chunk.get_mut(1) {
-            *second = (r * sin) as f32;
+    for (block, chunk) in out.chunks_mut(2 * BLOCK).enumerate() {
+        let first = (block * BLOCK) as u64;
+        let mut radius = [0.0f64; BLOCK];
+        let mut angle = [0.0f64; BLOCK];
+        for (j, (r, a)) in radius.iter_mut().zip(angle.iter_mut()).enumerate() {
+            let p = first + j as u64;
+            *r = uniform(word(seed, stream, 2 * p));
+            *a = std::f64::consts::TAU * uniform(word(seed, stream, 2 * p + 1));
+        }
+        for r in &mut radius {
+            *r = (-2.0 * ln_unit(*r)).sqrt();
+        }
+        let mut sin = [0.0f64; BLOCK];
+        let mut cos = [0.0f64; BLOCK];
+        for j in 0..BLOCK {
+            (sin[j], cos[j]) = sin_cos_turn(angle[j]);
+        }
+        for (j, pair) in chunk.chunks_mut(2).enumerate() {
+            pair[0] = (radius[j] * cos[j]) as f32;
+            if let Some(second) = pair.get_mut(1) {
+                *second = (radius[j] * sin[j]) as f32;
+            }
         }
     }
 }
@@ -67,6 +187,74 @@ mod tests {
             normals(42, 0, 4),
             vec![0.414_719_76, 0.652_681_23, -0.891_886_23, 1.326_833_6]
         );
+    }
+
+    #[test]
+    fn sin_cos_turn_is_within_one_ulp_of_libm() {
+        let ulps = |a: f64, b: f64| (a.to_bits() as i64 - b.to_bits() as i64).abs();
+        let mut worst = 0;
+        for i in 0..2_000_000u64 {
+            let x = std::f64::consts::TAU * uniform(word(3, 4, i));
+            let (s, c) = sin_cos_turn(x);
+            worst = worst.max(ulps(s, x.sin())).max(ulps(c, x.cos()));
+        }
+        // Quadrant edges and the ends of the range.
+        for x in [
+            0.0,
+            1e-300,
+            1e-9,
+            std::f64::consts::FRAC_PI_4,
+            std::f64::consts::FRAC_PI_2,
+        ] {
+            let (s, c) = sin_cos_turn(x);
+            worst = worst.max(ulps(s, x.sin())).max(ulps(c, x.cos()));
+        }
+        for k in 1..=4 {
+            let x = k as f64 * std::f64::consts::FRAC_PI_2;
+            let (s, c) = sin_cos_turn(x);
+            assert!(
+                (s - x.sin()).abs() < 1e-16 && (c - x.cos()).abs() < 1e-16,
+                "{x}"
+            );
+        }
+        assert!(worst <= 1, "{worst} ulp");
+    }
+
+    #[test]
+    fn ln_unit_is_within_one_ulp_of_libm() {
+        let ulps = |a: f64, b: f64| (a.to_bits() as i64 - b.to_bits() as i64).abs();
+        let mut worst = 0;
+        for i in 0..2_000_000u64 {
+            let u = uniform(word(5, 6, i));
+            worst = worst.max(ulps(ln_unit(u), u.ln()));
+        }
+        // The smallest and largest uniforms, and mantissas either side of sqrt(2).
+        let edges = [
+            uniform(0),
+            uniform(u64::MAX),
+            std::f64::consts::FRAC_1_SQRT_2,
+            0.5 * std::f64::consts::SQRT_2.next_up(),
+            0.5 * std::f64::consts::SQRT_2.next_down(),
+            0.999_999_999_999,
+        ];
+        for u in edges {
+            worst = worst.max(ulps(ln_unit(u), u.ln()));
+        }
+        assert_eq!(ln_unit(1.0), 0.0);
+        assert!(worst <= 1, "{worst} ulp");
+    }
+
+    #[test]
+    fn normals_equal_the_libm_formula_after_the_f32_cast() {
+        // The same Box-Muller with the platform's sin and cos gives the same f32 normals.
+        let fast = normals(11, 2, 2_000_000);
+        for (p, pair) in fast.chunks(2).enumerate() {
+            let u0 = uniform(word(11, 2, 2 * p as u64));
+            let u1 = uniform(word(11, 2, 2 * p as u64 + 1));
+            let r = (-2.0 * u0.ln()).sqrt();
+            let (sin, cos) = (std::f64::consts::TAU * u1).sin_cos();
+            assert_eq!(pair, [(r * cos) as f32, (r * sin) as f32], "pair {p}");
+        }
     }
 
     #[test]

@@ -16,6 +16,8 @@
 //! All arithmetic on features is f32 with coefficients computed in f64 and rounded once, in the
 //! order written above, so the Python reference can reproduce it.
 
+use std::sync::mpsc;
+
 use ndarray::{Array2, Array3, ArrayView3, Axis, Zip};
 
 use super::noise::{HARMONIZE_STREAM_BASE, INITIAL_NOISE_STREAM, fill_normals};
@@ -120,12 +122,73 @@ pub fn low_pass(x: ArrayView3<'_, f32>, factor: usize) -> Array3<f32> {
 /// Normals of one noise stream, shaped `[B, F, N]`.
 fn noise(seed: u64, stream: u64, shape: (usize, usize, usize)) -> Array3<f32> {
     let mut out = Array3::<f32>::zeros(shape);
+    fill_noise(seed, stream, &mut out);
+    out
+}
+
+fn fill_noise(seed: u64, stream: u64, out: &mut Array3<f32>) {
     fill_normals(
         seed,
         stream,
-        out.as_slice_mut().expect("a new array is contiguous"),
+        out.as_slice_mut().expect("noise buffers are contiguous"),
     );
-    out
+}
+
+/// A thread that draws noise streams into recycled buffers while the network runs, so a step
+/// neither spawns a thread nor allocates.
+struct NoiseWorker {
+    requests: mpsc::Sender<(u64, Array3<f32>)>,
+    filled: mpsc::Receiver<Array3<f32>>,
+    spare: Vec<Array3<f32>>,
+    shape: (usize, usize, usize),
+}
+
+impl NoiseWorker {
+    fn start<'scope>(
+        scope: &'scope std::thread::Scope<'scope, '_>,
+        seed: u64,
+        shape: (usize, usize, usize),
+    ) -> NoiseWorker {
+        let (requests, jobs) = mpsc::channel::<(u64, Array3<f32>)>();
+        let (done, filled) = mpsc::channel();
+        scope.spawn(move || {
+            for (stream, mut buffer) in jobs {
+                fill_noise(seed, stream, &mut buffer);
+                if done.send(buffer).is_err() {
+                    break;
+                }
+            }
+        });
+        NoiseWorker {
+            requests,
+            filled,
+            spare: Vec::new(),
+            shape,
+        }
+    }
+
+    /// Asks for stream `stream`; results come back in the order asked.
+    fn request(&mut self, stream: u64) {
+        let buffer = self
+            .spare
+            .pop()
+            .unwrap_or_else(|| Array3::zeros(self.shape));
+        self.requests
+            .send((stream, buffer))
+            .expect("the noise thread runs until the worker is dropped");
+    }
+
+    /// The oldest stream asked for.
+    fn receive(&mut self) -> Array3<f32> {
+        self.filled
+            .recv()
+            .expect("the noise thread answers every request")
+    }
+
+    /// Gives a buffer back for reuse.
+    fn recycle(&mut self, buffer: Array3<f32>) {
+        self.spare.push(buffer);
+    }
 }
 
 /// Runs the sampling loop for `batch` samples of `frames` frames; returns normalised features
@@ -158,68 +221,75 @@ pub fn sample<D: Denoiser>(
         .as_ref()
         .map_or(0, |h| h.free_steps(steps));
     let mut x = noise(seed, INITIAL_NOISE_STREAM, shape);
-    for step in 0..steps {
-        let k = steps - 1 - step;
-        let t = vec![schedule.timesteps[k] as i64; batch];
-        let harmonizing = guidance.harmonization.is_some() && step < steps - free;
-        // The step's noise does not depend on the network's output: draw it on another thread
-        // while the network runs (for a crowd it costs as much as a fifth of a step).
-        let (x0, eps, harmonize_eps) = std::thread::scope(|scope| {
-            let eps = (k > 0).then(|| scope.spawn(|| noise(seed, step as u64 + 1, shape)));
-            let harmonize_eps = (harmonizing && k > 0).then(|| {
-                scope.spawn(|| noise(seed, HARMONIZE_STREAM_BASE + step as u64 + 1, shape))
-            });
+    std::thread::scope(|scope| {
+        // A step's noise does not depend on the network's output: it is drawn on the worker
+        // while the network runs (for a crowd it costs as much as a twentieth of a step).
+        let mut worker = NoiseWorker::start(scope, seed, shape);
+        for step in 0..steps {
+            let k = steps - 1 - step;
+            let t = vec![schedule.timesteps[k] as i64; batch];
+            let harmonizing = guidance.harmonization.is_some() && step < steps - free;
+            if k > 0 {
+                worker.request(step as u64 + 1);
+                if harmonizing {
+                    worker.request(HARMONIZE_STREAM_BASE + step as u64 + 1);
+                }
+            }
             let x0 = denoiser.denoise(x.view(), &t);
-            let join =
-                |h: std::thread::ScopedJoinHandle<'_, Array3<f32>>| h.join().expect("noise thread");
-            (x0, eps.map(join), harmonize_eps.map(join))
-        });
-        let mut x0 = x0?;
-        if let Some(inpaint) = &guidance.inpainting {
-            for mut row in x0.outer_iter_mut() {
-                Zip::from(&mut row)
-                    .and(&inpaint.mask)
-                    .and(&inpaint.reference)
-                    .for_each(|p, &m, &y| *p = *p * (1.0 - m) + y * m);
+            let eps = (k > 0).then(|| worker.receive());
+            let harmonize_eps = (k > 0 && harmonizing).then(|| worker.receive());
+            let mut x0 = x0?;
+            if let Some(inpaint) = &guidance.inpainting {
+                for mut row in x0.outer_iter_mut() {
+                    Zip::from(&mut row)
+                        .and(&inpaint.mask)
+                        .and(&inpaint.reference)
+                        .for_each(|p, &m, &y| *p = *p * (1.0 - m) + y * m);
+                }
             }
-        }
-        let (c0, ct) = schedule.posterior_mean_coefficients(k);
-        let (c0, ct) = (c0 as f32, ct as f32);
-        Zip::from(&mut x)
-            .and(&x0)
-            .for_each(|x, &p| *x = c0 * p + ct * *x);
-        if let Some(eps) = eps {
-            let sigma = schedule.posterior_std(k) as f32;
-            Zip::from(&mut x)
-                .and(&eps)
-                .for_each(|x, &e| *x += sigma * e);
-        }
-        if let Some(h) = &guidance.harmonization
-            && step < steps - free
-        {
-            // After the last step the sample is clean, so the target is the clean content.
-            let (a, s) = if k > 0 {
-                schedule.q_sample_coefficients(k - 1)
-            } else {
-                (1.0, 0.0)
-            };
-            let (a, s) = (a as f32, s as f32);
-            let mut noisy = harmonize_eps.unwrap_or_else(|| Array3::zeros(shape));
-            for mut row in noisy.outer_iter_mut() {
-                Zip::from(&mut row)
-                    .and(&h.content)
-                    .for_each(|e, &y| *e = a * y + s * *e);
+            let (c0, ct) = schedule.posterior_mean_coefficients(k);
+            let (c0, ct) = (c0 as f32, ct as f32);
+            match eps {
+                Some(eps) => {
+                    let sigma = schedule.posterior_std(k) as f32;
+                    Zip::from(&mut x)
+                        .and(&x0)
+                        .and(&eps)
+                        .for_each(|x, &p, &e| *x = (c0 * p + ct * *x) + sigma * e);
+                    worker.recycle(eps);
+                }
+                None => Zip::from(&mut x)
+                    .and(&x0)
+                    .for_each(|x, &p| *x = c0 * p + ct * *x),
             }
-            let ours = low_pass(x.view(), h.factor);
-            let theirs = low_pass(noisy.view(), h.factor);
-            Zip::from(&mut x)
-                .and(&ours)
-                .and(&theirs)
-                .for_each(|x, &o, &c| *x = *x - o + c);
+            if let Some(h) = &guidance.harmonization
+                && step < steps - free
+            {
+                // After the last step the sample is clean, so the target is the clean content.
+                let (a, s) = if k > 0 {
+                    schedule.q_sample_coefficients(k - 1)
+                } else {
+                    (1.0, 0.0)
+                };
+                let (a, s) = (a as f32, s as f32);
+                let mut noisy = harmonize_eps.unwrap_or_else(|| Array3::zeros(shape));
+                for mut row in noisy.outer_iter_mut() {
+                    Zip::from(&mut row)
+                        .and(&h.content)
+                        .for_each(|e, &y| *e = a * y + s * *e);
+                }
+                let ours = low_pass(x.view(), h.factor);
+                let theirs = low_pass(noisy.view(), h.factor);
+                Zip::from(&mut x)
+                    .and(&ours)
+                    .and(&theirs)
+                    .for_each(|x, &o, &c| *x = *x - o + c);
+                worker.recycle(noisy);
+            }
+            progress(step + 1, steps);
         }
-        progress(step + 1, steps);
-    }
-    Ok(x)
+        Ok(x)
+    })
 }
 
 #[cfg(test)]
