@@ -13,6 +13,7 @@ use super::sampling::{
     DEFAULT_STEPS, check_writable, parse_steps, progress_bar, reference_features,
 };
 use crate::eval::{COVERAGE_WINDOW, Report, evaluate, metric_features};
+use crate::features_file::write_features;
 use crate::files::write_atomically;
 use crate::model::{Model, ModelOptions};
 use crate::tasks::{self, Request, Task};
@@ -51,6 +52,9 @@ pub struct EvalArgs {
     /// Also write the scores (with every sample's) as JSON here.
     #[arg(long, value_name = "OUT.json")]
     json: Option<PathBuf>,
+    /// Also write the samples' raw features as JSON here (to check the scores elsewhere).
+    #[arg(long, value_name = "OUT.json")]
+    features_json: Option<PathBuf>,
     /// Do not show the progress bar.
     #[arg(long)]
     quiet: bool,
@@ -111,7 +115,13 @@ pub(super) fn run(args: &EvalArgs) -> Result<()> {
         bail!("--threads must be at least 1");
     }
     let steps = parse_steps(&args.steps)?;
-    check_writable(&args.json.iter().cloned().collect::<Vec<_>>())?;
+    let outputs: Vec<PathBuf> = args
+        .json
+        .iter()
+        .chain(args.features_json.iter())
+        .cloned()
+        .collect();
+    check_writable(&outputs)?;
     let mut model = Model::open(
         &args.model,
         &ModelOptions {
@@ -190,6 +200,10 @@ pub(super) fn run(args: &EvalArgs) -> Result<()> {
     println!();
     print!("{}", report_table(&report));
 
+    if let Some(path) = &args.features_json {
+        write_features(path, layout, generated.features.view())?;
+        eprintln!("wrote {}", path.display());
+    }
     if let Some(path) = &args.json {
         let file = EvalFile {
             format: "sinmdm-eval",
