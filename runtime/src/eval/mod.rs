@@ -61,6 +61,18 @@ pub enum EvalError {
         /// The least accepted.
         needed: usize,
     },
+    /// Samples of different lengths.
+    #[error(
+        "sample {index} has {got} frames, sample 0 has {expected}; score samples of one length"
+    )]
+    LengthMismatch {
+        /// The sample.
+        index: usize,
+        /// Frames of sample 0.
+        expected: usize,
+        /// Its frames.
+        got: usize,
+    },
     /// Motions of different feature widths.
     #[error("sample {index} has {got} metric features per frame, the clip {expected}")]
     WidthMismatch {
@@ -268,11 +280,18 @@ pub fn evaluate(
                 got: sample.ncols(),
             });
         }
-        if sample.nrows() < COVERAGE_WINDOW || sample.nrows() != samples[0].nrows() {
+        if sample.nrows() != samples[0].nrows() {
+            return Err(EvalError::LengthMismatch {
+                index,
+                expected: samples[0].nrows(),
+                got: sample.nrows(),
+            });
+        }
+        if sample.nrows() < COVERAGE_WINDOW {
             return Err(EvalError::TooShort {
                 what: format!("sample {index}"),
                 frames: sample.nrows(),
-                needed: COVERAGE_WINDOW.max(samples[0].nrows()),
+                needed: COVERAGE_WINDOW,
             });
         }
     }
@@ -391,6 +410,15 @@ mod tests {
             evaluate(short.view(), std::slice::from_ref(&clip), 1),
             Err(EvalError::TooShort { .. })
         ));
+        let longer = motion(60, 2, 4);
+        assert_eq!(
+            evaluate(clip.view(), &[clip.clone(), longer], 1),
+            Err(EvalError::LengthMismatch {
+                index: 1,
+                expected: 50,
+                got: 60
+            })
+        );
         let wide = motion(50, 3, 3);
         assert!(matches!(
             evaluate(clip.view(), &[wide], 1),
