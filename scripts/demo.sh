@@ -1,17 +1,25 @@
 #!/usr/bin/env bash
-# The main job on a shipped default: sets the project up if needed, then generates from the
-# shipped walk model: three new walks of twice the clip's length, an in-between and an
-# expansion of the clip, as BVH files (open them in Blender) in out/.
+# The main job on the shipped models: sets the project up if needed, then
+#  - three new walks of twice the clip's length from the walk model (with a GIF of them),
+#  - an in-between (the clip's first 3 s and its last part kept, the gap generated),
+#  - a style transfer: the CMU walk in the style of the model trained on the CMU hop,
+#  - three new fox motions from the fox model,
+# as BVH files (they open in Blender with the clip's skeleton, units and frame rate).
+# Usage: scripts/demo.sh [OUT_DIR]   (default: out)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+out=${1:-out}
 scripts/setup.sh
-mkdir -p out
-model=onnx-models/human_walk_cmu.onnx
-clip=tests/data/bvh/human_walk_cmu_131_01.bvh
+mkdir -p "$out"
 sinmdm=./target/release/sinmdm
-"$sinmdm" info "$model" | sed -n '2p;9,10p'
-"$sinmdm" generate -m "$model" --count 3 --seed 1 -o out/walk_new.bvh
-"$sinmdm" inbetween -m "$model" --reference "$clip" --keep 0:3s --keep 5s: -o out/walk_inbetween.bvh
-"$sinmdm" expand -m "$model" --reference "$clip" --prefix 2s --suffix 2s -o out/walk_expanded.bvh
+walk_model=onnx-models/human_walk_cmu.onnx
+hop_model=onnx-models/human_hop_cmu.onnx
+fox_model=onnx-models/fox_survey_khronos.onnx
+walk=tests/data/bvh/human_walk_cmu_131_01.bvh
+"$sinmdm" generate -m "$walk_model" --count 3 --seed 1 -o "$out/walk_new.bvh" --render "$out/walk_new.gif"
+"$sinmdm" inbetween -m "$walk_model" --reference "$walk" --keep 0:3s --keep 5s: -o "$out/walk_inbetween.bvh"
+"$sinmdm" harmonize -m "$hop_model" --content "$walk" -o "$out/walk_in_hop_style.bvh"
+"$sinmdm" generate -m "$fox_model" --count 3 --seed 1 -o "$out/fox_new.bvh" --render "$out/fox_new.gif"
 echo
-echo "demo: BVH files written to $(pwd)/out/"
+echo "demo: BVH files and GIFs written to $(cd "$out" && pwd)/"
+ls "$out"
