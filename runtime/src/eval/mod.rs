@@ -27,6 +27,8 @@
 //! `1 - difference / maximum`.
 
 mod patched_nn;
+#[cfg(test)]
+mod test_data;
 mod window_match;
 
 use ndarray::{Array2, ArrayView2, Axis};
@@ -339,16 +341,7 @@ pub fn evaluate(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn motion(frames: usize, width: usize, seed: u64) -> Array2<f64> {
-        let mut state = seed ^ 0x51_7cc1_b727_220a;
-        Array2::from_shape_fn((frames, width), |_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        })
-    }
+    use test_data::random_motion as motion;
 
     #[test]
     fn intra_diversity_matches_every_pair_written_out() {

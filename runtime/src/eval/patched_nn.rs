@@ -65,29 +65,13 @@ pub fn patched_nearest_neighbour(sums: &DiagonalSums, min_segment: usize) -> Opt
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::eval::test_data::{frame_distance, random_motion as motion};
     use ndarray::{Array2, s};
-
-    fn motion(frames: usize, width: usize, seed: u64) -> Array2<f64> {
-        let mut state = seed ^ 0x9e37_79b9_7f4a_7c15;
-        Array2::from_shape_fn((frames, width), |_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        })
-    }
 
     /// Every cut of `a` into segments of >= m frames, each matched to `b` at every offset, with
     /// each segment's cost summed frame by frame: the definition, without shortcuts.
     fn brute_force(a: &Array2<f64>, b: &Array2<f64>, m: usize) -> Option<f64> {
-        let frame = |i: usize, k: usize| -> f64 {
-            a.row(i)
-                .iter()
-                .zip(b.row(k).iter())
-                .map(|(p, q)| (p - q) * (p - q))
-                .sum::<f64>()
-                .sqrt()
-        };
+        let frame = |i: usize, k: usize| frame_distance(a, i, b, k);
         let segment = |l: usize, j: usize| -> f64 {
             let n = j - l;
             if n > b.nrows() {

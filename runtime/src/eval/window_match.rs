@@ -104,28 +104,7 @@ impl DiagonalSums {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ndarray::Array2;
-
-    fn motion(frames: usize, width: usize, seed: u64) -> Array2<f64> {
-        let mut state = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        Array2::from_shape_fn((frames, width), |_| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        })
-    }
-
-    fn dist(a: &Array2<f64>, i: usize, b: &Array2<f64>, k: usize) -> f64 {
-        a.row(i)
-            .iter()
-            .zip(b.row(k).iter())
-            .map(|(p, q)| (p - q) * (p - q))
-            .sum::<f64>()
-            .sqrt()
-    }
+    use crate::eval::test_data::{frame_distance as dist, random_motion as motion};
 
     #[test]
     fn window_sums_match_direct_sums() {
