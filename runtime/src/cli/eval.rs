@@ -103,10 +103,6 @@ pub fn report_table(report: &Report) -> String {
     s
 }
 
-fn display(path: &Path) -> String {
-    path.display().to_string()
-}
-
 pub(super) fn run(args: &EvalArgs) -> Result<()> {
     if args.samples == 0 {
         bail!("--samples must be at least 1");
@@ -208,8 +204,8 @@ pub(super) fn run(args: &EvalArgs) -> Result<()> {
         let file = EvalFile {
             format: "sinmdm-eval",
             version: 1,
-            model: display(&args.model),
-            clip: display(&args.clip),
+            model: args.model.display().to_string(),
+            clip: args.clip.display().to_string(),
             model_training_steps: training.steps,
             samples: args.samples,
             frames,
