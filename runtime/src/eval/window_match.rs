@@ -71,29 +71,35 @@ impl DiagonalSums {
     /// For each window `a[s..s+len]`, the mean per-frame distance to its best match anywhere in
     /// `b`. Empty when either side is shorter than `len`.
     pub fn nearest_a_windows(&self, len: usize) -> Vec<f64> {
-        if len == 0 || self.a_frames < len || self.b_frames < len {
-            return Vec::new();
-        }
-        (0..=self.a_frames - len)
-            .map(|s| {
-                let best = (0..=self.b_frames - len)
-                    .map(|k| self.window(s, k, len))
-                    .fold(f64::INFINITY, f64::min);
-                best / len as f64
-            })
-            .collect()
+        self.nearest_windows(len, self.a_frames, self.b_frames, |s, k| {
+            self.window(s, k, len)
+        })
     }
 
     /// For each window `b[k..k+len]`, the mean per-frame distance to its best match anywhere in
     /// `a`. Empty when either side is shorter than `len`.
     pub fn nearest_b_windows(&self, len: usize) -> Vec<f64> {
-        if len == 0 || self.a_frames < len || self.b_frames < len {
+        self.nearest_windows(len, self.b_frames, self.a_frames, |k, s| {
+            self.window(s, k, len)
+        })
+    }
+
+    /// For each `len`-frame window of one side (`own` frames), the least `cost(own start, other
+    /// start)` over the other side's windows, divided by `len`.
+    fn nearest_windows(
+        &self,
+        len: usize,
+        own: usize,
+        other: usize,
+        cost: impl Fn(usize, usize) -> f64,
+    ) -> Vec<f64> {
+        if len == 0 || own < len || other < len {
             return Vec::new();
         }
-        (0..=self.b_frames - len)
-            .map(|k| {
-                let best = (0..=self.a_frames - len)
-                    .map(|s| self.window(s, k, len))
+        (0..=own - len)
+            .map(|i| {
+                let best = (0..=other - len)
+                    .map(|j| cost(i, j))
                     .fold(f64::INFINITY, f64::min);
                 best / len as f64
             })
