@@ -55,15 +55,6 @@ impl BareSession {
         let (_, v) = out["x0"].try_extract_tensor::<f32>().unwrap();
         std::hint::black_box(v[0]);
     }
-
-    /// Mean seconds per call over `calls` calls.
-    fn seconds_per_call(&mut self, calls: usize) -> f64 {
-        let start = Instant::now();
-        for _ in 0..calls {
-            self.call();
-        }
-        start.elapsed().as_secs_f64() / calls as f64
-    }
 }
 
 /// The model, timing the time spent inside onnxruntime.
@@ -132,8 +123,10 @@ fn main() {
             start.elapsed().as_secs_f64() / 50.0 * 1e3
         );
     }
-    // Bare calls and whole sampling runs alternate, so a slow spell of the machine hits both;
-    // the overhead is the median over rounds of (loop time per step / bare time per call - 1).
+    // A bare call follows every step of the sampling loop (from its progress callback, when the
+    // noise thread is idle), so a slow spell of the machine hits the loop's steps and the bare
+    // calls alike. A round is one sampling run; its overhead is (loop time without the
+    // callbacks) / (time of its bare calls) - 1, and the table gives the median over rounds.
     let rounds: usize = std::env::var("SINMDM_BENCH_ROUNDS")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -146,7 +139,6 @@ fn main() {
         if batch == 16 && steps == 1000 && std::env::var("SINMDM_BENCH_LONG").is_err() {
             continue;
         }
-        let calls = steps.min(100);
         let mut bare_session = BareSession::open(&path, threads, batch, f, frames);
         let schedule = if steps == 1000 {
             Schedule::cosine(1000).unwrap()
@@ -159,14 +151,14 @@ fn main() {
                 &vec![1; batch],
             )
             .unwrap();
-        let (mut bares, mut loops, mut overheads, mut totals, mut outside) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut bares, mut loops, mut overheads, mut outside) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for _ in 0..rounds {
-            let bare = bare_session.seconds_per_call(calls);
             let mut timed = Timed {
                 model: &mut model,
                 inside: 0.0,
             };
+            let mut bare_total = 0.0;
             let start = Instant::now();
             let out = sample(
                 &mut timed,
@@ -175,16 +167,18 @@ fn main() {
                 frames,
                 1,
                 &Guidance::default(),
-                &mut |_, _| {},
+                &mut |_, _| {
+                    let entered = Instant::now();
+                    bare_session.call();
+                    bare_total += entered.elapsed().as_secs_f64();
+                },
             )
             .unwrap();
-            let total = start.elapsed().as_secs_f64();
+            let total = start.elapsed().as_secs_f64() - bare_total;
             std::hint::black_box(out[[0, 0, 0]]);
-            let per_step = total / steps as f64;
-            bares.push(bare);
-            loops.push(per_step);
-            overheads.push(per_step / bare - 1.0);
-            totals.push(total);
+            bares.push(bare_total / steps as f64);
+            loops.push(total / steps as f64);
+            overheads.push(total / bare_total - 1.0);
             outside.push((total - timed.inside) / timed.inside);
         }
         let (lo, hi) = overheads
@@ -192,15 +186,16 @@ fn main() {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
                 (a.min(v), b.max(v))
             });
+        let per_step = median(&mut loops);
         println!(
             "| {batch} | {steps} | {:.2} ms | {:.2} ms | {:+.1} % ({:+.1} to {:+.1}) | {:.1} % | {:.2} s | {:.0} |",
             median(&mut bares) * 1e3,
-            median(&mut loops) * 1e3,
+            per_step * 1e3,
             median(&mut overheads) * 100.0,
             lo * 100.0,
             hi * 100.0,
             median(&mut outside) * 100.0,
-            median(&mut totals),
+            per_step * steps as f64,
             peak_memory_mib().unwrap_or(f64::NAN)
         );
     }

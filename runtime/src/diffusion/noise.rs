@@ -23,6 +23,7 @@ const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;
 const STREAM_MIX: u64 = 0xD1B5_4A32_D192_ED03;
 
 /// The splitmix64 finaliser.
+#[inline(always)]
 pub fn mix(mut z: u64) -> u64 {
     z ^= z >> 30;
     z = z.wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -32,12 +33,14 @@ pub fn mix(mut z: u64) -> u64 {
 }
 
 /// Word `index` of stream `stream` under `seed`.
+#[inline(always)]
 pub fn word(seed: u64, stream: u64, index: u64) -> u64 {
     let base = seed ^ stream.wrapping_mul(STREAM_MIX);
     mix(base.wrapping_add(index.wrapping_add(1).wrapping_mul(GOLDEN)))
 }
 
 /// A word as a uniform number in (0, 1]: `((word >> 11) + 1) * 2^-53`.
+#[inline(always)]
 pub fn uniform(word: u64) -> f64 {
     ((word >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64)
 }
@@ -72,7 +75,7 @@ const COS: [f64; 6] = [
 /// of pi/2 is exact), the kernels give `sin y` and `cos y`, and the quadrant `q mod 4` swaps and
 /// negates them: `(s, c), (c, -s), (-s, -c), (-c, s)`. The Python reference repeats every
 /// operation in the same order.
-#[inline]
+#[inline(always)]
 pub fn sin_cos_turn(x: f64) -> (f64, f64) {
     let quadrant = (x * TWO_OVER_PI + 0.5) as i64;
     let q = quadrant as f64;
@@ -118,7 +121,7 @@ const LOG: [f64; 7] = [
 /// `ln m = f - (f^2/2 - s (f^2/2 + R(s^2)))` for fdlibm's polynomial `R`, and
 /// `ln u = e ln2_hi - ((f^2/2 - (s (f^2/2 + R) + e ln2_lo)) - f)`. The Python reference repeats
 /// every operation in the same order.
-#[inline]
+#[inline(always)]
 pub fn ln_unit(u: f64) -> f64 {
     let bits = u.to_bits();
     let exponent = ((bits >> 52) & 0x7ff) as i64 - 1023;
@@ -138,34 +141,91 @@ pub fn ln_unit(u: f64) -> f64 {
     e * LN2_HI - ((half_f2 - (s * (half_f2 + r) + e * LN2_LO)) - f)
 }
 
-/// Pairs of normals made per block: small fixed arrays the compiler turns into vector code.
-const BLOCK: usize = 8;
+/// Pairs of normals made per block: small fixed arrays the compiler turns into vector code
+/// (4 was fastest with each instruction set measured: baseline, AVX2 and AVX-512).
+const BLOCK: usize = 4;
+
+/// Normals `2 first .. 2 (first + BLOCK)` of a stream: `BLOCK` Box-Muller pairs.
+#[inline(always)]
+fn fill_block(seed: u64, stream: u64, first: u64, out: &mut [f32; 2 * BLOCK]) {
+    let mut radius = [0.0f64; BLOCK];
+    let mut angle = [0.0f64; BLOCK];
+    for j in 0..BLOCK {
+        let p = first + j as u64;
+        radius[j] = uniform(word(seed, stream, 2 * p));
+        angle[j] = std::f64::consts::TAU * uniform(word(seed, stream, 2 * p + 1));
+    }
+    for r in &mut radius {
+        *r = (-2.0 * ln_unit(*r)).sqrt();
+    }
+    let mut sin = [0.0f64; BLOCK];
+    let mut cos = [0.0f64; BLOCK];
+    for j in 0..BLOCK {
+        (sin[j], cos[j]) = sin_cos_turn(angle[j]);
+    }
+    for j in 0..BLOCK {
+        out[2 * j] = (radius[j] * cos[j]) as f32;
+        out[2 * j + 1] = (radius[j] * sin[j]) as f32;
+    }
+}
+
+/// The generator written once; [`fill_normals`] compiles it for several instruction sets.
+#[inline(always)]
+fn fill_normals_portable(seed: u64, stream: u64, out: &mut [f32]) {
+    let mut chunks = out.chunks_exact_mut(2 * BLOCK);
+    let mut first = 0u64;
+    for chunk in &mut chunks {
+        let chunk: &mut [f32; 2 * BLOCK] = chunk.try_into().expect("chunks_exact_mut");
+        fill_block(seed, stream, first, chunk);
+        first += BLOCK as u64;
+    }
+    let rest = chunks.into_remainder();
+    if !rest.is_empty() {
+        let mut block = [0.0f32; 2 * BLOCK];
+        fill_block(seed, stream, first, &mut block);
+        let len = rest.len();
+        rest.copy_from_slice(&block[..len]);
+    }
+}
 
 /// Fills `out` with normals `0..out.len()` of stream `stream` under `seed`.
+///
+/// On x86-64 the same code is also compiled for AVX2 and AVX-512 (whose 64-bit integer
+/// multiply and conversions make the hash vectorise) and the best the CPU has is picked at run
+/// time: about 4.5x faster with AVX-512. The values do not depend on the choice: every step is
+/// a correctly rounded IEEE operation or exact integer arithmetic, and Rust never fuses a
+/// multiply and an add, so each version gives the same bits (a test compares them).
 pub fn fill_normals(seed: u64, stream: u64, out: &mut [f32]) {
-    for (block, chunk) in out.chunks_mut(2 * BLOCK).enumerate() {
-        let first = (block * BLOCK) as u64;
-        let mut radius = [0.0f64; BLOCK];
-        let mut angle = [0.0f64; BLOCK];
-        for (j, (r, a)) in radius.iter_mut().zip(angle.iter_mut()).enumerate() {
-            let p = first + j as u64;
-            *r = uniform(word(seed, stream, 2 * p));
-            *a = std::f64::consts::TAU * uniform(word(seed, stream, 2 * p + 1));
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+        {
+            // SAFETY: the CPU has the features this version was compiled for.
+            return unsafe { vector::fill_normals_avx512(seed, stream, out) };
         }
-        for r in &mut radius {
-            *r = (-2.0 * ln_unit(*r)).sqrt();
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: as above.
+            return unsafe { vector::fill_normals_avx2(seed, stream, out) };
         }
-        let mut sin = [0.0f64; BLOCK];
-        let mut cos = [0.0f64; BLOCK];
-        for j in 0..BLOCK {
-            (sin[j], cos[j]) = sin_cos_turn(angle[j]);
-        }
-        for (j, pair) in chunk.chunks_mut(2).enumerate() {
-            pair[0] = (radius[j] * cos[j]) as f32;
-            if let Some(second) = pair.get_mut(1) {
-                *second = (radius[j] * sin[j]) as f32;
-            }
-        }
+    }
+    fill_normals_portable(seed, stream, out);
+}
+
+/// [`fill_normals_portable`] compiled for wider vector units.
+#[cfg(target_arch = "x86_64")]
+mod vector {
+    /// AVX-512 (F, DQ, VL) version.
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx2")]
+    pub(super) fn fill_normals_avx512(seed: u64, stream: u64, out: &mut [f32]) {
+        super::fill_normals_portable(seed, stream, out);
+    }
+
+    /// AVX2 version.
+    #[target_feature(enable = "avx2")]
+    pub(super) fn fill_normals_avx2(seed: u64, stream: u64, out: &mut [f32]) {
+        super::fill_normals_portable(seed, stream, out);
     }
 }
 
@@ -254,6 +314,37 @@ mod tests {
             let r = (-2.0 * u0.ln()).sqrt();
             let (sin, cos) = (std::f64::consts::TAU * u1).sin_cos();
             assert_eq!(pair, [(r * cos) as f32, (r * sin) as f32], "pair {p}");
+        }
+    }
+
+    #[test]
+    fn every_instruction_set_gives_the_same_bits() {
+        // Odd lengths cover the partial last block.
+        for (stream, len) in [(0, 1_000_003), (9, 7), (10, 1)] {
+            let mut portable = vec![0.0f32; len];
+            fill_normals_portable(13, stream, &mut portable);
+            assert_eq!(
+                normals(13, stream, len),
+                portable,
+                "dispatched, stream {stream}"
+            );
+            #[cfg(target_arch = "x86_64")]
+            {
+                let mut wide = vec![0.0f32; len];
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    // SAFETY: the CPU has AVX2.
+                    unsafe { vector::fill_normals_avx2(13, stream, &mut wide) };
+                    assert_eq!(wide, portable, "AVX2, stream {stream}");
+                }
+                if std::arch::is_x86_feature_detected!("avx512f")
+                    && std::arch::is_x86_feature_detected!("avx512dq")
+                    && std::arch::is_x86_feature_detected!("avx512vl")
+                {
+                    // SAFETY: the CPU has AVX-512 F, DQ and VL.
+                    unsafe { vector::fill_normals_avx512(13, stream, &mut wide) };
+                    assert_eq!(wide, portable, "AVX-512, stream {stream}");
+                }
+            }
         }
     }
 
