@@ -1,6 +1,8 @@
 //! The QnA-UNet denoiser in burn: timestep embedding, residual blocks, QnA attention.
 
+pub mod dropout;
 pub mod layers;
+pub mod pointwise;
 pub mod qna;
 pub mod resblock;
 pub mod timestep;

@@ -76,40 +76,50 @@ impl QnaBlock {
             .reshape([batch, frames, heads])
     }
 
-    /// `sum_j w[h, j] t[n + j - (k-1)/2]` over frames (dim 1) of `t` `[B, N, H, X]`, zero outside.
-    fn window_sum(&self, t: Tensor<4>, bias: &Tensor<2>) -> Tensor<4> {
-        let frames = t.dims()[1];
-        let pad = (self.window - 1) / 2;
-        let padded = t.pad([(0, 0), (pad, pad), (0, 0), (0, 0)], PadMode::Constant(0.0));
-        (0..self.window)
-            .map(|j| {
-                padded.clone().narrow(1, j, frames)
-                    * bias.clone().narrow(1, j, 1).reshape([1, 1, self.heads, 1])
-            })
-            .reduce(|a, b| a + b)
-            .expect("window >= 1")
-    }
-
     /// `x` `[B, N, C]` to `[B, N, C]`.
+    ///
+    /// With `e[n] = exp(s[n] - max s)` and `b_j = exp(rpe_j)`, the attention of frame `n` to
+    /// neighbour `m = n + j - (k-1)/2` inside the clip is `a_j[n] = b_j e[m] / sum_j' b_j' e[..]`.
+    /// These weights are only `[B, N, H]` each, so they are normalised first and the full-size
+    /// values are touched once per neighbour (a product and a sum), with no full-size division.
     pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
         let [batch, frames, channels] = x.dims();
         let heads = self.heads;
         let width = channels / heads;
+        let pad = (self.window - 1) / 2;
         let normed = self.norm.forward(x.clone());
         let scores = self.scores(normed.clone());
         let top = scores.clone().max_dim(1);
-        let weights = (scores - top)
-            .clamp_min(SCORE_FLOOR)
-            .exp()
-            .reshape([batch, frames, heads, 1]);
+        let weights = (scores - top).clamp_min(SCORE_FLOOR).exp();
+        let bias = self.rpe.val().exp();
+        // Each neighbour's unnormalised weight seen from frame n, zero outside the clip: [B, N, H].
+        let padded = weights.pad([(0, 0), (pad, pad), (0, 0)], PadMode::Constant(0.0));
+        let neighbour: Vec<Tensor<3>> = (0..self.window)
+            .map(|j| {
+                padded.clone().narrow(1, j, frames)
+                    * bias.clone().narrow(1, j, 1).reshape([1, 1, heads])
+            })
+            .collect();
+        let total = neighbour
+            .iter()
+            .cloned()
+            .reduce(|a, b| a + b)
+            .expect("window >= 1");
         let values = self
             .value
             .forward(normed)
-            .reshape([batch, frames, heads, width]);
-        let bias = self.rpe.val().exp();
-        let numerator = self.window_sum(values * weights.clone(), &bias);
-        let denominator = self.window_sum(weights, &bias);
-        let attended = (numerator / denominator).reshape([batch, frames, channels]);
+            .reshape([batch, frames, heads, width])
+            .pad([(0, 0), (pad, pad), (0, 0), (0, 0)], PadMode::Constant(0.0));
+        let attended = neighbour
+            .into_iter()
+            .enumerate()
+            .map(|(j, w)| {
+                values.clone().narrow(1, j, frames)
+                    * (w / total.clone()).reshape([batch, frames, heads, 1])
+            })
+            .reduce(|a, b| a + b)
+            .expect("window >= 1")
+            .reshape([batch, frames, channels]);
         x + self.proj.forward(attended)
     }
 }

@@ -1,10 +1,11 @@
 //! The residual block with timestep-conditioned scale and shift.
 
+use super::pointwise::silu;
 use burn::module::Module;
-use burn::nn::{Dropout, DropoutConfig, Linear, LinearConfig};
-use burn::tensor::activation::silu;
+use burn::nn::{Linear, LinearConfig};
 use burn::tensor::{Device, Tensor};
 
+use super::dropout::HashDropout;
 use super::group_norm;
 use super::layers::{ChannelNorm, FrameConv};
 
@@ -16,7 +17,7 @@ pub struct ResBlock {
     in_conv: FrameConv,
     embedding: Linear,
     out_norm: ChannelNorm,
-    dropout: Dropout,
+    dropout: HashDropout,
     out_conv: FrameConv,
     skip: Option<FrameConv>,
 }
@@ -35,7 +36,7 @@ impl ResBlock {
             in_conv: FrameConv::new(input, output, 3, device),
             embedding: LinearConfig::new(embedding_width, 2 * output).init(device),
             out_norm: group_norm(output, device),
-            dropout: DropoutConfig::new(dropout).init(),
+            dropout: HashDropout::new(dropout),
             out_conv: FrameConv::zeros(output, output, 3, device),
             skip: (input != output).then(|| FrameConv::new(input, output, 1, device)),
         }

@@ -1,8 +1,8 @@
 //! The timestep embedding: sinusoidal features of the integer step, then a two-layer MLP.
 
+use super::pointwise::silu;
 use burn::module::Module;
 use burn::nn::{Linear, LinearConfig};
-use burn::tensor::activation::silu;
 use burn::tensor::{Device, Tensor, TensorData};
 
 /// Width of the sinusoidal features (cosines then sines, 128 each).

@@ -1,7 +1,7 @@
 //! The one-level QnA-UNet denoiser of SPEC §3.
 
+use super::pointwise::silu;
 use burn::module::Module;
-use burn::tensor::activation::silu;
 use burn::tensor::{Device, Tensor};
 
 use super::group_norm;
