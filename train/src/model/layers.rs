@@ -90,6 +90,20 @@ impl ChannelNorm {
     /// the full-size tensor is touched by one multiply-add instead of a subtract, a divide, a
     /// multiply and an add (fewer passes and fewer saved intermediates for the backward pass).
     pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
+        let (scale, shift) = self.scale_and_shift(&x);
+        x * scale + shift
+    }
+
+    /// `forward(x) * (1 + scale) + shift` for a per-item `scale` and `shift` `[B, 1, C]` (the
+    /// timestep modulation of a residual block), still in one multiply-add over `x`.
+    pub fn forward_modulated(&self, x: Tensor<3>, scale: Tensor<3>, shift: Tensor<3>) -> Tensor<3> {
+        let (a, b) = self.scale_and_shift(&x);
+        let gain = scale + 1.0;
+        x * (a * gain.clone()) + (b * gain + shift)
+    }
+
+    /// The per-item scale and shift `[B, 1, C]` with `forward(x) = x * scale + shift`.
+    fn scale_and_shift(&self, x: &Tensor<3>) -> (Tensor<3>, Tensor<3>) {
         let [batch, frames, channels] = x.dims();
         let width = channels / self.groups;
         let grouped = x.clone().reshape([batch, frames, self.groups, width]);
@@ -99,6 +113,9 @@ impl ChannelNorm {
         let beta = self.beta.val().reshape([1, 1, self.groups, width]);
         let scale = gamma / (var + self.epsilon).sqrt();
         let shift = beta - mean * scale.clone();
-        x * scale.reshape([batch, 1, channels]) + shift.reshape([batch, 1, channels])
+        (
+            scale.reshape([batch, 1, channels]),
+            shift.reshape([batch, 1, channels]),
+        )
     }
 }

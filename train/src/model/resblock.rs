@@ -52,7 +52,7 @@ impl ResBlock {
             .reshape([batch, 1, 2 * channels]);
         let scale = scale_shift.clone().narrow(2, 0, channels);
         let shift = scale_shift.narrow(2, channels, channels);
-        let h = self.out_norm.forward(h) * (scale + 1.0) + shift;
+        let h = self.out_norm.forward_modulated(h, scale, shift);
         let h = self.out_conv.forward(self.dropout.forward(silu(h)));
         let skip = match &self.skip {
             Some(conv) => conv.forward(x),
