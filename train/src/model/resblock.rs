@@ -5,7 +5,7 @@ use burn::module::Module;
 use burn::nn::{Linear, LinearConfig};
 use burn::tensor::{Device, Tensor};
 
-use super::dropout::HashDropout;
+use super::dropout::{DropoutKey, HashDropout};
 use super::group_norm;
 use super::layers::{ChannelNorm, FrameConv};
 
@@ -23,12 +23,14 @@ pub struct ResBlock {
 }
 
 impl ResBlock {
-    /// A block from `input` to `output` channels, conditioned on an embedding of `embedding_width`.
+    /// A block from `input` to `output` channels, conditioned on an embedding of `embedding_width`;
+    /// `layer` numbers the block's dropout among the network's.
     pub fn new(
         input: usize,
         output: usize,
         embedding_width: usize,
         dropout: f64,
+        layer: u64,
         device: &Device,
     ) -> Self {
         ResBlock {
@@ -36,14 +38,19 @@ impl ResBlock {
             in_conv: FrameConv::new(input, output, 3, device),
             embedding: LinearConfig::new(embedding_width, 2 * output).init(device),
             out_norm: group_norm(output, device),
-            dropout: HashDropout::new(dropout),
+            dropout: HashDropout::new(dropout, layer),
             out_conv: FrameConv::zeros(output, output, 3, device),
             skip: (input != output).then(|| FrameConv::new(input, output, 1, device)),
         }
     }
 
-    /// `x` `[B, N, in]`, `embedding` `[B, 4C]` to `[B, N, out]`.
-    pub fn forward(&self, x: Tensor<3>, embedding: Tensor<2>) -> Tensor<3> {
+    /// `x` `[B, N, in]`, `embedding` `[B, 4C]` to `[B, N, out]`; dropout only with a key.
+    pub fn forward(
+        &self,
+        x: Tensor<3>,
+        embedding: Tensor<2>,
+        dropout: Option<DropoutKey>,
+    ) -> Tensor<3> {
         let h = self.in_conv.forward(silu(self.in_norm.forward(x.clone())));
         let [batch, _, channels] = h.dims();
         let scale_shift = self
@@ -53,7 +60,9 @@ impl ResBlock {
         let scale = scale_shift.clone().narrow(2, 0, channels);
         let shift = scale_shift.narrow(2, channels, channels);
         let h = self.out_norm.forward_modulated(h, scale, shift);
-        let h = self.out_conv.forward(self.dropout.forward(silu(h)));
+        let h = self
+            .out_conv
+            .forward(self.dropout.forward(silu(h), dropout));
         let skip = match &self.skip {
             Some(conv) => conv.forward(x),
             None => x,

@@ -4,6 +4,7 @@ use super::pointwise::silu;
 use burn::module::Module;
 use burn::tensor::{Device, Tensor};
 
+use super::dropout::DropoutKey;
 use super::group_norm;
 use super::layers::{ChannelNorm, FrameConv};
 use super::qna::QnaBlock;
@@ -36,11 +37,11 @@ impl QnaUnet {
         let net = QnaUnet {
             time: TimestepEmbedding::new(c, device),
             input: FrameConv::new(features, c, 3, device),
-            block1: ResBlock::new(c, c, emb, config.dropout, device),
+            block1: ResBlock::new(c, c, emb, config.dropout, 1, device),
             attention1: qna(),
-            block2: ResBlock::new(c, c, emb, config.dropout, device),
+            block2: ResBlock::new(c, c, emb, config.dropout, 2, device),
             attention2: qna(),
-            block3: ResBlock::new(2 * c, c, emb, config.dropout, device),
+            block3: ResBlock::new(2 * c, c, emb, config.dropout, 3, device),
             attention3: qna(),
             out_norm: group_norm(c, device),
             output: FrameConv::zeros(c, features, 3, device),
@@ -49,20 +50,33 @@ impl QnaUnet {
         net
     }
 
-    /// `x_t` `[B, F, N]` and `t` `[B]` (integer steps as floats) to the predicted `x0` `[B, F, N]`.
+    /// `x_t` `[B, F, N]` and `t` `[B]` (integer steps as floats) to the predicted `x0` `[B, F, N]`,
+    /// without dropout (inference, export checks).
     pub fn forward(&self, x_t: Tensor<3>, t: Tensor<1>) -> Tensor<3> {
+        self.forward_training(x_t, t, None)
+    }
+
+    /// [`QnaUnet::forward`] with the dropout masks of `dropout` (training).
+    pub fn forward_training(
+        &self,
+        x_t: Tensor<3>,
+        t: Tensor<1>,
+        dropout: Option<DropoutKey>,
+    ) -> Tensor<3> {
         let emb = self.time.forward(t);
         // Internally [B, N, C]: every layer is then a matrix product over B * N rows.
         let h0 = self.input.forward(x_t.swap_dims(1, 2));
         let h1 = self
             .attention1
-            .forward(self.block1.forward(h0.clone(), emb.clone()));
+            .forward(self.block1.forward(h0.clone(), emb.clone(), dropout));
         let h2 = self
             .attention2
-            .forward(self.block2.forward(h1, emb.clone()));
-        let h3 = self
-            .attention3
-            .forward(self.block3.forward(Tensor::cat(vec![h2, h0], 2), emb));
+            .forward(self.block2.forward(h1, emb.clone(), dropout));
+        let h3 = self.attention3.forward(self.block3.forward(
+            Tensor::cat(vec![h2, h0], 2),
+            emb,
+            dropout,
+        ));
         self.output
             .forward(silu(self.out_norm.forward(h3)))
             .swap_dims(1, 2)

@@ -65,7 +65,8 @@ pub fn perturb<M: Module>(module: M, std: f64) -> M {
                 .map(|t| {
                     let noise =
                         Tensor::random(t.shape(), Distribution::Normal(0.0, std), &t.device());
-                    t + noise
+                    // A new leaf, so it can be tracked on an autodiff device too.
+                    (t + noise).detach()
                 })
                 .set_require_grad(true)
         }
