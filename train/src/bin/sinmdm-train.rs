@@ -38,7 +38,8 @@ struct Args {
     /// Print the clip's size, the parameter count and the receptive field, then stop.
     #[arg(long)]
     dry_run: bool,
-    /// CPU threads (default: all cores).
+    /// CPU threads (default: all cores). Each step's batch is split into this many shards that
+    /// run in parallel; a run is bit-for-bit repeatable for the same seed and thread count.
     #[arg(long)]
     threads: Option<usize>,
     /// Write the trained model as ONNX here when training finishes (same as running
