@@ -96,7 +96,13 @@ pub fn optimisation_step(
     x0: Tensor<3>,
     learning_rate: f64,
 ) -> (QnaUnet, f64) {
-    match sharded_gradients(&model, x_t, t, x0, rayon::current_num_threads()) {
+    // A GPU runs one batch best whole.
+    let shards = if on_cpu(&x_t.device()) {
+        rayon::current_num_threads()
+    } else {
+        1
+    };
+    match sharded_gradients(&model, x_t, t, x0, shards) {
         (loss, Some(grads)) => (optimizer.step(learning_rate, model, grads), loss),
         (loss, None) => (model, loss),
     }
@@ -179,6 +185,11 @@ fn shard_ranges(batch: usize, threads: usize) -> Vec<(usize, usize)> {
             (first - len, len)
         })
         .collect()
+}
+
+/// Whether `device` is the CPU backend (with or without autodiff).
+fn on_cpu(device: &Device) -> bool {
+    device.clone().inner() == Device::flex()
 }
 
 /// The dropout seed of a step, from the device generator (which the trainer seeds every step).
@@ -544,6 +555,12 @@ mod tests {
     use super::*;
     use crate::model::weights::perturb;
     use burn::tensor::Distribution;
+
+    #[test]
+    fn the_cpu_device_is_recognised() {
+        assert!(on_cpu(&Device::flex()));
+        assert!(on_cpu(&Device::flex().autodiff()));
+    }
 
     #[test]
     fn shards_split_batches_evenly_with_larger_ones_first() {
