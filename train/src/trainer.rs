@@ -18,8 +18,8 @@ use crate::config::TrainConfig;
 use crate::data::make_batch;
 use crate::error::{TrainError, io};
 use crate::loss_log::LossLog;
-use crate::model::QnaUnet;
 use crate::model::dropout::DropoutKey;
+use crate::model::{QnaUnet, on_cpu};
 
 /// Copy of the clip inside the run folder, so a run resumes without the original file.
 pub const CLIP_COPY: &str = "clip.bvh";
@@ -185,11 +185,6 @@ fn shard_ranges(batch: usize, threads: usize) -> Vec<(usize, usize)> {
             (first - len, len)
         })
         .collect()
-}
-
-/// Whether `device` is the CPU backend (with or without autodiff).
-fn on_cpu(device: &Device) -> bool {
-    device.clone().inner() == Device::flex()
 }
 
 /// The dropout seed of a step, from the device generator (which the trainer seeds every step).
@@ -555,12 +550,6 @@ mod tests {
     use super::*;
     use crate::model::weights::perturb;
     use burn::tensor::Distribution;
-
-    #[test]
-    fn the_cpu_device_is_recognised() {
-        assert!(on_cpu(&Device::flex()));
-        assert!(on_cpu(&Device::flex().autodiff()));
-    }
 
     #[test]
     fn shards_split_batches_evenly_with_larger_ones_first() {

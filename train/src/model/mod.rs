@@ -23,6 +23,12 @@ pub(crate) fn group_norm(channels: usize, device: &Device) -> layers::ChannelNor
     layers::ChannelNorm::new(NORM_GROUPS, channels, 1e-5, device)
 }
 
+/// Whether `device` is the CPU backend (with or without autodiff), where the workarounds for its
+/// single-threaded element-wise operations pay off.
+pub(crate) fn on_cpu(device: &Device) -> bool {
+    device.clone().inner() == Device::flex()
+}
+
 /// Draws every lazily initialised parameter now, in module order, so the weights depend only on
 /// the seed and not on the order of later tensor operations.
 pub(crate) fn materialize<M: Module>(module: &M) {
@@ -33,4 +39,15 @@ pub(crate) fn materialize<M: Module>(module: &M) {
         }
     }
     module.visit(&mut Touch);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cpu_device_is_recognised() {
+        assert!(on_cpu(&Device::flex()));
+        assert!(on_cpu(&Device::flex().autodiff()));
+    }
 }
