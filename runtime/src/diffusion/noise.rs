@@ -198,10 +198,7 @@ fn fill_normals_portable(seed: u64, stream: u64, out: &mut [f32]) {
 pub fn fill_normals(seed: u64, stream: u64, out: &mut [f32]) {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx512f")
-            && std::arch::is_x86_feature_detected!("avx512dq")
-            && std::arch::is_x86_feature_detected!("avx512vl")
-        {
+        if vector::has_avx512() {
             // SAFETY: the CPU has the features this version was compiled for.
             return unsafe { vector::fill_normals_avx512(seed, stream, out) };
         }
@@ -216,6 +213,13 @@ pub fn fill_normals(seed: u64, stream: u64, out: &mut [f32]) {
 /// [`fill_normals_portable`] compiled for wider vector units.
 #[cfg(target_arch = "x86_64")]
 mod vector {
+    /// Whether the CPU has what [`fill_normals_avx512`] is compiled for.
+    pub(super) fn has_avx512() -> bool {
+        std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+    }
+
     /// AVX-512 (F, DQ, VL) version.
     #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx2")]
     pub(super) fn fill_normals_avx512(seed: u64, stream: u64, out: &mut [f32]) {
@@ -336,10 +340,7 @@ mod tests {
                     unsafe { vector::fill_normals_avx2(13, stream, &mut wide) };
                     assert_eq!(wide, portable, "AVX2, stream {stream}");
                 }
-                if std::arch::is_x86_feature_detected!("avx512f")
-                    && std::arch::is_x86_feature_detected!("avx512dq")
-                    && std::arch::is_x86_feature_detected!("avx512vl")
-                {
+                if vector::has_avx512() {
                     // SAFETY: the CPU has AVX-512 F, DQ and VL.
                     unsafe { vector::fill_normals_avx512(13, stream, &mut wide) };
                     assert_eq!(wide, portable, "AVX-512, stream {stream}");
