@@ -209,8 +209,16 @@ fn cli_reports_bad_input_and_writes_no_partial_output() {
 fn bad_encoder_settings_are_errors() {
     use sinmdm::motion::{ContactConfig, EncodeOptions, MotionError, encode};
     let clip = parse_bvh(VALID, "clip.bvh").unwrap();
-    let with =
-        |contacts: ContactConfig, fps: Option<f64>| encode(&clip, &EncodeOptions { fps, contacts });
+    let with = |contacts: ContactConfig, fps: Option<f64>| {
+        encode(
+            &clip,
+            &EncodeOptions {
+                fps,
+                contacts,
+                up: None,
+            },
+        )
+    };
     let unknown = ContactConfig {
         joints: Some(vec!["LeftFoot".into()]),
         ..ContactConfig::default()

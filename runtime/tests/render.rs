@@ -3,7 +3,9 @@
 
 use std::path::PathBuf;
 
-use sinmdm::bvh::read_bvh;
+use sinmdm::bvh::{parse_bvh, read_bvh, to_bvh_string};
+use sinmdm::motion::detect_up;
+use sinmdm::motion::up::{UpAxis, reorient};
 use sinmdm::render::figure::{FIGURE_COLOURS, projected_height};
 use sinmdm::render::{Camera, Figure, RenderOptions, contact_sheet, gif_bytes};
 
@@ -11,7 +13,20 @@ fn walk() -> Figure {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../tests/data/bvh/human_walk_cmu_131_01.bvh");
     let clip = read_bvh(path).unwrap();
-    Figure::new(&clip.to_local(), "walk", 0.2)
+    Figure::new(&clip.to_local(), UpAxis::PosY, "walk", 0.2)
+}
+
+/// The walk as a Z-up file, its up axis read from the motion.
+fn z_up_walk() -> Figure {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/bvh/human_walk_cmu_131_01.bvh");
+    let clip = read_bvh(path).unwrap();
+    let copy = reorient(&clip.to_local(), &UpAxis::PosZ.file_from_canonical()).to_channels();
+    let copy = parse_bvh(&to_bvh_string(&copy), "walk_zup.bvh").unwrap();
+    let motion = copy.to_local();
+    let up = detect_up(&motion).axis;
+    assert_eq!(up, UpAxis::PosZ);
+    Figure::new(&motion, up, "walk z-up", 0.2)
 }
 
 /// Rows spanned by pixels of `colour` in an RGBA frame of `width` pixels.
@@ -27,7 +42,17 @@ fn colour_rows(rgba: &[u8], width: usize, colour: [u8; 3]) -> Option<(usize, usi
 
 #[test]
 fn gif_of_the_walk_has_a_figure_of_the_right_height_in_every_frame() {
-    let figure = walk();
+    check_gif(walk());
+}
+
+#[test]
+fn a_z_up_copy_is_drawn_upright_at_the_same_height() {
+    let (upright, copy) = (walk(), z_up_walk());
+    assert!((upright.height - copy.height).abs() < 1e-6 * upright.height);
+    check_gif(copy);
+}
+
+fn check_gif(figure: Figure) {
     let options = RenderOptions::default();
     let bytes = gif_bytes(std::slice::from_ref(&figure), &options).unwrap();
 

@@ -25,6 +25,12 @@ pub struct ClipFacts {
     pub layout: FeatureLayout,
     /// Per-feature mean and std of the clip.
     pub normalizer: Normalizer,
+    /// The up axis used and where it came from (the detection's evidence, or the config).
+    #[serde(default)]
+    pub up: String,
+    /// The clip is an in-place cycle (contacts measured against its treadmill).
+    #[serde(default)]
+    pub in_place: bool,
 }
 
 /// A clip ready for training: its facts and normalised features `[F, N]`.
@@ -65,6 +71,7 @@ impl ClipData {
                 speed_threshold: data.contact_speed,
                 ..ContactConfig::default()
             },
+            up: data.up,
         };
         let encoded = encode(&clip, &options).map_err(|source| TrainError::Motion {
             path: path.to_path_buf(),
@@ -85,8 +92,14 @@ impl ClipData {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
+        let up = match &encoded.up_detection {
+            Some(found) => format!("{} (read from the motion)", found.describe()),
+            None => format!("{} (data.up in the config)", encoded.layout.up),
+        };
         Ok(ClipData {
             facts: ClipFacts {
+                up,
+                in_place: encoded.in_place,
                 name,
                 sha256: sha256_hex(&bytes),
                 frames,

@@ -76,6 +76,10 @@ pub struct DataConfig {
     pub contact_joints: Option<Vec<String>>,
     /// Contact speed threshold in skeleton heights per second.
     pub contact_speed: f64,
+    /// The clip's up axis (`x`, `y`, `z`, `-x`, `-y`, `-z`); absent or `null` reads it from the
+    /// motion.
+    #[serde(default)]
+    pub up: Option<sinmdm::motion::UpAxis>,
 }
 
 impl TrainConfig {

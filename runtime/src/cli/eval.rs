@@ -34,6 +34,8 @@ pub struct EvalArgs {
     /// The clip to score against: the model's training clip.
     #[arg(long, value_name = "CLIP.bvh")]
     clip: PathBuf,
+    #[command(flatten)]
+    up: super::sampling::ClipUpArg,
     /// Samples to generate (one batched run).
     #[arg(long, default_value_t = 20)]
     samples: usize,
@@ -124,7 +126,7 @@ pub(super) fn run(args: &EvalArgs) -> Result<()> {
             threads: args.threads,
         },
     )?;
-    let clip = reference_features(&model, &args.clip)?;
+    let clip = reference_features(&model, &args.clip, args.up.up)?;
     let clip_frames = clip.len_of(Axis(1));
     let frames = args.frames.unwrap_or(2 * clip_frames);
     if frames < COVERAGE_WINDOW {

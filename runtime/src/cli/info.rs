@@ -40,6 +40,8 @@ pub struct EncodeArgs {
     /// The features JSON to write.
     #[arg(short, long, value_name = "OUT.json")]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub up: super::sampling::ClipUpArg,
 }
 
 /// A readable summary of a model's metadata.
@@ -67,6 +69,11 @@ pub fn describe(path: &std::path::Path, m: &ModelMetadata) -> String {
         l.skeleton_height
     );
     let _ = writeln!(s, "frame rate   {} fps", l.fps);
+    let _ = writeln!(
+        s,
+        "up axis      {} (its clips are read and written {}-up; a file without the field is Y-up)",
+        l.up, l.up
+    );
     if let Some(root) = &l.root {
         let _ = writeln!(
             s,
@@ -124,7 +131,7 @@ pub(super) fn info(args: &InfoArgs) -> Result<()> {
 
 pub(super) fn encode(args: &EncodeArgs) -> Result<()> {
     let model = Model::open(&args.model, &ModelOptions { threads: Some(1) })?;
-    let features = reference_features(&model, &args.clip)?;
+    let features = reference_features(&model, &args.clip, args.up.up)?;
     write_features(
         &args.output,
         &model.metadata().layout,

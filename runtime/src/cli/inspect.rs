@@ -8,6 +8,7 @@ use clap::Args;
 
 use crate::bvh::{read_bvh, write_bvh};
 use crate::files::write_atomically;
+use crate::motion::up::{UP, file_axis_name};
 use crate::motion::{
     ContactConfig, EncodeOptions, decode, encode, fk, global_poses, math, skeleton::Channel,
 };
@@ -15,7 +16,8 @@ use crate::motion::{
 pub(super) const EXAMPLES: &str = "Examples:
   sinmdm inspect tests/data/bvh/human_walk_cmu_131_01.bvh
   sinmdm inspect walk.bvh --fps 30 --roundtrip walk_30fps.bvh
-  sinmdm inspect dog.bvh --contact-joints LeftHand,RightHand,LeftFoot,RightFoot";
+  sinmdm inspect dog.bvh --contact-joints LeftHand,RightHand,LeftFoot,RightFoot
+  sinmdm inspect zup_clip.bvh --up z";
 
 /// Arguments of `sinmdm inspect`.
 #[derive(Debug, Args)]
@@ -37,6 +39,8 @@ pub struct InspectArgs {
     /// Contact speed threshold in skeleton heights per second.
     #[arg(long, default_value_t = ContactConfig::default().speed_threshold)]
     pub contact_speed: f64,
+    #[command(flatten)]
+    pub up: super::sampling::ClipUpArg,
 }
 
 /// A plain-words guess of the file's length unit from the skeleton height.
@@ -65,6 +69,7 @@ pub(super) fn run(args: &InspectArgs) -> Result<()> {
             speed_threshold: args.contact_speed,
             ..ContactConfig::default()
         },
+        up: args.up.up,
     };
     let encoded = encode(&clip, &options)
         .with_context(|| format!("{}: cannot encode the clip", args.clip.display()))?;
@@ -92,23 +97,32 @@ pub(super) fn run(args: &InspectArgs) -> Result<()> {
         skeleton.len(),
         skeleton.channel_count()
     );
+    let up_line = match &encoded.up_detection {
+        Some(found) => format!("{} (read from the motion)", found.describe()),
+        None => format!("{} (given with --up)", layout.up),
+    };
+    let _ = writeln!(out, "up         {up_line}");
     let height = layout.skeleton_height;
-    let _ = writeln!(out, "height     {height:.3} file units");
+    let _ = writeln!(out, "height     {height:.3} file units along {}", layout.up);
     let _ = writeln!(out, "units      {}", units_guess(height));
     match &layout.root {
         Some(root) => {
             let axes: Vec<String> = root
                 .axes
                 .iter()
-                .map(|a| match a {
-                    crate::motion::Axis::Y => "Y".to_string(),
-                    other => format!("d{other}"),
+                .map(|a| {
+                    let name = file_axis_name(layout.up, a.index());
+                    if a.index() == UP {
+                        format!("height({name})")
+                    } else {
+                        format!("d{name}")
+                    }
                 })
                 .collect();
             let s = root.start_position;
             let _ = writeln!(
                 out,
-                "root       {} -> {} (start {:.3} {:.3} {:.3})",
+                "root       {} -> {} (start {:.3} {:.3} {:.3}, canonical Y-up)",
                 skeleton.joints[root.joint].name,
                 axes.join(" "),
                 s[0],
@@ -123,6 +137,15 @@ pub(super) fn run(args: &InspectArgs) -> Result<()> {
             );
         }
     }
+    let _ = writeln!(
+        out,
+        "cycle      {}",
+        if encoded.in_place {
+            "in-place cycle: the root does not travel, so contacts are measured against the treadmill (the feet's common backward drift)"
+        } else {
+            "travels (or stands): contacts from speed over the ground"
+        }
+    );
     let contacts: Vec<String> = layout
         .contact_joints
         .iter()

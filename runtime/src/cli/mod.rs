@@ -5,6 +5,7 @@ mod eval;
 mod info;
 mod inspect;
 mod render;
+mod reorient;
 mod sampling;
 mod tasks;
 
@@ -44,6 +45,9 @@ pub enum Command {
     /// Draw BVH clips as stick figures: an animated GIF, or a PNG contact sheet.
     #[command(after_help = render::EXAMPLES)]
     Render(render::RenderArgs),
+    /// Rewrite a clip with another up axis (Z-up to Y-up, say) and/or turned about its up axis.
+    #[command(after_help = reorient::EXAMPLES)]
+    Reorient(reorient::ReorientArgs),
     /// Score a model: generate samples and measure coverage and diversity against its clip.
     #[command(after_help = eval::EXAMPLES)]
     Eval(eval::EvalArgs),
@@ -68,6 +72,7 @@ pub fn main() -> std::process::ExitCode {
         Command::Eval(args) => eval::run(&args),
         Command::Info(args) => info::info(&args),
         Command::Render(args) => render::run(&args),
+        Command::Reorient(args) => reorient::run(&args),
         Command::Encode(args) => info::encode(&args),
     };
     match result {

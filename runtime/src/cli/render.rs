@@ -7,7 +7,7 @@ use clap::{Args, ValueEnum};
 
 use crate::bvh::read_bvh;
 use crate::files::write_atomically;
-use crate::motion::ContactConfig;
+use crate::motion::{Confidence, ContactConfig, detect_up};
 use crate::render::{Camera, Figure, RenderOptions, contact_sheet, gif_bytes};
 
 pub(super) const EXAMPLES: &str = "Examples:
@@ -42,6 +42,8 @@ pub struct RenderArgs {
     /// Frames on a PNG contact sheet.
     #[arg(long, default_value_t = 8)]
     pub sheet_frames: usize,
+    #[command(flatten)]
+    pub up: super::sampling::ClipUpArg,
 }
 
 /// Writes `figures` as a GIF or PNG chosen by the extension of `path`.
@@ -84,8 +86,24 @@ pub(super) fn run(args: &RenderArgs) -> Result<()> {
         let label = path
             .file_stem()
             .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+        let motion = clip.to_local();
+        let up = match args.up.up {
+            Some(up) => up,
+            None => {
+                let found = detect_up(&motion);
+                if found.confidence == Confidence::Unsure {
+                    eprintln!(
+                        "{}: up axis {}; pass --up if the figure is not upright",
+                        path.display(),
+                        found.describe()
+                    );
+                }
+                found.axis
+            }
+        };
         figures.push(Figure::new(
-            &clip.to_local(),
+            &motion,
+            up,
             label,
             ContactConfig::default().speed_threshold,
         ));

@@ -11,7 +11,8 @@ use crate::bvh::{read_bvh, to_bvh_string};
 use crate::features_file::write_features;
 use crate::files::write_atomically;
 use crate::model::{Model, ModelOptions};
-use crate::motion::encode_for;
+use crate::motion::up::{Confidence, UpAxis, detect_up, reorient};
+use crate::motion::{encode_for, math};
 use crate::render::{Camera, Figure};
 use crate::tasks::{self, Generated, Request, Span, Task};
 
@@ -138,9 +139,40 @@ pub fn parse_span(text: &str, fps: f64, frames: usize) -> Result<Span> {
     Ok(Span::new(start, end))
 }
 
-/// Reads a BVH clip of the model's skeleton as raw features in the model's layout.
-pub fn reference_features(model: &Model, clip: &Path) -> Result<Array2<f32>> {
-    let channels = read_bvh(clip)?;
+/// `--up`: the up axis of a clip the command reads.
+#[derive(Debug, Clone, Args)]
+pub struct ClipUpArg {
+    /// The clip's up axis: x, y, z, -x, -y or -z (default: read from the motion; for a
+    /// reference or content clip, the model's own when the motion does not say clearly).
+    #[arg(long, value_name = "AXIS")]
+    pub up: Option<UpAxis>,
+}
+
+/// Reads a BVH clip of the model's skeleton as raw features in the model's layout. The clip's up
+/// axis is `up`, else the detected one when the detection is sure, else the model's; a clip
+/// whose up differs from the model's is turned into the model's convention first.
+pub fn reference_features(model: &Model, clip: &Path, up: Option<UpAxis>) -> Result<Array2<f32>> {
+    let mut channels = read_bvh(clip)?;
+    let model_up = model.metadata().layout.up;
+    let clip_up = up.unwrap_or_else(|| {
+        let found = detect_up(&channels.to_local());
+        if found.confidence == Confidence::Sure {
+            found.axis
+        } else {
+            model_up
+        }
+    });
+    if clip_up != model_up {
+        eprintln!(
+            "{}: up axis {clip_up}, the model's is {model_up}: turning the clip into the model's convention",
+            clip.display()
+        );
+        let turn = math::mat_mul(
+            &model_up.file_from_canonical(),
+            &clip_up.canonical_from_file(),
+        );
+        channels = reorient(&channels.to_local(), &turn).to_channels();
+    }
     encode_for(&channels, &model.metadata().layout).with_context(|| {
         format!(
             "{}: cannot use it with model {}",
@@ -246,6 +278,7 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         for i in 0..generated.count() {
             let mut figure = Figure::new(
                 &generated.motion(i)?,
+                layout.up,
                 format!("sample {i}"),
                 layout.contact_speed_threshold,
             );

@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use anyhow::{Result, bail};
 use clap::Args;
 
-use super::sampling::{SamplingArgs, parse_position, parse_span, reference_features, run_task};
+use super::sampling::{
+    ClipUpArg, SamplingArgs, parse_position, parse_span, reference_features, run_task,
+};
 use crate::tasks::{
     EXPAND_RAMP, HARMONIZE_FACTOR, HARMONIZE_FREE_SHARE, INBETWEEN_RAMP, Task, joints_by_name,
     subtree,
@@ -54,6 +56,8 @@ pub struct InbetweenArgs {
     /// The clip whose spans are kept (same skeleton as the model).
     #[arg(long, value_name = "CLIP.bvh")]
     reference: PathBuf,
+    #[command(flatten)]
+    up: ClipUpArg,
     /// A span of the reference to keep, START:END (END exclusive; empty END = the end), in frames
     /// or seconds (`2s`). Repeat for several; the gaps between them are generated.
     #[arg(long, required = true, value_name = "START:END")]
@@ -71,6 +75,8 @@ pub struct ExpandArgs {
     /// The clip to expand (same skeleton as the model).
     #[arg(long, value_name = "CLIP.bvh")]
     reference: PathBuf,
+    #[command(flatten)]
+    up: ClipUpArg,
     /// New motion before the clip, in frames or seconds (`2s`).
     #[arg(long, default_value = "0")]
     prefix: String,
@@ -90,6 +96,8 @@ pub struct ComposeArgs {
     /// The clip the chosen joints come from (same skeleton as the model).
     #[arg(long, value_name = "CLIP.bvh")]
     reference: PathBuf,
+    #[command(flatten)]
+    up: ClipUpArg,
     /// Joints taken from the reference, comma-separated names.
     #[arg(long, value_delimiter = ',')]
     joints: Vec<String>,
@@ -116,6 +124,8 @@ pub struct HarmonizeArgs {
     /// The content clip (same skeleton as the model, which was trained on the style clip).
     #[arg(long, value_name = "CLIP.bvh")]
     content: PathBuf,
+    #[command(flatten)]
+    up: ClipUpArg,
     /// Down-sampling factor of the low-pass that carries the content.
     #[arg(long, default_value_t = HARMONIZE_FACTOR)]
     factor: usize,
@@ -143,7 +153,7 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
 
 pub(super) fn inbetween(args: &InbetweenArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
-    let reference = reference_features(&model, &args.reference)?;
+    let reference = reference_features(&model, &args.reference, args.up.up)?;
     let fps = model.metadata().layout.fps;
     let keep = args
         .keep
@@ -161,7 +171,7 @@ pub(super) fn inbetween(args: &InbetweenArgs) -> Result<()> {
 
 pub(super) fn expand(args: &ExpandArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
-    let reference = reference_features(&model, &args.reference)?;
+    let reference = reference_features(&model, &args.reference, args.up.up)?;
     let fps = model.metadata().layout.fps;
     let task = Task::Expand {
         reference,
@@ -175,7 +185,7 @@ pub(super) fn expand(args: &ExpandArgs) -> Result<()> {
 
 pub(super) fn compose(args: &ComposeArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
-    let reference = reference_features(&model, &args.reference)?;
+    let reference = reference_features(&model, &args.reference, args.up.up)?;
     let layout = &model.metadata().layout;
     let fps = layout.fps;
     let mut joints = joints_by_name(layout, &args.joints)?;
@@ -200,7 +210,7 @@ pub(super) fn compose(args: &ComposeArgs) -> Result<()> {
 
 pub(super) fn harmonize(args: &HarmonizeArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
-    let content = reference_features(&model, &args.content)?;
+    let content = reference_features(&model, &args.content, args.up.up)?;
     let task = Task::Harmonize {
         content,
         factor: args.factor,

@@ -1,8 +1,8 @@
 //! The per-frame feature vector the model learns, and the way back to a motion.
 //!
 //! Columns, in this order (each group may be empty):
-//! 1. root: for the motion root's position channels, X and Z as per-frame displacement on the
-//!    ground plane (frame 0 copies frame 1) and Y as absolute height;
+//! 1. root: for the motion root's position channels, the two ground-plane axes as per-frame
+//!    displacement (frame 0 copies frame 1) and the up axis as absolute height;
 //! 2. rotations: the 6D rotation of every joint that has rotation channels, in joint order;
 //! 3. positions: the non-root position channels that vary over the clip (absolute values);
 //! 4. contacts: one 0/1 label per contact joint.
@@ -10,18 +10,24 @@
 //! Position channels that never change are static skeleton data ([`FeatureLayout::rest_translations`]),
 //! and the root's first position is kept as [`RootFeatures::start_position`], so decoding
 //! integrates the displacements back to world positions.
+//!
+//! Features live in the canonical Y-up frame ([`super::up`]): `encode` turns the clip into it
+//! with the clip's detected (or given) up axis, recorded as [`FeatureLayout::up`], and `decode`
+//! turns the motion back into the file's frame. So a Z-up clip and its Y-up twin have the same
+//! features, and the root's axes below are canonical axes (Y = up).
 
 use ndarray::{Array2, ArrayView2};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::clip::{ChannelClip, LocalMotion};
-use super::contacts::{ContactConfig, choose_contact_joints, contact_labels};
+use super::contacts::{ContactConfig, choose_contact_joints, label_contacts};
 use super::fk::{global_poses, skeleton_height};
-use super::math::{IDENTITY, Vec3};
+use super::math::{self, IDENTITY, Vec3};
 use super::resample::resample;
 use super::rotation::{mat_from_6d, mat_to_6d};
 use super::skeleton::{Axis, Channel, Skeleton};
+use super::up::{UP, UpAxis, UpDetection, choose_up, to_canonical, to_file};
 
 /// Errors while turning a clip into features or features into a clip.
 #[derive(Debug, Error, PartialEq)]
@@ -89,9 +95,10 @@ pub struct RootFeatures {
     /// The joint that carries the clip's travel (the BVH root, or its only child when the root is
     /// a static container such as Bandai-Namco's `joint_Root`).
     pub joint: usize,
-    /// Its position axes, in X, Y, Z order: X and Z become displacements, Y stays absolute.
+    /// Its position axes in the canonical frame, in X, Y, Z order: X and Z (the ground plane)
+    /// become displacements, Y (up) stays absolute.
     pub axes: Vec<Axis>,
-    /// Its local translation at frame 0, where decoding starts integrating.
+    /// Its local translation at frame 0 (canonical frame), where decoding starts integrating.
     pub start_position: Vec3,
 }
 
@@ -141,6 +148,10 @@ pub struct FeatureLayout {
     pub contact_speed_threshold: f64,
     /// The skeleton height the thresholds are relative to (file units).
     pub skeleton_height: f64,
+    /// The file's up axis: features are in the canonical Y-up frame, and decoding turns them
+    /// back into this one. Model files written before the field existed are Y-up.
+    #[serde(default)]
+    pub up: UpAxis,
 }
 
 impl FeatureLayout {
@@ -157,7 +168,7 @@ impl FeatureLayout {
         let mut out = Vec::with_capacity(self.width());
         if let Some(root) = &self.root {
             for &axis in &root.axes {
-                let kind = if axis == Axis::Y {
+                let kind = if axis.index() == UP {
                     ColumnKind::RootHeight
                 } else {
                     ColumnKind::RootDisplacement(axis)
@@ -220,6 +231,8 @@ pub struct EncodeOptions {
     pub fps: Option<f64>,
     /// Contact joints and threshold.
     pub contacts: ContactConfig,
+    /// The clip's up axis; `None` detects it from the motion ([`super::up::detect_up`]).
+    pub up: Option<UpAxis>,
 }
 
 impl Default for EncodeOptions {
@@ -227,6 +240,7 @@ impl Default for EncodeOptions {
         EncodeOptions {
             fps: Some(30.0),
             contacts: ContactConfig::default(),
+            up: None,
         }
     }
 }
@@ -240,6 +254,11 @@ pub struct EncodedClip {
     pub features: Array2<f32>,
     /// Share of frames in contact for each contact joint.
     pub contact_share: Vec<f64>,
+    /// The up-axis detection and its evidence (`None` when the axis was given).
+    pub up_detection: Option<UpDetection>,
+    /// The clip is an in-place cycle (its root does not travel) and its contacts were labelled
+    /// relative to the treadmill.
+    pub in_place: bool,
 }
 
 /// The longest feature sequence `encode` makes (over nine hours at 30 fps).
@@ -330,7 +349,10 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         .collect();
     let root_joint = motion_root(skeleton, &any_position_varies);
 
-    let local = resample(&clip.to_local(), fps);
+    let file_local = clip.to_local();
+    let (up, up_detection) = choose_up(&file_local, options.up);
+    let canonical_from_file = up.canonical_from_file();
+    let local = to_canonical(&resample(&file_local, fps), up);
     let joints = skeleton.len();
 
     let first = clip.frame(0);
@@ -345,13 +367,25 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
                     translation[axis.index()] = first[starts[j] + c];
                 }
             }
+            if joint.parent.is_none() {
+                translation = math::mat_vec(&canonical_from_file, translation);
+            }
             translation
         })
         .collect();
-    let root_axes: Vec<Axis> = [Axis::X, Axis::Y, Axis::Z]
-        .into_iter()
-        .filter(|a| skeleton.joints[root_joint].position_axes().contains(a))
-        .collect();
+    let root_file_axes = skeleton.joints[root_joint].position_axes();
+    let root_axes: Vec<Axis> = if root_joint == 0 {
+        let mut canonical: Vec<usize> = root_file_axes
+            .iter()
+            .map(|a| up.canonical_index(a.index()))
+            .collect();
+        canonical.sort_unstable();
+        canonical.into_iter().map(Axis::from_index).collect()
+    } else {
+        let mut axes = root_file_axes;
+        axes.sort_by_key(|a| a.index());
+        axes
+    };
     let root = (!root_axes.is_empty()).then(|| RootFeatures {
         joint: root_joint,
         axes: root_axes,
@@ -402,23 +436,33 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         rest_translations,
         contact_speed_threshold: options.contacts.speed_threshold,
         skeleton_height: height,
+        up,
     };
 
-    let (features, contact_share) = fill_features(&layout, &local, &poses);
+    let filled = fill_features(&layout, &local, &poses);
     Ok(EncodedClip {
         layout,
-        features,
-        contact_share,
+        features: filled.features,
+        contact_share: filled.contact_share,
+        up_detection,
+        in_place: filled.in_place,
     })
 }
 
-/// Writes the columns of `layout` for `local` (already at the layout's frame rate, `poses` its
-/// global poses); returns the features and each contact joint's share of frames in contact.
+/// What [`fill_features`] makes.
+struct Filled {
+    features: Array2<f32>,
+    contact_share: Vec<f64>,
+    in_place: bool,
+}
+
+/// Writes the columns of `layout` for `local` (canonical frame, already at the layout's frame
+/// rate, `poses` its global poses), with each contact joint's share of frames in contact.
 fn fill_features(
     layout: &FeatureLayout,
     local: &LocalMotion,
     poses: &[super::fk::GlobalPose],
-) -> (Array2<f32>, Vec<f64>) {
+) -> Filled {
     let frames = local.frame_count();
     let joints = layout.skeleton.len();
     let fps = layout.fps;
@@ -430,7 +474,7 @@ fn fill_features(
             let a = axis.index();
             let at = |f: usize| local.translations[f * joints + root.joint][a];
             for f in 0..frames {
-                features[[row, f]] = if axis == Axis::Y {
+                features[[row, f]] = if a == UP {
                     at(f) as f32
                 } else if frames < 2 {
                     0.0
@@ -458,8 +502,15 @@ fn fill_features(
         row += 1;
     }
     let mut contact_share = Vec::with_capacity(layout.contact_joints.len());
-    for &joint in &layout.contact_joints {
-        let labels = contact_labels(poses, joint, fps, height, layout.contact_speed_threshold);
+    let labelled = label_contacts(
+        poses,
+        layout.root.as_ref().map_or(0, |r| r.joint),
+        &layout.contact_joints,
+        fps,
+        height,
+        layout.contact_speed_threshold,
+    );
+    for labels in labelled.labels {
         contact_share.push(labels.iter().map(|&l| f64::from(l)).sum::<f64>() / frames as f64);
         for (f, label) in labels.into_iter().enumerate() {
             features[[row, f]] = label;
@@ -467,12 +518,16 @@ fn fill_features(
         row += 1;
     }
     debug_assert_eq!(row, layout.width());
-    (features, contact_share)
+    Filled {
+        features,
+        contact_share,
+        in_place: labelled.in_place,
+    }
 }
 
 /// Encodes a clip of the same skeleton in an existing layout (a model's): resampled to the
-/// layout's frame rate, with the layout's columns, contact joints and contact threshold, so the
-/// result lines up with the features the model was trained on.
+/// layout's frame rate, read with the layout's up axis, with the layout's columns, contact joints
+/// and contact threshold, so the result lines up with the features the model was trained on.
 pub fn encode_for(clip: &ChannelClip, layout: &FeatureLayout) -> Result<Array2<f32>, MotionError> {
     if clip.frame_count() == 0 {
         return Err(MotionError::NoFrames);
@@ -481,13 +536,13 @@ pub fn encode_for(clip: &ChannelClip, layout: &FeatureLayout) -> Result<Array2<f
         return Err(MotionError::SkeletonMismatch(problem));
     }
     check_resampled_length(clip, layout.fps)?;
-    let local = resample(&clip.to_local(), layout.fps);
+    let local = to_canonical(&resample(&clip.to_local(), layout.fps), layout.up);
     let poses = global_poses(&local);
-    Ok(fill_features(layout, &local, &poses).0)
+    Ok(fill_features(layout, &local, &poses).features)
 }
 
-/// Turns features `[F, N]` back into local joint transforms. Contact labels are not needed to
-/// rebuild the pose and are ignored.
+/// Turns features `[F, N]` back into local joint transforms in the file's frame (its up axis,
+/// [`FeatureLayout::up`]). Contact labels are not needed to rebuild the pose and are ignored.
 pub fn decode(
     layout: &FeatureLayout,
     features: ArrayView2<'_, f32>,
@@ -514,7 +569,7 @@ pub fn decode(
             let mut value = root.start_position[a];
             for f in 0..frames {
                 let feature = f64::from(features[[row, f]]);
-                if axis == Axis::Y {
+                if a == UP {
                     value = feature;
                 } else if f > 0 {
                     value += feature;
@@ -540,10 +595,11 @@ pub fn decode(
         }
         row += 1;
     }
-    Ok(LocalMotion {
+    let canonical = LocalMotion {
         skeleton: layout.skeleton.clone(),
         fps: layout.fps,
         rotations,
         translations,
-    })
+    };
+    Ok(to_file(&canonical, layout.up))
 }

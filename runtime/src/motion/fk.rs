@@ -2,6 +2,7 @@
 
 use super::clip::LocalMotion;
 use super::math::{self, Mat3, Vec3};
+use super::up::height_of;
 
 /// Global positions of one frame: every joint, then every End Site (in joint order).
 #[derive(Debug, Clone, PartialEq)]
@@ -73,9 +74,9 @@ pub fn global_poses(motion: &LocalMotion) -> Vec<GlobalPose> {
         .collect()
 }
 
-/// The skeleton's height: the mean over frames of the vertical (Y) extent of all joints and End
-/// Sites. Measured on the posed clip rather than the rest pose, because some rigs (the MANN dog)
-/// lie along +X at rest.
+/// The skeleton's height: the mean over frames of the vertical extent of all joints and End
+/// Sites, from canonical-frame poses ([`super::up`]). Measured on the posed clip rather than the
+/// rest pose, because some rigs (the MANN dog) lie along +X at rest.
 pub fn skeleton_height(poses: &[GlobalPose]) -> f64 {
     if poses.is_empty() {
         return 0.0;
@@ -86,7 +87,7 @@ pub fn skeleton_height(poses: &[GlobalPose]) -> f64 {
             let (lo, hi) = pose
                 .points()
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                    (lo.min(p[1]), hi.max(p[1]))
+                    (lo.min(height_of(p)), hi.max(height_of(p)))
                 });
             hi - lo
         })

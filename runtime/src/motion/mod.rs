@@ -11,6 +11,7 @@ pub mod pose;
 pub mod resample;
 pub mod rotation;
 pub mod skeleton;
+pub mod up;
 
 pub use clip::{ChannelClip, LocalMotion, fps_from_frame_time};
 pub use contacts::ContactConfig;
@@ -22,3 +23,4 @@ pub use fk::{GlobalPose, global_pose, global_poses, skeleton_height};
 pub use normalize::Normalizer;
 pub use pose::{Pose, poses};
 pub use skeleton::{Axis, Channel, Joint, Skeleton};
+pub use up::{Confidence, UpAxis, UpDetection, detect_up};

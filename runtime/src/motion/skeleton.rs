@@ -10,7 +10,7 @@ use super::math::Vec3;
 pub enum Axis {
     /// X.
     X,
-    /// Y (up in every clip this tool handles).
+    /// Y (up in the canonical frame, see [`super::up`]).
     Y,
     /// Z.
     Z,

@@ -1,9 +1,13 @@
 //! Stick-figure renders of motion: forward kinematics, an orthographic camera from the front
 //! left and above, a ground grid, contacts highlighted, several clips side by side.
+//!
+//! Figures are drawn in the canonical Y-up frame ([`crate::motion::up`]): a Z-up clip is turned
+//! upright first, so the camera and the grid never depend on the file's convention.
 
 use super::canvas::{Canvas, Rgb};
-use crate::motion::contacts::{choose_contact_joints, contact_labels};
+use crate::motion::contacts::{choose_contact_joints, label_contacts, travelling_root};
 use crate::motion::math::{Vec3, dot, sub};
+use crate::motion::up::{GROUND_PLANE, UpAxis, height_of, on_ground, to_canonical};
 use crate::motion::{GlobalPose, LocalMotion, global_poses, skeleton_height};
 
 /// Background colour.
@@ -38,7 +42,7 @@ pub enum Camera {
 /// One clip to draw.
 #[derive(Debug, Clone)]
 pub struct Figure {
-    /// Global joint positions per frame.
+    /// Global joint positions per frame, in the canonical Y-up frame.
     pub poses: Vec<GlobalPose>,
     /// Parent of each joint.
     pub parents: Vec<Option<usize>>,
@@ -57,23 +61,29 @@ pub struct Figure {
 }
 
 impl Figure {
-    /// A figure of `motion`, with contact joints found as the encoder finds them and labels
-    /// from the speed threshold (in skeleton heights per second).
-    pub fn new(motion: &LocalMotion, label: impl Into<String>, contact_speed: f64) -> Figure {
-        let poses = global_poses(motion);
+    /// A figure of `motion` (in the frame of a file whose up axis is `up`), with contact joints
+    /// found as the encoder finds them and labels from the speed threshold (in skeleton heights
+    /// per second).
+    pub fn new(
+        motion: &LocalMotion,
+        up: UpAxis,
+        label: impl Into<String>,
+        contact_speed: f64,
+    ) -> Figure {
+        let poses = global_poses(&to_canonical(motion, up));
         let height = skeleton_height(&poses).max(1e-9);
         let ground = poses
             .iter()
             .flat_map(|p| p.points())
-            .map(|p| p[1])
+            .map(height_of)
             .fold(f64::INFINITY, f64::min);
         let joints = choose_contact_joints(&motion.skeleton, &poses, height, 0.25);
+        let root = travelling_root(&motion.skeleton, &poses);
+        let labelled = label_contacts(&poses, root, &joints, motion.fps, height, contact_speed);
         let contacts = joints
             .into_iter()
-            .map(|j| {
-                let labels = contact_labels(&poses, j, motion.fps, height, contact_speed);
-                (j, labels.into_iter().map(|l| l > 0.5).collect())
-            })
+            .zip(labelled.labels)
+            .map(|(j, labels)| (j, labels.into_iter().map(|l| l > 0.5).collect()))
             .collect();
         Figure {
             parents: motion.skeleton.joints.iter().map(|j| j.parent).collect(),
@@ -93,8 +103,7 @@ impl Figure {
     }
 
     fn root_ground(&self, frame: usize) -> Vec3 {
-        let r = self.poses[frame].joints[0];
-        [r[0], self.ground, r[2]]
+        on_ground(self.poses[frame].joints[0], self.ground)
     }
 }
 
@@ -119,8 +128,8 @@ impl Default for RenderOptions {
     }
 }
 
-/// The orthographic view: screen right and up vectors in world space (Y up), looking from the
-/// front left and slightly above.
+/// The orthographic view: screen right and up vectors in the canonical frame (Y up), looking
+/// from the front left and slightly above.
 fn view_axes() -> (Vec3, Vec3) {
     let (azimuth, elevation) = (35f64.to_radians(), 15f64.to_radians());
     let right = [azimuth.cos(), 0.0, -azimuth.sin()];
@@ -173,12 +182,16 @@ fn projection(figure: &Figure, frame: usize, options: &RenderOptions) -> Project
             let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
             for f in 0..figure.frames() {
                 let r = figure.root_ground(f);
-                for (i, axis) in [0, 2].into_iter().enumerate() {
+                for (i, axis) in GROUND_PLANE.into_iter().enumerate() {
                     lo[i] = lo[i].min(r[axis]);
                     hi[i] = hi[i].max(r[axis]);
                 }
             }
-            let centre = [(lo[0] + hi[0]) / 2.0, figure.ground, (lo[1] + hi[1]) / 2.0];
+            let mut centre = [0.0; 3];
+            for (i, axis) in GROUND_PLANE.into_iter().enumerate() {
+                centre[axis] = (lo[i] + hi[i]) / 2.0;
+            }
+            let centre = on_ground(centre, figure.ground);
             let extent = (hi[0] - lo[0]).hypot(hi[1] - lo[1]) + figure.height;
             Projection {
                 centre,

@@ -80,6 +80,10 @@ fn dry_run(args: &Args) -> Result<()> {
         data.facts.frames,
         data.facts.layout.fps
     );
+    println!("up axis         {}", data.facts.up);
+    if data.facts.in_place {
+        println!("cycle           in place: contacts measured against the treadmill");
+    }
     println!("features F      {features}");
     println!("channels C      {}", config.model.channels);
     println!("parameters      {}", model.num_params());
@@ -155,6 +159,10 @@ fn main() -> Result<()> {
         state.step,
         state.config.training.steps
     );
+    eprintln!("up axis {}", state.clip.up);
+    if state.clip.in_place {
+        eprintln!("in-place cycle: contacts measured against the treadmill");
+    }
     let bar = ProgressBar::new(state.config.training.steps);
     if !std::io::stderr().is_terminal() {
         bar.set_draw_target(ProgressDrawTarget::hidden());

@@ -1,0 +1,311 @@
+//! Any clip as it comes: re-oriented copies of every clip (Z-up, X-up, -Z-up, turned about up)
+//! are detected with the right up axis and encode to the features of the original; a Z-up copy
+//! round-trips in its own frame; in-place cycles keep their contacts; weak evidence is reported.
+
+mod common;
+
+use sinmdm::bvh::{parse_bvh, read_bvh, to_bvh_string};
+use sinmdm::motion::contacts::travelling_root;
+use sinmdm::motion::math::{self, Mat3};
+use sinmdm::motion::up::{UP, UpAxis, reorient};
+use sinmdm::motion::{
+    ChannelClip, ColumnKind, Confidence, EncodeOptions, EncodedClip, decode, detect_up, encode,
+    global_poses, skeleton_height,
+};
+
+/// The clip written as BVH text and read back, as another tool would hand it over.
+fn through_file(clip: &ChannelClip) -> ChannelClip {
+    parse_bvh(&to_bvh_string(clip), "copy.bvh").unwrap()
+}
+
+/// A copy of `clip` turned by `rotation` and written as a file.
+fn turned(clip: &ChannelClip, rotation: &Mat3) -> ChannelClip {
+    through_file(&reorient(&clip.to_local(), rotation).to_channels())
+}
+
+fn name(path: &std::path::Path) -> String {
+    path.file_name().unwrap().to_string_lossy().into_owned()
+}
+
+/// Largest difference between two feature arrays, column by column.
+fn max_diff(a: &EncodedClip, b: &EncodedClip) -> f32 {
+    assert_eq!(a.features.dim(), b.features.dim());
+    a.features
+        .iter()
+        .zip(&b.features)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f32::max)
+}
+
+#[test]
+fn every_clip_is_read_as_y_up_with_confidence() {
+    let clips = common::all_clips();
+    assert!(clips.len() >= 4, "the shipped clips are missing");
+    for path in clips {
+        let found = detect_up(&read_bvh(&path).unwrap().to_local());
+        assert_eq!(
+            found.axis,
+            UpAxis::PosY,
+            "{}: {}",
+            name(&path),
+            found.describe()
+        );
+        assert_eq!(
+            found.confidence,
+            Confidence::Sure,
+            "{}: {}",
+            name(&path),
+            found.describe()
+        );
+    }
+}
+
+#[test]
+fn re_oriented_copies_are_detected_and_encode_to_the_same_features() {
+    let clips = common::all_clips();
+    assert!(clips.len() >= 4, "the shipped clips are missing");
+    for path in clips {
+        let clip = read_bvh(&path).unwrap();
+        let original = encode(&clip, &EncodeOptions::default()).unwrap();
+        for up in [UpAxis::PosZ, UpAxis::PosX, UpAxis::NegZ] {
+            let copy = turned(&clip, &up.file_from_canonical());
+            let found = detect_up(&copy.to_local());
+            assert_eq!(
+                found.axis,
+                up,
+                "{} as {up}: {}",
+                name(&path),
+                found.describe()
+            );
+            assert_eq!(found.confidence, Confidence::Sure, "{}", found.describe());
+            let encoded = encode(&copy, &EncodeOptions::default()).unwrap();
+            assert_eq!(encoded.layout.up, up);
+            assert_eq!(
+                encoded.layout.contact_joints,
+                original.layout.contact_joints
+            );
+            assert_eq!(
+                encoded.layout.root,
+                original.layout.root.clone().map(|mut r| {
+                    // The start position is the same up to the text round trip.
+                    r.start_position = encoded.layout.root.as_ref().unwrap().start_position;
+                    r
+                })
+            );
+            let start_a = original.layout.root.as_ref().map(|r| r.start_position);
+            let start_b = encoded.layout.root.as_ref().map(|r| r.start_position);
+            if let (Some(a), Some(b)) = (start_a, start_b) {
+                let h = original.layout.skeleton_height;
+                assert!(math::norm(math::sub(a, b)) < 1e-6 * h, "{a:?} {b:?}");
+            }
+            let h = original.layout.skeleton_height;
+            assert!(
+                (encoded.layout.skeleton_height - h).abs() < 1e-6 * h,
+                "{}: height {} against {h}",
+                name(&path),
+                encoded.layout.skeleton_height
+            );
+            let diff = max_diff(&original, &encoded);
+            assert!(
+                diff < 1e-5,
+                "{} as {up}: features differ by {diff}",
+                name(&path)
+            );
+        }
+    }
+}
+
+#[test]
+fn a_turn_about_up_changes_only_the_root_heading() {
+    for path in common::all_clips() {
+        let clip = read_bvh(&path).unwrap();
+        let original = encode(&clip, &EncodeOptions::default()).unwrap();
+        for degrees in [90.0f64, 180.0] {
+            let turn = math::axis_rotation(UP, degrees.to_radians());
+            let copy = turned(&clip, &turn);
+            let found = detect_up(&copy.to_local());
+            assert_eq!(found.axis, UpAxis::PosY, "{}", found.describe());
+            let encoded = encode(&copy, &EncodeOptions::default()).unwrap();
+            assert_eq!(
+                encoded.layout.contact_joints,
+                original.layout.contact_joints
+            );
+            let layout = &original.layout;
+            let columns = layout.columns();
+            let root = layout.root.as_ref().map(|r| r.joint);
+            let top = 0;
+            for (i, column) in columns.iter().enumerate() {
+                let (a, b) = (original.features.row(i), encoded.features.row(i));
+                let matches = |x: &dyn Fn(usize) -> f64| {
+                    (0..a.len())
+                        .map(|f| (x(f) - f64::from(b[f])).abs())
+                        .fold(0.0, f64::max)
+                };
+                let worst = match column.kind {
+                    // Ground displacements turn with the clip: compare the turned vector.
+                    ColumnKind::RootDisplacement(axis) if root == Some(top) => {
+                        let dx = original.features.row(i - axis.index() / 2 * 2);
+                        let dz = original.features.row(i - axis.index() / 2 * 2 + 2);
+                        let k = axis.index();
+                        matches(&|f| {
+                            let v = math::mat_vec(&turn, [f64::from(dx[f]), 0.0, f64::from(dz[f])]);
+                            v[k]
+                        }) / layout.skeleton_height
+                    }
+                    // The top joint's heading turns: its 6D rotation is premultiplied.
+                    ColumnKind::Rotation6d(_) if column.joint == top => continue,
+                    _ => matches(&|f| f64::from(a[f])),
+                };
+                assert!(
+                    worst < 1e-5,
+                    "{} turned {degrees}: column {} differs by {worst}",
+                    name(&path),
+                    layout.column_name(column)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_z_up_copy_round_trips_in_its_own_frame() {
+    for path in common::all_clips() {
+        let clip = read_bvh(&path).unwrap();
+        let copy = turned(&clip, &UpAxis::PosZ.file_from_canonical());
+        let options = EncodeOptions {
+            fps: None,
+            ..EncodeOptions::default()
+        };
+        let encoded = encode(&copy, &options).unwrap();
+        let written = through_file(
+            &decode(&encoded.layout, encoded.features.view())
+                .unwrap()
+                .to_channels(),
+        );
+        assert_eq!(written.skeleton, copy.skeleton, "{}", name(&path));
+        let before = global_poses(&copy.to_local());
+        let after = global_poses(&written.to_local());
+        let worst = before
+            .iter()
+            .zip(&after)
+            .flat_map(|(a, b)| a.points().zip(b.points()))
+            .map(|(p, q)| math::norm(math::sub(p, q)))
+            .fold(0.0, f64::max);
+        let height = encoded.layout.skeleton_height;
+        assert!(
+            worst <= 1e-4 * height,
+            "{}: {worst} > 1e-4 x {height}",
+            name(&path)
+        );
+        // And it is Z-up: the figure's vertical extent is along Z.
+        let z_extent: f64 = after
+            .iter()
+            .map(|p| {
+                let zs: Vec<f64> = p.points().map(|q| q[2]).collect();
+                zs.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                    - zs.iter().copied().fold(f64::INFINITY, f64::min)
+            })
+            .sum::<f64>()
+            / after.len() as f64;
+        assert!(
+            (z_extent - height).abs() < 1e-6 * height,
+            "{z_extent} {height}"
+        );
+    }
+}
+
+/// The clip with the root's travel on the ground removed (in a Y-up file: its X and Z
+/// positions held at frame 0's), as a game's in-place cycle has it.
+fn in_place_copy(clip: &ChannelClip) -> ChannelClip {
+    let mut local = clip.to_local();
+    let joints = local.skeleton.len();
+    let root = travelling_root(&local.skeleton, &global_poses(&local));
+    let start = local.translations[root];
+    for f in 0..local.frame_count() {
+        let t = &mut local.translations[f * joints + root];
+        t[0] = start[0];
+        t[2] = start[2];
+    }
+    through_file(&local.to_channels())
+}
+
+#[test]
+fn in_place_cycles_keep_their_contacts() {
+    let walks_and_dogs: Vec<_> = common::all_clips()
+        .into_iter()
+        .filter(|p| {
+            let n = name(p);
+            n.contains("walk") || n.starts_with("dog_")
+        })
+        .collect();
+    assert!(!walks_and_dogs.is_empty());
+    for path in walks_and_dogs {
+        let clip = read_bvh(&path).unwrap();
+        let travelling = encode(&clip, &EncodeOptions::default()).unwrap();
+        assert!(!travelling.in_place, "{} is not in place", name(&path));
+        let options = EncodeOptions {
+            contacts: sinmdm::motion::ContactConfig {
+                joints: Some(
+                    travelling
+                        .layout
+                        .contact_joints
+                        .iter()
+                        .map(|&j| travelling.layout.skeleton.joints[j].name.clone())
+                        .collect(),
+                ),
+                ..Default::default()
+            },
+            ..EncodeOptions::default()
+        };
+        let cycle = encode(&in_place_copy(&clip), &options).unwrap();
+        assert!(
+            cycle.in_place,
+            "{}: not recognised as in place",
+            name(&path)
+        );
+        for (k, (a, b)) in travelling
+            .contact_share
+            .iter()
+            .zip(&cycle.contact_share)
+            .enumerate()
+        {
+            let joint = &travelling.layout.skeleton.joints[travelling.layout.contact_joints[k]];
+            assert!(
+                (a - b).abs() <= 0.10,
+                "{} {}: {:.0}% in contact travelling, {:.0}% in place",
+                name(&path),
+                joint.name,
+                a * 100.0,
+                b * 100.0
+            );
+        }
+    }
+}
+
+#[test]
+fn weak_evidence_is_reported_not_hidden() {
+    let clip =
+        read_bvh(common::workspace().join("tests/data/bvh/human_walk_cmu_131_01.bvh")).unwrap();
+    // A single frame.
+    let mut one = clip.clone();
+    let width = one.skeleton.channel_count();
+    one.values.truncate(width);
+    let found = detect_up(&one.to_local());
+    assert_eq!(found.confidence, Confidence::Unsure, "{}", found.describe());
+    assert!(found.describe().contains("UNSURE"));
+    // A figure lying at 45 degrees: no axis fits.
+    let tilt = math::axis_rotation(2, 45f64.to_radians());
+    let found = detect_up(&turned(&clip, &tilt).to_local());
+    assert_eq!(found.confidence, Confidence::Unsure, "{}", found.describe());
+    // An explicit axis wins and skips the detection.
+    let options = EncodeOptions {
+        up: Some(UpAxis::PosY),
+        ..EncodeOptions::default()
+    };
+    let encoded = encode(&one, &options).unwrap();
+    assert!(encoded.up_detection.is_none());
+    assert_eq!(encoded.layout.up, UpAxis::PosY);
+    // The skeleton height is measured along the given axis.
+    let poses = global_poses(&one.to_local());
+    assert!((encoded.layout.skeleton_height - skeleton_height(&poses)).abs() < 1e-9);
+}
