@@ -143,7 +143,7 @@ fn a_turn_about_up_changes_only_the_root_heading() {
                 };
                 let worst = match column.kind {
                     // Ground displacements turn with the clip: compare the turned vector.
-                    ColumnKind::RootDisplacement(axis) if root == Some(top) => {
+                    ColumnKind::RootDisplacement(axis) if root.is_some() => {
                         let dx = original.features.row(i - axis.index() / 2 * 2);
                         let dz = original.features.row(i - axis.index() / 2 * 2 + 2);
                         let k = axis.index();
@@ -152,8 +152,13 @@ fn a_turn_about_up_changes_only_the_root_heading() {
                             v[k]
                         }) / layout.skeleton_height
                     }
-                    // The top joint's heading turns: its 6D rotation is premultiplied.
-                    ColumnKind::Rotation6d(_) if column.joint == top => continue,
+                    // The top joint's heading turns (and the travelling joint's, taken in the
+                    // canonical frame when it hangs below a container): premultiplied.
+                    ColumnKind::Rotation6d(_)
+                        if column.joint == top || root == Some(column.joint) =>
+                    {
+                        continue;
+                    }
                     _ => matches(&|f| f64::from(a[f])),
                 };
                 assert!(
@@ -230,6 +235,14 @@ fn in_place_copy(clip: &ChannelClip) -> ChannelClip {
 }
 
 #[test]
+fn no_shipped_or_shared_clip_is_taken_for_an_in_place_cycle() {
+    for path in common::all_clips() {
+        let encoded = encode(&read_bvh(&path).unwrap(), &EncodeOptions::default()).unwrap();
+        assert!(!encoded.in_place, "{} is not in place", name(&path));
+    }
+}
+
+#[test]
 fn in_place_cycles_keep_their_contacts() {
     let walks_and_dogs: Vec<_> = common::all_clips()
         .into_iter()
@@ -242,7 +255,6 @@ fn in_place_cycles_keep_their_contacts() {
     for path in walks_and_dogs {
         let clip = read_bvh(&path).unwrap();
         let travelling = encode(&clip, &EncodeOptions::default()).unwrap();
-        assert!(!travelling.in_place, "{} is not in place", name(&path));
         let options = EncodeOptions {
             contacts: sinmdm::motion::ContactConfig {
                 joints: Some(
@@ -305,7 +317,117 @@ fn weak_evidence_is_reported_not_hidden() {
     let encoded = encode(&one, &options).unwrap();
     assert!(encoded.up_detection.is_none());
     assert_eq!(encoded.layout.up, UpAxis::PosY);
-    // The skeleton height is measured along the given axis.
-    let poses = global_poses(&one.to_local());
-    assert!((encoded.layout.skeleton_height - skeleton_height(&poses)).abs() < 1e-9);
+    // The skeleton height is measured along the given axis: a Z-up copy read as Z-up has the
+    // original's height, read as Y-up it has its depth.
+    let copy = turned(&clip, &UpAxis::PosZ.file_from_canonical());
+    let height = skeleton_height(&global_poses(&clip.to_local()));
+    let as_z = EncodeOptions {
+        up: Some(UpAxis::PosZ),
+        fps: None,
+        ..EncodeOptions::default()
+    };
+    let as_y = EncodeOptions {
+        up: Some(UpAxis::PosY),
+        ..as_z.clone()
+    };
+    let z = encode(&copy, &as_z).unwrap().layout.skeleton_height;
+    let y = encode(&copy, &as_y).unwrap().layout.skeleton_height;
+    assert!((z - height).abs() < 1e-6 * height, "{z} {height}");
+    assert!(
+        y < 0.8 * height,
+        "read as Y-up the copy is {y} high, the figure {height}"
+    );
+}
+
+/// The clip below a static container joint (as some rigs have it), with the body turned by
+/// `turn` inside the container's frame: a Z-up rig whose container is not rotated.
+fn in_container(clip: &ChannelClip, turn: &Mat3) -> ChannelClip {
+    use sinmdm::motion::{Axis, Channel, Joint, Skeleton};
+    let mut joints = vec![Joint {
+        name: "container".into(),
+        parent: None,
+        offset: [0.0; 3],
+        channels: vec![
+            Channel::Rotation(Axis::Z),
+            Channel::Rotation(Axis::X),
+            Channel::Rotation(Axis::Y),
+        ],
+        end_site: None,
+    }];
+    for joint in &clip.skeleton.joints {
+        let mut joint = joint.clone();
+        joint.parent = Some(joint.parent.map_or(0, |p| p + 1));
+        joints.push(joint);
+    }
+    let width = clip.skeleton.channel_count();
+    let values = (0..clip.frame_count())
+        .flat_map(|f| {
+            [0.0; 3]
+                .into_iter()
+                .chain(clip.values[f * width..(f + 1) * width].iter().copied())
+        })
+        .collect();
+    let wrapped = ChannelClip {
+        skeleton: Skeleton { joints },
+        fps: clip.fps,
+        values,
+    };
+    let mut local = wrapped.to_local();
+    let n = local.skeleton.len();
+    for f in 0..local.frame_count() {
+        let k = f * n + 1;
+        local.rotations[k] = math::mat_mul(turn, &local.rotations[k]);
+        local.translations[k] = math::mat_vec(turn, local.translations[k]);
+    }
+    through_file(&local.to_channels())
+}
+
+#[test]
+fn a_z_up_rig_below_a_static_container_reads_like_its_y_up_twin() {
+    let clip =
+        read_bvh(common::workspace().join("tests/data/bvh/human_walk_cmu_131_01.bvh")).unwrap();
+    let y_up = in_container(&clip, &math::IDENTITY);
+    let z_up = in_container(&clip, &UpAxis::PosZ.file_from_canonical());
+    let found = detect_up(&z_up.to_local());
+    assert_eq!(found.axis, UpAxis::PosZ, "{}", found.describe());
+    assert_eq!(found.confidence, Confidence::Sure, "{}", found.describe());
+    let a = encode(&y_up, &EncodeOptions::default()).unwrap();
+    let b = encode(&z_up, &EncodeOptions::default()).unwrap();
+    assert_eq!(a.layout.root.as_ref().unwrap().joint, 1);
+    assert_eq!(b.layout.root.as_ref().unwrap().joint, 1);
+    assert_eq!(a.layout.contact_joints, b.layout.contact_joints);
+    let h = a.layout.skeleton_height;
+    assert!((a.layout.skeleton_height - b.layout.skeleton_height).abs() < 1e-6 * h);
+    // Every column but the container's own (constant) rotation is the same.
+    for (i, column) in a.layout.columns().iter().enumerate() {
+        if column.joint == 0 {
+            continue;
+        }
+        let worst = a
+            .features
+            .row(i)
+            .iter()
+            .zip(b.features.row(i))
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f32::max);
+        assert!(
+            worst < 1e-5,
+            "{} differs by {worst}",
+            a.layout.column_name(column)
+        );
+    }
+    // And the Z-up rig round-trips in its own frame.
+    let options = EncodeOptions {
+        fps: None,
+        ..EncodeOptions::default()
+    };
+    let encoded = encode(&z_up, &options).unwrap();
+    let back = decode(&encoded.layout, encoded.features.view()).unwrap();
+    let worst = global_poses(&z_up.to_local())
+        .iter()
+        .zip(&global_poses(&back))
+        .flat_map(|(p, q)| p.points().zip(q.points()))
+        .map(|(p, q)| math::norm(math::sub(p, q)))
+        .fold(0.0, f64::max);
+    assert!(worst <= 1e-4 * h, "{worst}");
 }

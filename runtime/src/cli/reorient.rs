@@ -7,7 +7,7 @@ use clap::Args;
 
 use crate::bvh::{read_bvh, write_bvh};
 use crate::motion::math;
-use crate::motion::up::{UP, UpAxis, detect_up, reorient};
+use crate::motion::up::{UP, UpAxis, detect_up, reorient, reorient_problem};
 
 pub(super) const EXAMPLES: &str = "Examples:
   sinmdm reorient zup_clip.bvh --to y -o yup_clip.bvh         # for a Y-up engine
@@ -40,6 +40,9 @@ pub(super) fn run(args: &ReorientArgs) -> Result<()> {
         bail!("--turn must be a number of degrees, got {}", args.turn);
     }
     let clip = read_bvh(&args.clip)?;
+    if let Some(problem) = reorient_problem(&clip.skeleton) {
+        bail!("{}: {problem}", args.clip.display());
+    }
     let motion = clip.to_local();
     let from = match args.up {
         Some(up) => up,

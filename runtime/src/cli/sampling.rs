@@ -11,7 +11,7 @@ use crate::bvh::{read_bvh, to_bvh_string};
 use crate::features_file::write_features;
 use crate::files::write_atomically;
 use crate::model::{Model, ModelOptions};
-use crate::motion::up::{Confidence, UpAxis, detect_up, reorient};
+use crate::motion::up::{Confidence, UpAxis, detect_up, reorient, reorient_problem};
 use crate::motion::{encode_for, math};
 use crate::render::{Camera, Figure};
 use crate::tasks::{self, Generated, Request, Span, Task};
@@ -163,6 +163,12 @@ pub fn reference_features(model: &Model, clip: &Path, up: Option<UpAxis>) -> Res
         }
     });
     if clip_up != model_up {
+        if let Some(problem) = reorient_problem(&channels.skeleton) {
+            bail!(
+                "{}: up axis {clip_up}, the model's is {model_up}, and {problem}",
+                clip.display()
+            );
+        }
         eprintln!(
             "{}: up axis {clip_up}, the model's is {model_up}: turning the clip into the model's convention",
             clip.display()

@@ -216,11 +216,11 @@ pub fn belt_displacement(
             horizontal(math::scale(step, 1.0 / (b - a) as f64))
         })
         .collect();
-    let half = ((fps * window_seconds / 2.0).round() as usize).max(1);
+    let half = ((fps * window_seconds / 2.0).round() as usize).clamp(1, n);
     let mut window = Vec::with_capacity(2 * half + 1);
     (0..n)
         .map(|f| {
-            let (lo, hi) = (f.saturating_sub(half), (f + half + 1).min(n));
+            let (lo, hi) = (f.saturating_sub(half), f.saturating_add(half + 1).min(n));
             let mut out = [0.0; 3];
             for (c, value) in out.iter_mut().enumerate() {
                 window.clear();

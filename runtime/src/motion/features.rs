@@ -22,8 +22,8 @@ use thiserror::Error;
 
 use super::clip::{ChannelClip, LocalMotion};
 use super::contacts::{ContactConfig, choose_contact_joints, label_contacts};
-use super::fk::{global_poses, skeleton_height};
-use super::math::{self, IDENTITY, Vec3};
+use super::fk::{global_pose, global_poses, skeleton_height};
+use super::math::{self, IDENTITY, Mat3, Vec3};
 use super::resample::resample;
 use super::rotation::{mat_from_6d, mat_to_6d};
 use super::skeleton::{Axis, Channel, Skeleton};
@@ -100,6 +100,27 @@ pub struct RootFeatures {
     pub axes: Vec<Axis>,
     /// Its local translation at frame 0 (canonical frame), where decoding starts integrating.
     pub start_position: Vec3,
+    /// The rotation from the joint's parent frame to the canonical frame, when the joint hangs
+    /// below a static container whose frame is turned (a Z-up rig whose `root` container holds
+    /// the pelvis): its translation and rotation features are taken in the canonical frame, so
+    /// height is height whatever the container's axes. Identity (and not written) otherwise.
+    #[serde(default = "identity", skip_serializing_if = "is_identity")]
+    pub frame: Mat3,
+}
+
+fn identity() -> Mat3 {
+    IDENTITY
+}
+
+fn is_identity(m: &Mat3) -> bool {
+    *m == IDENTITY
+}
+
+impl RootFeatures {
+    /// Whether the features need the [`RootFeatures::frame`] turn.
+    fn turned(&self) -> bool {
+        !is_identity(&self.frame)
+    }
 }
 
 /// What one feature column holds.
@@ -373,23 +394,44 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
             translation
         })
         .collect();
-    let root_file_axes = skeleton.joints[root_joint].position_axes();
-    let root_axes: Vec<Axis> = if root_joint == 0 {
-        let mut canonical: Vec<usize> = root_file_axes
-            .iter()
-            .map(|a| up.canonical_index(a.index()))
-            .collect();
-        canonical.sort_unstable();
-        canonical.into_iter().map(Axis::from_index).collect()
-    } else {
-        let mut axes = root_file_axes;
-        axes.sort_by_key(|a| a.index());
-        axes
+    // A motion root below the top joint sits in its container's frame; take that frame (at
+    // frame 0: the container is static) to the canonical one.
+    // Entries within 1e-9 of 0 or +-1 are snapped, so a container turned by a quarter turn
+    // written as text (cos 90 = 6e-17) gives an exact axis permutation.
+    let frame = match skeleton.joints[root_joint].parent {
+        Some(parent) => global_pose(&local, 0).rotations[parent].map(|row| {
+            row.map(|v| {
+                if (v - v.round()).abs() < 1e-9 {
+                    v.round() + 0.0
+                } else {
+                    v
+                }
+            })
+        }),
+        None => IDENTITY,
     };
+    let to_canonical_axes = if root_joint == 0 {
+        canonical_from_file
+    } else {
+        frame
+    };
+    let mut root_axes: Vec<usize> = skeleton.joints[root_joint]
+        .position_axes()
+        .iter()
+        .map(|a| {
+            let column = [0, 1, 2].map(|i| to_canonical_axes[i][a.index()].abs());
+            (0..3)
+                .max_by(|&x, &y| column[x].total_cmp(&column[y]))
+                .unwrap_or(a.index())
+        })
+        .collect();
+    root_axes.sort_unstable();
+    root_axes.dedup();
     let root = (!root_axes.is_empty()).then(|| RootFeatures {
         joint: root_joint,
-        axes: root_axes,
-        start_position: local.translations[root_joint],
+        axes: root_axes.into_iter().map(Axis::from_index).collect(),
+        start_position: math::mat_vec(&frame, local.translations[root_joint]),
+        frame,
     });
     let rotation_joints: Vec<usize> = (0..joints)
         .filter(|&j| skeleton.joints[j].rotates())
@@ -472,7 +514,14 @@ fn fill_features(
     if let Some(root) = &layout.root {
         for &axis in &root.axes {
             let a = axis.index();
-            let at = |f: usize| local.translations[f * joints + root.joint][a];
+            let at = |f: usize| {
+                let t = local.translations[f * joints + root.joint];
+                if root.turned() {
+                    math::mat_vec(&root.frame, t)[a]
+                } else {
+                    t[a]
+                }
+            };
             for f in 0..frames {
                 features[[row, f]] = if a == UP {
                     at(f) as f32
@@ -486,9 +535,18 @@ fn fill_features(
             row += 1;
         }
     }
+    let root_turn = layout
+        .root
+        .as_ref()
+        .filter(|r| r.turned())
+        .map(|r| (r.joint, r.frame));
     for &joint in &layout.rotation_joints {
         for f in 0..frames {
-            let six = mat_to_6d(&local.rotations[f * joints + joint]);
+            let rotation = &local.rotations[f * joints + joint];
+            let six = match root_turn {
+                Some((j, frame)) if j == joint => mat_to_6d(&math::mat_mul(&frame, rotation)),
+                _ => mat_to_6d(rotation),
+            };
             for (c, value) in six.iter().enumerate() {
                 features[[row + c, f]] = *value as f32;
             }
@@ -558,10 +616,25 @@ pub fn decode(
         return Err(MotionError::NonFinite { row, frame });
     }
     let joints = layout.skeleton.len();
-    let mut rotations = vec![IDENTITY; frames * joints];
+    // A top joint without rotation channels keeps the file's orientation once turned back.
+    let mut rest_rotations = vec![IDENTITY; joints];
+    for (j, joint) in layout.skeleton.joints.iter().enumerate() {
+        if joint.parent.is_none() && !joint.rotates() {
+            rest_rotations[j] = layout.up.canonical_from_file();
+        }
+    }
+    let mut rotations: Vec<Mat3> = (0..frames)
+        .flat_map(|_| rest_rotations.iter().copied())
+        .collect();
     let mut translations: Vec<Vec3> = (0..frames)
         .flat_map(|_| layout.rest_translations.iter().copied())
         .collect();
+    if let Some(root) = layout.root.as_ref().filter(|r| r.turned()) {
+        for f in 0..frames {
+            let t = &mut translations[f * joints + root.joint];
+            *t = math::mat_vec(&root.frame, *t);
+        }
+    }
     let mut row = 0;
     if let Some(root) = &layout.root {
         for &axis in &root.axes {
@@ -594,6 +667,14 @@ pub fn decode(
             translations[f * joints + joint][axis.index()] = f64::from(features[[row, f]]);
         }
         row += 1;
+    }
+    if let Some(root) = layout.root.as_ref().filter(|r| r.turned()) {
+        let back = math::transpose(&root.frame);
+        for f in 0..frames {
+            let k = f * joints + root.joint;
+            translations[k] = math::mat_vec(&back, translations[k]);
+            rotations[k] = math::mat_mul(&back, &rotations[k]);
+        }
     }
     let canonical = LocalMotion {
         skeleton: layout.skeleton.clone(),

@@ -4,7 +4,8 @@
 use super::clip::LocalMotion;
 use super::math::quat_from_mat;
 
-/// One frame of a skeleton pose, in the clip's units and its right-handed, Y-up BVH frame.
+/// One frame of a skeleton pose, in the clip's units and its file's right-handed frame (its up axis is
+/// [`super::FeatureLayout::up`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pose {
     /// World position of the root joint.

@@ -231,6 +231,21 @@ pub fn reorient(motion: &LocalMotion, rotation: &Mat3) -> LocalMotion {
     out
 }
 
+/// Why [`reorient`] cannot write a clip faithfully: its top joint lacks the channels that would
+/// carry the turn (all three rotations, and all three positions if it has any), naming the joint.
+pub fn reorient_problem(skeleton: &Skeleton) -> Option<String> {
+    skeleton.joints.iter().filter(|j| j.parent.is_none()).find_map(|joint| {
+        let rotations = joint.rotation_order().len();
+        let positions = joint.position_axes().len();
+        (rotations != 3 || (positions != 0 && positions != 3)).then(|| {
+            format!(
+                "the top joint '{}' has {rotations} rotation and {positions} position channels; turning the clip needs 3 rotations (and 0 or 3 positions)",
+                joint.name
+            )
+        })
+    })
+}
+
 /// How sure [`detect_up`] is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Confidence {
@@ -355,6 +370,9 @@ pub fn detect_up(motion: &LocalMotion) -> UpDetection {
     // A static container above the hips (some rigs) is no part of the body.
     let top = travelling_root(skeleton, &poses);
     let weights = limb_weights(skeleton, top);
+    let in_body: Vec<bool> = (0..skeleton.len())
+        .map(|j| is_below(skeleton, j, top))
+        .collect();
     let total_weight: f64 = weights.iter().map(|(_, w)| w).sum();
     let mut hang = [0.0; 3];
     let mut size = 0.0;
@@ -385,7 +403,19 @@ pub fn detect_up(motion: &LocalMotion) -> UpDetection {
             }
         }
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for p in pose.points() {
+        let body = pose
+            .joints
+            .iter()
+            .enumerate()
+            .filter(|&(j, _)| in_body[j])
+            .map(|(_, p)| *p)
+            .chain(
+                pose.end_sites
+                    .iter()
+                    .filter(|(j, _)| in_body[*j])
+                    .map(|(_, p)| *p),
+            );
+        for p in body {
             for i in 0..3 {
                 lo[i] = lo[i].min(p[i]);
                 hi[i] = hi[i].max(p[i]);
