@@ -183,7 +183,8 @@ pub fn is_in_place(
 
 /// Length of the median filter over the lowest foot's drift, in seconds. Measured on in-place
 /// copies of the walks and dog clips (contact share within 10 points of the travelling clip's):
-/// one frame follows the swing foot when the lowest foot switches (up to +12 points), a second
+/// one frame follows the swing foot when the lowest foot switches (up to +19 points; five frames
+/// +12), a second
 /// smooths over the gait's own speed changes (up to -29 points), a third of a second keeps every
 /// foot within 8.2 points.
 pub const BELT_WINDOW_SECONDS: f64 = 1.0 / 3.0;
