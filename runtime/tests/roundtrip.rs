@@ -5,20 +5,10 @@ mod common;
 
 use sinmdm::bvh::{parse_bvh, read_bvh, to_bvh_string};
 use sinmdm::motion::{
-    ChannelClip, EncodeOptions, GlobalPose, decode, encode, global_poses, math, skeleton_height,
+    ChannelClip, EncodeOptions, GlobalPose, decode, encode, global_poses, skeleton_height,
 };
 
-fn max_position_error(a: &[GlobalPose], b: &[GlobalPose]) -> f64 {
-    assert_eq!(a.len(), b.len(), "frame counts differ");
-    a.iter()
-        .zip(b)
-        .flat_map(|(p, q)| {
-            assert_eq!(p.joints.len(), q.joints.len());
-            p.points().zip(q.points())
-        })
-        .map(|(p, q)| math::norm(math::sub(p, q)))
-        .fold(0.0, f64::max)
-}
+use common::max_position_error;
 
 #[test]
 fn round_trip_at_the_clips_own_rate_reproduces_global_positions() {

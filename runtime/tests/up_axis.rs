@@ -190,12 +190,7 @@ fn a_z_up_copy_round_trips_in_its_own_frame() {
         assert_eq!(written.skeleton, copy.skeleton, "{}", name(&path));
         let before = global_poses(&copy.to_local());
         let after = global_poses(&written.to_local());
-        let worst = before
-            .iter()
-            .zip(&after)
-            .flat_map(|(a, b)| a.points().zip(b.points()))
-            .map(|(p, q)| math::norm(math::sub(p, q)))
-            .fold(0.0, f64::max);
+        let worst = common::max_position_error(&before, &after);
         let height = encoded.layout.skeleton_height;
         assert!(
             worst <= 1e-4 * height,
@@ -423,11 +418,6 @@ fn a_z_up_rig_below_a_static_container_reads_like_its_y_up_twin() {
     };
     let encoded = encode(&z_up, &options).unwrap();
     let back = decode(&encoded.layout, encoded.features.view()).unwrap();
-    let worst = global_poses(&z_up.to_local())
-        .iter()
-        .zip(&global_poses(&back))
-        .flat_map(|(p, q)| p.points().zip(q.points()))
-        .map(|(p, q)| math::norm(math::sub(p, q)))
-        .fold(0.0, f64::max);
+    let worst = common::max_position_error(&global_poses(&z_up.to_local()), &global_poses(&back));
     assert!(worst <= 1e-4 * h, "{worst}");
 }

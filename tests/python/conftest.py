@@ -3,6 +3,8 @@
 import pathlib
 import subprocess
 
+import bvhio
+import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -29,3 +31,14 @@ def sinmdm():
         return done.stdout
 
     return run
+
+
+def bvhio_joint_positions(path):
+    """Global joint positions [frames, joints, 3] and joint names, as bvhio computes them."""
+    root = bvhio.readAsHierarchy(str(path))
+    layout = root.layout()
+    frames = []
+    for frame in range(len(root.Keyframes)):
+        root.loadPose(frame)
+        frames.append([list(joint.PositionWorld) for joint, _, _ in layout])
+    return np.asarray(frames, dtype=np.float64), [joint.Name for joint, _, _ in layout]

@@ -8,22 +8,10 @@ of the original clip. Both must agree within 1e-4 x skeleton height in every fra
 
 import json
 
-import bvhio
 import numpy as np
 import pytest
 
-from conftest import clips
-
-
-def bvhio_positions(path):
-    """Global joint positions [frames, joints, 3] and joint names, as bvhio computes them."""
-    root = bvhio.readAsHierarchy(str(path))
-    layout = root.layout()
-    frames = []
-    for frame in range(len(root.Keyframes)):
-        root.loadPose(frame)
-        frames.append([list(joint.PositionWorld) for joint, _, _ in layout])
-    return np.asarray(frames, dtype=np.float64), [joint.Name for joint, _, _ in layout]
+from conftest import bvhio_joint_positions as bvhio_positions, clips
 
 
 def skeleton_height(positions):

@@ -5,11 +5,10 @@ round trip in the copy's own Z-up frame, and training, info, every task and eval
 import json
 import subprocess
 
-import bvhio
 import numpy as np
 import pytest
 
-from conftest import ROOT, clips
+from conftest import ROOT, bvhio_joint_positions, clips
 
 TRAIN = ROOT / "target" / "release" / "sinmdm-train"
 WALK = ROOT / "tests" / "data" / "bvh" / "human_walk_cmu_131_01.bvh"
@@ -19,13 +18,7 @@ Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
 
 def bvhio_positions(path):
     """Global joint positions [frames, joints, 3], as bvhio computes them."""
-    root = bvhio.readAsHierarchy(str(path))
-    layout = root.layout()
-    frames = []
-    for frame in range(len(root.Keyframes)):
-        root.loadPose(frame)
-        frames.append([list(joint.PositionWorld) for joint, _, _ in layout])
-    return np.asarray(frames, dtype=np.float64)
+    return bvhio_joint_positions(path)[0]
 
 
 def extent(positions, axis):

@@ -4,6 +4,8 @@
 
 use std::path::PathBuf;
 
+use sinmdm::motion::{GlobalPose, math};
+
 /// The workspace root.
 pub fn workspace() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -42,4 +44,17 @@ fn bvh_files(dir: PathBuf) -> Vec<PathBuf> {
         .unwrap_or_default();
     files.sort();
     files
+}
+
+/// Largest distance between corresponding points (joints and End Sites) of two pose sequences.
+pub fn max_position_error(a: &[GlobalPose], b: &[GlobalPose]) -> f64 {
+    assert_eq!(a.len(), b.len(), "frame counts differ");
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| {
+            assert_eq!(p.joints.len(), q.joints.len());
+            p.points().zip(q.points())
+        })
+        .map(|(p, q)| math::norm(math::sub(p, q)))
+        .fold(0.0, f64::max)
 }
