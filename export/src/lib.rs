@@ -14,8 +14,8 @@ use std::path::Path;
 use onnx_protobuf::{Message, ModelProto, OperatorSetIdProto, StringStringEntryProto};
 use sinmdm::model_file::{METADATA_KEY, ModelMetadata, SCHEMA_KEY, SCHEMA_VERSION};
 
-pub use unet::NetworkShape;
-pub use weights::{WeightTensor, Weights};
+pub use sinmdm::network::NetworkShape;
+pub use sinmdm::network::{WeightTensor, Weights};
 
 /// ONNX IR version written (onnxruntime 1.31 reads up to 10).
 pub const IR_VERSION: i64 = 8;
@@ -63,9 +63,13 @@ pub fn to_onnx_bytes(
     shape: NetworkShape,
     metadata: &ModelMetadata,
 ) -> Result<Vec<u8>, ExportError> {
-    if metadata.network.features != shape.features
-        || metadata.normalizer.mean.len() != shape.features
-        || metadata.layout.width() != shape.features
+    if metadata.network.shape() != shape {
+        return Err(ExportError::Metadata(format!(
+            "the network is {shape:?}; the metadata says {:?}",
+            metadata.network.shape()
+        )));
+    }
+    if metadata.normalizer.mean.len() != shape.features || metadata.layout.width() != shape.features
     {
         return Err(ExportError::Metadata(format!(
             "the network has {} feature rows; the metadata describes {} (layout) and {} (normaliser)",

@@ -5,29 +5,12 @@ use onnx_protobuf::{GraphProto, tensor_proto::DataType};
 
 use crate::ExportError;
 use crate::graph::{Attr, GraphBuilder};
-use crate::weights::{Weights, get};
-
-/// GroupNorm groups.
-pub const NORM_GROUPS: usize = 32;
-/// GroupNorm epsilon.
-pub const NORM_EPSILON: f32 = 1e-5;
-/// Scores below the sequence maximum by more than this are raised to it (as in training).
-pub const SCORE_FLOOR: f32 = -60.0;
-/// Width of the sinusoidal timestep features.
-const SINUSOID_WIDTH: usize = 256;
-
-/// The network's sizes.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NetworkShape {
-    /// Feature rows F.
-    pub features: usize,
-    /// Channels C.
-    pub channels: usize,
-    /// QnA heads H.
-    pub heads: usize,
-    /// QnA window k.
-    pub window: usize,
-}
+use crate::weights::get;
+use sinmdm::network::{
+    BATCH_AXIS, CONV_KERNEL, EMBEDDING_MULTIPLIER, FRAMES_AXIS, INPUT_FEATURES, INPUT_STEP,
+    NORM_EPSILON, NORM_GROUPS, NetworkShape, OUTPUT_FEATURES, SCORE_FLOOR, SINUSOID_WIDTH, Weights,
+    timestep_frequencies,
+};
 
 struct Net<'a> {
     b: GraphBuilder,
@@ -139,8 +122,13 @@ impl Net<'_> {
         let c = self.shape.channels;
         let n = self.group_norm(x, &format!("{prefix}.in_norm"), cin)?;
         let a = self.silu(&n);
-        let h = self.conv(&a, &format!("{prefix}.in_conv"), cin, cout, 3)?;
-        let ss = self.linear(emb, &format!("{prefix}.embedding"), 4 * c, 2 * cout)?;
+        let h = self.conv(&a, &format!("{prefix}.in_conv"), cin, cout, CONV_KERNEL)?;
+        let ss = self.linear(
+            emb,
+            &format!("{prefix}.embedding"),
+            EMBEDDING_MULTIPLIER * c,
+            2 * cout,
+        )?;
         let ss = self.b.op("Unsqueeze", &[&ss, "axis_2"], vec![]);
         let scale = self.b.op(
             "Slice",
@@ -162,7 +150,7 @@ impl Net<'_> {
         let hs = self.b.op("Mul", &[&hn, &scale1], vec![]);
         let hs = self.b.op("Add", &[&hs, &shift], vec![]);
         let a = self.silu(&hs);
-        let h = self.conv(&a, &format!("{prefix}.out_conv"), cout, cout, 3)?;
+        let h = self.conv(&a, &format!("{prefix}.out_conv"), cout, cout, CONV_KERNEL)?;
         let skip = if cin != cout {
             self.conv(x, &format!("{prefix}.skip"), cin, cout, 1)?
         } else {
@@ -264,11 +252,9 @@ pub fn build(weights: &Weights, shape: NetworkShape) -> Result<GraphProto, Expor
         features: f,
         channels: c,
         heads: h,
-        window: k,
+        window: _,
     } = shape;
-    if c % NORM_GROUPS != 0 || c % h != 0 || k % 2 == 0 {
-        return Err(ExportError::BadShape(format!("{shape:?}")));
-    }
+    shape.check().map_err(ExportError::BadShape)?;
     let mut b = GraphBuilder::default();
     b.int64("groups_shape", &[0, NORM_GROUPS as i64, -1]);
     b.float("groups_ones", &[NORM_GROUPS], &[1.0; NORM_GROUPS]);
@@ -284,11 +270,8 @@ pub fn build(weights: &Weights, shape: NetworkShape) -> Result<GraphProto, Expor
         b.int64(&format!("{prefix}.split"), &[cout as i64]);
         b.int64(&format!("{prefix}.end"), &[2 * cout as i64]);
     }
-    let half = SINUSOID_WIDTH / 2;
-    let freqs: Vec<f32> = (0..half)
-        .map(|i| (-(10000f64.ln()) * i as f64 / half as f64).exp() as f32)
-        .collect();
-    b.float("time_frequencies", &[1, half], &freqs);
+    let freqs = timestep_frequencies();
+    b.float("time_frequencies", &[1, freqs.len()], &freqs);
     let mut net = Net {
         b,
         w: weights,
@@ -298,7 +281,7 @@ pub fn build(weights: &Weights, shape: NetworkShape) -> Result<GraphProto, Expor
 
     let tf = net.b.op(
         "Cast",
-        &["t"],
+        &[INPUT_STEP],
         vec![("to", Attr::Int(DataType::FLOAT as i64))],
     );
     let tu = net.b.op("Unsqueeze", &[&tf, "axis_1"], vec![]);
@@ -308,12 +291,22 @@ pub fn build(weights: &Weights, shape: NetworkShape) -> Result<GraphProto, Expor
     let sinusoid = net
         .b
         .op("Concat", &[&cos, &sin], vec![("axis", Attr::Int(1))]);
-    let e = net.linear(&sinusoid, "time.first", SINUSOID_WIDTH, 4 * c)?;
+    let e = net.linear(
+        &sinusoid,
+        "time.first",
+        SINUSOID_WIDTH,
+        EMBEDDING_MULTIPLIER * c,
+    )?;
     let e = net.silu(&e);
-    let e = net.linear(&e, "time.second", 4 * c, 4 * c)?;
+    let e = net.linear(
+        &e,
+        "time.second",
+        EMBEDDING_MULTIPLIER * c,
+        EMBEDDING_MULTIPLIER * c,
+    )?;
     let emb = net.silu(&e);
 
-    let h0 = net.conv("x_t", "input", f, c, 3)?;
+    let h0 = net.conv(INPUT_FEATURES, "input", f, c, CONV_KERNEL)?;
     let h1 = net.resblock(&h0, "block1", c, c, &emb)?;
     let h1 = net.qna(&h1, "attention1")?;
     let h2 = net.resblock(&h1, "block2", c, c, &emb)?;
@@ -325,23 +318,23 @@ pub fn build(weights: &Weights, shape: NetworkShape) -> Result<GraphProto, Expor
     let h3 = net.qna(&h3, "attention3")?;
     let n = net.group_norm(&h3, "out_norm", c)?;
     let a = net.silu(&n);
-    let out = net.conv(&a, "output", c, f, 3)?;
-    net.b.op_into("Identity", &[&out], vec![], "x0");
+    let out = net.conv(&a, "output", c, f, CONV_KERNEL)?;
+    net.b.op_into("Identity", &[&out], vec![], OUTPUT_FEATURES);
     let fi = f as i64;
     Ok(net.b.finish(
         "sinmdm_qna_unet",
         &[
             (
-                "x_t",
+                INPUT_FEATURES,
                 DataType::FLOAT,
-                vec![Err("batch"), Ok(fi), Err("frames")],
+                vec![Err(BATCH_AXIS), Ok(fi), Err(FRAMES_AXIS)],
             ),
-            ("t", DataType::INT64, vec![Err("batch")]),
+            (INPUT_STEP, DataType::INT64, vec![Err(BATCH_AXIS)]),
         ],
         &[(
-            "x0",
+            OUTPUT_FEATURES,
             DataType::FLOAT,
-            vec![Err("batch"), Ok(fi), Err("frames")],
+            vec![Err(BATCH_AXIS), Ok(fi), Err(FRAMES_AXIS)],
         )],
     ))
 }

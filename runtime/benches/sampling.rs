@@ -11,7 +11,8 @@ use ort::session::Session;
 use ort::value::Tensor;
 use sinmdm::diffusion::Schedule;
 use sinmdm::diffusion::sampler::{Denoiser, Guidance, sample};
-use sinmdm::model::{Model, ModelOptions};
+use sinmdm::network::{INPUT_FEATURES, INPUT_STEP, OUTPUT_FEATURES};
+use sinmdm::{Model, ModelOptions};
 
 /// Peak resident memory of this process in MiB (Linux `VmHWM`), if known.
 fn peak_memory_mib() -> Option<f64> {
@@ -31,7 +32,7 @@ struct BareSession {
 
 impl BareSession {
     fn open(path: &str, threads: usize, b: usize, f: usize, n: usize) -> BareSession {
-        let rt = sinmdm::onnxruntime::init().expect("onnxruntime");
+        let rt = sinmdm::init_onnxruntime().expect("onnxruntime");
         let session = Session::builder(&rt.environment)
             .and_then(|s| Ok(s.with_intra_threads(threads)?))
             .and_then(|s| Ok(s.with_intra_op_spinning(false)?))
@@ -50,9 +51,9 @@ impl BareSession {
         let ts = Tensor::from_array(([b], vec![500i64; b].into_boxed_slice())).unwrap();
         let out = self
             .session
-            .run(ort::inputs!["x_t" => xs, "t" => ts])
+            .run(ort::inputs![INPUT_FEATURES => xs, INPUT_STEP => ts])
             .unwrap();
-        let (_, v) = out["x0"].try_extract_tensor::<f32>().unwrap();
+        let (_, v) = out[OUTPUT_FEATURES].try_extract_tensor::<f32>().unwrap();
         std::hint::black_box(v[0]);
     }
 }
@@ -64,7 +65,7 @@ struct Timed<'a> {
 }
 
 impl Denoiser for Timed<'_> {
-    type Error = sinmdm::model::ModelError;
+    type Error = sinmdm::ModelError;
     fn features(&self) -> usize {
         self.model.features()
     }

@@ -1,34 +1,63 @@
 //! # sinmdm
 //!
-//! The runtime of sinmdm-rs: single-motion diffusion for any skeleton. This crate holds the motion
-//! representation (skeletons, rotations, forward kinematics, the feature vector a model learns),
-//! BVH input and output (feature `bvh`), the onnxruntime loader, and the `sinmdm` command line
-//! (feature `cli`). With default features off it depends only on `ort` and `ndarray` (plus
-//! `serde` for the model metadata), for embedding in a game engine.
+//! The engine runtime of sinmdm-rs: a model trained on one motion clip (a `.onnx` file written
+//! by `sinmdm-export`) generates new motion of any length, crowds, in-betweens, expansions,
+//! body-part composition and style transfer, through onnxruntime. Its dependencies are `ort`,
+//! `ndarray`, `serde` and `thiserror`; BVH reading and writing is the default feature `bvh`.
 //!
-//! ```no_run
-//! # #[cfg(feature = "bvh")] {
-//! use sinmdm::motion::{EncodeOptions, encode, decode, poses};
-//! let clip = sinmdm::bvh::read_bvh("tests/data/bvh/human_walk_cmu_131_01.bvh")?;
-//! let encoded = encode(&clip, &EncodeOptions::default())?; // 30 fps features [F, N]
-//! let motion = decode(&encoded.layout, encoded.features.view())?;
-//! let frames = poses(&motion); // per frame: root position + local quaternions
-//! # }
-//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! The engine path is the items on this page: open a [`Model`], look at its [`Skeleton`], make
+//! a [`Request`] of a [`Task`], [`run`] it (or [`plan`] it and step a [`Sampler`] yourself),
+//! and read [`Pose`]s from the [`Generated`] batch.
+//!
 //! ```
+//! use std::ops::ControlFlow;
+//! use sinmdm::{Model, ModelOptions, Request, Task};
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../onnx-models/human_walk_cmu.onnx");
+//! let mut model = Model::open(path, &ModelOptions::default())?;
+//! println!("{} joints at {} fps", model.skeleton().len(), model.fps());
+//! let request = Request {
+//!     task: Task::Generate { frames: 60 },
+//!     count: 2,
+//!     seed: 7,
+//!     steps: Some(10),
+//! };
+//! let generated = sinmdm::run(&mut model, &request, &mut |_done, _steps| ControlFlow::Continue(()))?;
+//! let poses = generated.poses(0)?; // per frame: root position, local rotations [x, y, z, w]
+//! assert_eq!(poses.len(), 60);
+//! assert_eq!(poses[0].rotations.len(), model.skeleton().len());
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! The modules hold the rest: [`motion`] (skeletons, rotations, the feature vector),
+//! [`bvh`] (files), [`diffusion`] (schedule, portable noise, sampler), [`tasks`] (task
+//! limits, spans, masks), [`model_file`] (the metadata schema) and [`network`] (the contract
+//! between training, export and this runtime).
+
+#![warn(missing_docs)]
 
 #[cfg(feature = "bvh")]
 pub mod bvh;
-#[cfg(feature = "cli")]
-pub mod cli;
 pub mod diffusion;
-pub mod eval;
+#[doc(hidden)]
 pub mod features_file;
+#[doc(hidden)]
 pub mod files;
-pub mod model;
+mod model;
 pub mod model_file;
 pub mod motion;
-pub mod onnxruntime;
-#[cfg(feature = "render")]
-pub mod render;
+pub mod network;
+mod onnxruntime;
 pub mod tasks;
+
+pub use diffusion::{Denoiser, Sampler, SamplerError};
+pub use model::{Model, ModelError, ModelOptions};
+pub use model_file::ModelMetadata;
+pub use motion::{Joint, Pose, Skeleton, UpAxis};
+pub use onnxruntime::{
+    ONNXRUNTIME_VERSION, OnnxRuntime, RuntimeLibraryError, init as init_onnxruntime,
+    load_onnxruntime,
+};
+pub use tasks::{Generated, Plan, Request, Span, Task, TaskError, plan, run};

@@ -9,15 +9,9 @@ use ort::session::builder::GraphOptimizationLevel;
 use ort::value::Tensor;
 use thiserror::Error;
 
-use crate::model_file::{METADATA_KEY, ModelMetadata, SCHEMA_KEY, SCHEMA_VERSION};
+use crate::model_file::{ModelMetadata, SCHEMA_KEY, SCHEMA_VERSION, parse_metadata};
+use crate::network::{INPUT_FEATURES, INPUT_STEP, OUTPUT_FEATURES};
 use crate::onnxruntime::{self, RuntimeLibraryError};
-
-/// Name of the graph input holding the noisy features.
-pub const INPUT_FEATURES: &str = "x_t";
-/// Name of the graph input holding the diffusion step of each batch row.
-pub const INPUT_STEP: &str = "t";
-/// Name of the graph output holding the predicted clean features.
-pub const OUTPUT_FEATURES: &str = "x0";
 
 /// Why a model could not be opened or run.
 #[derive(Debug, Error)]
@@ -86,6 +80,14 @@ pub enum ModelError {
         /// Rows given.
         got: usize,
     },
+    /// A denoiser call whose timesteps do not match its batch.
+    #[error("a denoiser call needs one diffusion step per batch row: {rows} rows, {steps} steps")]
+    StepCount {
+        /// Batch rows of `x_t`.
+        rows: usize,
+        /// Timesteps given.
+        steps: usize,
+    },
     /// onnxruntime failed while running the graph.
     #[error("onnxruntime failed running '{path}': {message}")]
     Run {
@@ -117,70 +119,6 @@ impl std::fmt::Debug for Model {
             .field("network", &self.metadata.network)
             .finish_non_exhaustive()
     }
-}
-
-/// Reads and checks the metadata entries of a model, given a lookup of `metadata_props`.
-pub fn parse_metadata(
-    path: &Path,
-    lookup: impl Fn(&str) -> Option<String>,
-) -> Result<ModelMetadata, ModelError> {
-    let schema = lookup(SCHEMA_KEY).ok_or_else(|| ModelError::NoMetadata {
-        path: path.to_path_buf(),
-    })?;
-    if schema.trim() != SCHEMA_VERSION.to_string() {
-        return Err(ModelError::SchemaVersion {
-            path: path.to_path_buf(),
-            found: schema,
-        });
-    }
-    let bad = |message: String| ModelError::BadMetadata {
-        path: path.to_path_buf(),
-        message,
-    };
-    let json = lookup(METADATA_KEY).ok_or_else(|| bad(format!("no '{METADATA_KEY}' entry")))?;
-    let metadata: ModelMetadata =
-        serde_json::from_str(&json).map_err(|e| bad(format!("'{METADATA_KEY}': {e}")))?;
-    check_consistent(&metadata).map_err(bad)?;
-    Ok(metadata)
-}
-
-/// Cross-checks of the metadata's parts against each other.
-fn check_consistent(m: &ModelMetadata) -> Result<(), String> {
-    let width = m.layout.width();
-    if m.network.features != width {
-        return Err(format!(
-            "network.features is {} but the feature layout has {width} columns",
-            m.network.features
-        ));
-    }
-    if m.normalizer.mean.len() != width || m.normalizer.std.len() != width {
-        return Err(format!(
-            "the normalizer has {} means and {} stds for {width} features",
-            m.normalizer.mean.len(),
-            m.normalizer.std.len()
-        ));
-    }
-    if let Some(i) = m
-        .normalizer
-        .std
-        .iter()
-        .position(|s| !(s.is_finite() && *s > 0.0))
-    {
-        return Err(format!("normalizer.std[{i}] is not a positive number"));
-    }
-    if m.diffusion.schedule != "cosine" || m.diffusion.prediction != "x0" {
-        return Err(format!(
-            "diffusion.schedule '{}' / prediction '{}': this runtime runs 'cosine' / 'x0'",
-            m.diffusion.schedule, m.diffusion.prediction
-        ));
-    }
-    if m.diffusion.steps < 2 {
-        return Err(format!("diffusion.steps is {}", m.diffusion.steps));
-    }
-    if !(m.layout.fps.is_finite() && m.layout.fps > 0.0) {
-        return Err(format!("layout.fps is {}", m.layout.fps));
-    }
-    Ok(())
 }
 
 /// A session over `bytes` with `threads` intra-op threads and no spinning when idle.
@@ -270,6 +208,21 @@ impl Model {
         &self.path
     }
 
+    /// The skeleton the model makes motion for (joint names, parents, offsets, channels).
+    pub fn skeleton(&self) -> &crate::motion::Skeleton {
+        &self.metadata.layout.skeleton
+    }
+
+    /// Frames per second of the motion the model makes.
+    pub fn fps(&self) -> f64 {
+        self.metadata.layout.fps
+    }
+
+    /// Frames of the clip the model was trained on (generation defaults to twice this).
+    pub fn clip_frames(&self) -> usize {
+        self.metadata.training.clip_frames
+    }
+
     /// Feature rows F.
     pub fn features(&self) -> usize {
         self.metadata.network.features
@@ -289,7 +242,12 @@ impl Model {
                 got: f,
             });
         }
-        assert_eq!(t.len(), b, "one diffusion step per batch row");
+        if t.len() != b {
+            return Err(ModelError::StepCount {
+                rows: b,
+                steps: t.len(),
+            });
+        }
         let path = self.path.clone();
         let run_failed = |e: ort::Error| ModelError::Run {
             path: path.clone(),
@@ -314,11 +272,14 @@ impl Model {
                 message: format!("output shape {shape:?}, expected [{b}, {f}, {n}]"),
             });
         }
-        Ok(Array3::from_shape_vec((b, f, n), values.to_vec()).expect("shape checked above"))
+        Array3::from_shape_vec((b, f, n), values.to_vec()).map_err(|e| ModelError::Run {
+            path: self.path.clone(),
+            message: format!("output of {} values: {e}", values.len()),
+        })
     }
 }
 
-impl crate::diffusion::sampler::Denoiser for Model {
+impl crate::diffusion::Denoiser for Model {
     type Error = ModelError;
 
     fn features(&self) -> usize {

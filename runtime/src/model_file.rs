@@ -3,7 +3,11 @@
 
 use serde::{Deserialize, Serialize};
 
+use std::path::Path;
+
+use crate::model::ModelError;
 use crate::motion::{FeatureLayout, Normalizer};
+use crate::network::NetworkShape;
 
 /// Key of the schema version.
 pub const SCHEMA_KEY: &str = "sinmdm.schema";
@@ -11,6 +15,11 @@ pub const SCHEMA_KEY: &str = "sinmdm.schema";
 pub const SCHEMA_VERSION: u32 = 1;
 /// Key of the JSON-encoded [`ModelMetadata`].
 pub const METADATA_KEY: &str = "sinmdm.metadata";
+
+/// The noise schedule this runtime runs ([`DiffusionFacts::schedule`]).
+pub const SCHEDULE: &str = "cosine";
+/// What the network predicts ([`DiffusionFacts::prediction`]).
+pub const PREDICTION: &str = "x0";
 
 /// Everything the runtime needs besides the graph.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -83,4 +92,84 @@ pub struct TrainingFacts {
     pub started: String,
     /// When the file was written (UTC, RFC 3339).
     pub exported: String,
+}
+
+impl NetworkFacts {
+    /// The sizes the graph was built with.
+    pub fn shape(&self) -> NetworkShape {
+        NetworkShape {
+            features: self.features,
+            channels: self.channels,
+            heads: self.heads,
+            window: self.window,
+        }
+    }
+}
+
+/// Reads and checks the metadata entries of a model, given a lookup of `metadata_props`.
+pub fn parse_metadata(
+    path: &Path,
+    lookup: impl Fn(&str) -> Option<String>,
+) -> Result<ModelMetadata, ModelError> {
+    let schema = lookup(SCHEMA_KEY).ok_or_else(|| ModelError::NoMetadata {
+        path: path.to_path_buf(),
+    })?;
+    if schema.trim() != SCHEMA_VERSION.to_string() {
+        return Err(ModelError::SchemaVersion {
+            path: path.to_path_buf(),
+            found: schema,
+        });
+    }
+    let bad = |message: String| ModelError::BadMetadata {
+        path: path.to_path_buf(),
+        message,
+    };
+    let json = lookup(METADATA_KEY).ok_or_else(|| bad(format!("no '{METADATA_KEY}' entry")))?;
+    let metadata: ModelMetadata =
+        serde_json::from_str(&json).map_err(|e| bad(format!("'{METADATA_KEY}': {e}")))?;
+    check_consistent(&metadata).map_err(bad)?;
+    Ok(metadata)
+}
+
+/// Cross-checks of the metadata's parts against each other.
+fn check_consistent(m: &ModelMetadata) -> Result<(), String> {
+    let width = m.layout.width();
+    if m.network.features != width {
+        return Err(format!(
+            "network.features is {} but the feature layout has {width} columns",
+            m.network.features
+        ));
+    }
+    if m.normalizer.mean.len() != width || m.normalizer.std.len() != width {
+        return Err(format!(
+            "the normalizer has {} means and {} stds for {width} features",
+            m.normalizer.mean.len(),
+            m.normalizer.std.len()
+        ));
+    }
+    if let Some(i) = m
+        .normalizer
+        .std
+        .iter()
+        .position(|s| !(s.is_finite() && *s > 0.0))
+    {
+        return Err(format!("normalizer.std[{i}] is not a positive number"));
+    }
+    m.network
+        .shape()
+        .check()
+        .map_err(|e| format!("network: {e}"))?;
+    if m.diffusion.schedule != SCHEDULE || m.diffusion.prediction != PREDICTION {
+        return Err(format!(
+            "diffusion.schedule '{}' / prediction '{}': this runtime runs '{SCHEDULE}' / '{PREDICTION}'",
+            m.diffusion.schedule, m.diffusion.prediction
+        ));
+    }
+    if m.diffusion.steps < 2 {
+        return Err(format!("diffusion.steps is {}", m.diffusion.steps));
+    }
+    if !(m.layout.fps.is_finite() && m.layout.fps > 0.0) {
+        return Err(format!("layout.fps is {}", m.layout.fps));
+    }
+    Ok(())
 }

@@ -1,12 +1,14 @@
 //! Finding and loading the onnxruntime shared library (`ort` with `load-dynamic`).
 //!
-//! Search order: the `ORT_DYLIB_PATH` environment variable (the `ort` crate's own), then the
-//! project's Python virtual environment made by `scripts/setup.sh` (`.venv/.../onnxruntime/capi/`),
-//! looked for above the current directory, above the running executable and in the source tree
-//! this crate was built from.
+//! A host that ships the library names it with [`load_onnxruntime`]. Otherwise the first model
+//! opened looks for it: the `ORT_DYLIB_PATH` environment variable (the `ort` crate's own), then
+//! the project's Python virtual environment made by `scripts/setup.sh`
+//! (`.venv/.../onnxruntime/capi/`), looked for above the current directory and above the running
+//! executable. Nothing of the machine the crate was built on is searched. A failed attempt is not
+//! remembered: the next one searches (or loads) again.
 
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 use thiserror::Error;
 
@@ -28,6 +30,14 @@ pub enum RuntimeLibraryError {
     /// `ORT_DYLIB_PATH` names a file that does not exist.
     #[error("ORT_DYLIB_PATH is set to '{0}', which does not exist")]
     EnvPathMissing(PathBuf),
+    /// The host named a library after another one was loaded (one per process).
+    #[error("onnxruntime is already loaded from '{loaded}'; cannot load '{asked}' as well")]
+    AlreadyLoaded {
+        /// The library in use.
+        loaded: PathBuf,
+        /// The library asked for.
+        asked: PathBuf,
+    },
     /// The file exists but onnxruntime would not load from it.
     #[error("could not load onnxruntime from '{path}': {message}")]
     LoadFailed {
@@ -85,12 +95,6 @@ fn candidate_roots() -> Vec<PathBuf> {
     if let Ok(exe) = std::env::current_exe() {
         roots.extend(exe.ancestors().skip(1).map(Path::to_path_buf));
     }
-    // The checkout this crate was built in (its parent is the workspace root).
-    roots.extend(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .ancestors()
-            .map(Path::to_path_buf),
-    );
     let mut seen = std::collections::HashSet::new();
     roots.retain(|r| seen.insert(r.clone()));
     roots
@@ -134,24 +138,70 @@ pub struct OnnxRuntime {
     pub environment: ort::environment::Environment,
 }
 
-/// Loads onnxruntime once per process; later calls return the first outcome.
+static LOADED: OnceLock<OnnxRuntime> = OnceLock::new();
+static LOADING: Mutex<()> = Mutex::new(());
+
+/// The onnxruntime in use: the one already loaded, or the library found by the search above,
+/// loaded now. Only a success is kept; after an error the next call tries again.
 pub fn init() -> Result<&'static OnnxRuntime, RuntimeLibraryError> {
-    static LOADED: OnceLock<Result<OnnxRuntime, RuntimeLibraryError>> = OnceLock::new();
-    let loaded = LOADED.get_or_init(|| {
-        let path = locate_library()?;
-        let failed = |message: String| RuntimeLibraryError::LoadFailed {
-            path: path.clone(),
-            message,
-        };
-        let environment = ort::init_from(&path)
-            .map_err(|e| failed(e.to_string()))?
-            .with_name("sinmdm")
-            .with_telemetry(false)
-            .build()
-            .map_err(|e| failed(e.to_string()))?;
-        Ok(OnnxRuntime { path, environment })
-    });
-    loaded.as_ref().map_err(Clone::clone)
+    load(None)
+}
+
+/// Loads onnxruntime from the library file `path` (a host that ships its own copy). Returns the
+/// runtime already loaded if it came from the same file, and an error if from another.
+pub fn load_onnxruntime(
+    path: impl AsRef<Path>,
+) -> Result<&'static OnnxRuntime, RuntimeLibraryError> {
+    load(Some(path.as_ref()))
+}
+
+fn load(asked: Option<&Path>) -> Result<&'static OnnxRuntime, RuntimeLibraryError> {
+    let check = |runtime: &'static OnnxRuntime| match asked {
+        Some(asked) if !same_file(asked, &runtime.path) => {
+            Err(RuntimeLibraryError::AlreadyLoaded {
+                loaded: runtime.path.clone(),
+                asked: asked.to_path_buf(),
+            })
+        }
+        _ => Ok(runtime),
+    };
+    if let Some(runtime) = LOADED.get() {
+        return check(runtime);
+    }
+    let _one_at_a_time = LOADING
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    if let Some(runtime) = LOADED.get() {
+        return check(runtime);
+    }
+    let path = match asked {
+        Some(p) if p.is_file() => p.to_path_buf(),
+        Some(p) => {
+            return Err(RuntimeLibraryError::LoadFailed {
+                path: p.to_path_buf(),
+                message: "no such file".into(),
+            });
+        }
+        None => locate_library()?,
+    };
+    let failed = |message: String| RuntimeLibraryError::LoadFailed {
+        path: path.clone(),
+        message,
+    };
+    let environment = ort::init_from(&path)
+        .map_err(|e| failed(e.to_string()))?
+        .with_name("sinmdm")
+        .with_telemetry(false)
+        .build()
+        .map_err(|e| failed(e.to_string()))?;
+    Ok(LOADED.get_or_init(|| OnnxRuntime { path, environment }))
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    }
 }
 
 #[cfg(test)]

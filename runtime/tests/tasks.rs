@@ -6,9 +6,9 @@ use std::path::PathBuf;
 use ndarray::{Array2, Array3, Axis, s};
 use sinmdm::bvh::read_bvh;
 use sinmdm::diffusion::sampler::low_pass;
-use sinmdm::model::{Model, ModelError, ModelOptions};
 use sinmdm::motion::encode_for;
 use sinmdm::tasks::{self, Generated, Request, Span, Task, TaskError};
+use sinmdm::{Model, ModelError, ModelOptions};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -38,7 +38,10 @@ fn run(model: &mut Model, task: Task, count: usize, steps: usize) -> Generated {
         seed: 3,
         steps: Some(steps),
     };
-    tasks::run(model, &request, &mut |_, _| {}).unwrap()
+    tasks::run(model, &request, &mut |_, _| {
+        std::ops::ControlFlow::Continue(())
+    })
+    .unwrap()
 }
 
 #[test]
@@ -168,7 +171,10 @@ fn same_seed_same_motion_and_another_seed_another() {
         seed: 4,
         steps: Some(10),
     };
-    let c = tasks::run(&mut m, &request, &mut |_, _| {}).unwrap();
+    let c = tasks::run(&mut m, &request, &mut |_, _| {
+        std::ops::ControlFlow::Continue(())
+    })
+    .unwrap();
     assert_ne!(a.normalized, c.normalized);
 }
 
@@ -336,9 +342,10 @@ fn metadata_problems_are_named() {
             _ => None,
         }
     };
-    let e = sinmdm::model::parse_metadata(path, lookup(None, Some(good.clone()))).unwrap_err();
+    let e = sinmdm::model_file::parse_metadata(path, lookup(None, Some(good.clone()))).unwrap_err();
     assert!(e.to_string().contains("has no sinmdm metadata"), "{e}");
-    let e = sinmdm::model::parse_metadata(path, lookup(Some("2"), Some(good.clone()))).unwrap_err();
+    let e = sinmdm::model_file::parse_metadata(path, lookup(Some("2"), Some(good.clone())))
+        .unwrap_err();
     assert!(
         e.to_string()
             .contains("schema '2'; this runtime reads schema 1"),
@@ -346,8 +353,8 @@ fn metadata_problems_are_named() {
     );
     let mut value: serde_json::Value = serde_json::from_str(&good).unwrap();
     value.as_object_mut().unwrap().remove("normalizer");
-    let e = sinmdm::model::parse_metadata(path, lookup(Some("1"), Some(value.to_string())))
+    let e = sinmdm::model_file::parse_metadata(path, lookup(Some("1"), Some(value.to_string())))
         .unwrap_err();
     assert!(e.to_string().contains("missing field `normalizer`"), "{e}");
-    assert!(sinmdm::model::parse_metadata(path, lookup(Some("1"), Some(good))).is_ok());
+    assert!(sinmdm::model_file::parse_metadata(path, lookup(Some("1"), Some(good))).is_ok());
 }

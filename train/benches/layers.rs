@@ -43,7 +43,12 @@ fn main() {
     let embedding = Tensor::<2>::random([batch, 4 * c], Distribution::Normal(0.0, 1.0), &device);
     let conv3 = FrameConv::new(c, c, 3, &device);
     let conv1 = FrameConv::new(c, c, 1, &device);
-    let norm = ChannelNorm::new(32, c, 1e-5, &device);
+    let norm = ChannelNorm::new(
+        sinmdm::network::NORM_GROUPS,
+        c,
+        f64::from(sinmdm::network::NORM_EPSILON),
+        &device,
+    );
     let dropout = HashDropout::new(0.5, 1);
     let qna = QnaBlock::new(c, 4, 3, &device);
     let block = ResBlock::new(c, c, 4 * c, 0.5, 1, &device);

@@ -4,8 +4,10 @@ use std::path::Path;
 
 use burn::module::Module;
 use burn::tensor::Device;
-use sinmdm::model_file::{DiffusionFacts, ModelMetadata, NetworkFacts, TrainingFacts};
-use sinmdm_export::{NetworkShape, WeightTensor, Weights};
+use sinmdm::model_file::{
+    DiffusionFacts, ModelMetadata, NetworkFacts, PREDICTION, SCHEDULE, TrainingFacts,
+};
+use sinmdm_export::{NetworkShape, Weights};
 
 use crate::checkpoint::{self, CheckpointState};
 use crate::error::TrainError;
@@ -15,17 +17,6 @@ use crate::model::weights::named_tensors;
 /// The network's weights by name, as the exporter reads them.
 pub fn weights_of(model: &QnaUnet) -> Weights {
     named_tensors(model)
-        .into_iter()
-        .map(|(name, t)| {
-            (
-                name,
-                WeightTensor {
-                    shape: t.shape,
-                    values: t.values,
-                },
-            )
-        })
-        .collect()
 }
 
 /// The network's sizes for a checkpoint state.
@@ -52,8 +43,8 @@ pub fn metadata_of(state: &CheckpointState) -> ModelMetadata {
         },
         diffusion: DiffusionFacts {
             steps: config.diffusion.steps,
-            schedule: "cosine".into(),
-            prediction: "x0".into(),
+            schedule: SCHEDULE.into(),
+            prediction: PREDICTION.into(),
         },
         layout: state.clip.layout.clone(),
         normalizer: state.clip.normalizer.clone(),

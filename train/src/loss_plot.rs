@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use sinmdm::render::{Series, log_chart};
+use sinmdm_render::{Series, log_chart};
 
 use crate::error::{TrainError, io};
 

@@ -1,5 +1,6 @@
 //! The exported ONNX graph computes what the burn network computes, in real onnxruntime.
 
+use sinmdm::network::{INPUT_FEATURES, INPUT_STEP, OUTPUT_FEATURES};
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::sync::atomic::AtomicBool;
@@ -47,8 +48,12 @@ fn ort_forward(
 ) -> Vec<f32> {
     let xs = OrtTensor::from_array(([b, f, n], x.to_vec().into_boxed_slice())).unwrap();
     let ts = OrtTensor::from_array(([b], t.to_vec().into_boxed_slice())).unwrap();
-    let outputs = session.run(ort::inputs!["x_t" => xs, "t" => ts]).unwrap();
-    let (shape, data) = outputs["x0"].try_extract_tensor::<f32>().unwrap();
+    let outputs = session
+        .run(ort::inputs![INPUT_FEATURES => xs, INPUT_STEP => ts])
+        .unwrap();
+    let (shape, data) = outputs[OUTPUT_FEATURES]
+        .try_extract_tensor::<f32>()
+        .unwrap();
     assert_eq!(shape.to_vec(), vec![b as i64, f as i64, n as i64]);
     data.to_vec()
 }
@@ -75,7 +80,7 @@ fn onnxruntime_matches_burn_for_any_batch_and_length() {
     let (model, state, run) = perturbed_run();
     let file = run.join("model.onnx");
     export_model(&model, &state, &file).unwrap();
-    let rt = sinmdm::onnxruntime::init().expect("run scripts/setup.sh first");
+    let rt = sinmdm::init_onnxruntime().expect("run scripts/setup.sh first");
     let mut session = Session::builder(&rt.environment)
         .unwrap()
         .commit_from_file(&file)

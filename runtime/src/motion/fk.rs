@@ -95,6 +95,21 @@ pub fn skeleton_height(poses: &[GlobalPose]) -> f64 {
     total / poses.len() as f64
 }
 
+/// The largest distance between the same joint of two motions of one skeleton, over every
+/// frame (how far a round trip moved anything); `None` when their frame or joint counts differ.
+pub fn max_position_error(a: &LocalMotion, b: &LocalMotion) -> Option<f64> {
+    if a.frame_count() != b.frame_count() || a.skeleton.len() != b.skeleton.len() {
+        return None;
+    }
+    let worst = global_poses(a)
+        .iter()
+        .zip(&global_poses(b))
+        .flat_map(|(p, q)| p.points().zip(q.points()))
+        .map(|(p, q)| super::math::norm(super::math::sub(p, q)))
+        .fold(0.0, f64::max);
+    Some(worst)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

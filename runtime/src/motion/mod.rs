@@ -19,7 +19,7 @@ pub use features::{
     Column, ColumnKind, EncodeOptions, EncodedClip, FeatureLayout, MotionError, RootFeatures,
     decode, encode, encode_for,
 };
-pub use fk::{GlobalPose, global_pose, global_poses, skeleton_height};
+pub use fk::{GlobalPose, global_pose, global_poses, max_position_error, skeleton_height};
 pub use normalize::Normalizer;
 pub use pose::{Pose, poses};
 pub use skeleton::{Axis, Channel, Joint, Skeleton};

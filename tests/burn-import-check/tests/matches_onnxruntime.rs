@@ -3,7 +3,7 @@
 use burn::tensor::{Int, Tensor, TensorData};
 use ndarray::Array3;
 use sinmdm::diffusion::noise::normals;
-use sinmdm::model::{Model, ModelOptions};
+use sinmdm::{Model, ModelOptions};
 
 const MODEL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../data/models/walk_tiny.onnx");
 

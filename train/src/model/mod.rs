@@ -15,12 +15,16 @@ use burn::tensor::{Device, Tensor};
 
 pub use unet::QnaUnet;
 
-/// Groups of every GroupNorm in the network.
-pub const NORM_GROUPS: usize = 32;
+pub use sinmdm::network::NORM_GROUPS;
 
-/// GroupNorm(32) with epsilon 1e-5 and affine weights, over `[B, N, C]`.
+/// GroupNorm with the contract's groups and epsilon and affine weights, over `[B, N, C]`.
 pub(crate) fn group_norm(channels: usize, device: &Device) -> layers::ChannelNorm {
-    layers::ChannelNorm::new(NORM_GROUPS, channels, 1e-5, device)
+    layers::ChannelNorm::new(
+        NORM_GROUPS,
+        channels,
+        f64::from(sinmdm::network::NORM_EPSILON),
+        device,
+    )
 }
 
 /// Whether `device` is the CPU backend (with or without autodiff), where the workarounds for its

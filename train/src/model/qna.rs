@@ -7,9 +7,7 @@ use burn::tensor::{Device, Distribution, Tensor};
 use super::group_norm;
 use super::layers::{ChannelNorm, FrameConv};
 
-/// Scores more than this far below the sequence maximum are raised to it before `exp`, so a
-/// window never sums to zero. Within one window such a gap means a weight ratio under 1e-26.
-pub const SCORE_FLOOR: f64 = -60.0;
+use sinmdm::network::SCORE_FLOOR;
 
 /// `x + proj(window-softmax(q . key(GN(x))) * value(GN(x)))` with a learned relative-position bias.
 #[derive(Module, Debug)]
@@ -90,7 +88,7 @@ impl QnaBlock {
         let normed = self.norm.forward(x.clone());
         let scores = self.scores(normed.clone());
         let top = scores.clone().max_dim(1);
-        let weights = (scores - top).clamp_min(SCORE_FLOOR).exp();
+        let weights = (scores - top).clamp_min(f64::from(SCORE_FLOOR)).exp();
         let bias = self.rpe.val().exp();
         // Each neighbour's unnormalised weight seen from frame n, zero outside the clip: [B, N, H].
         let padded = weights.pad([(0, 0), (pad, pad), (0, 0)], PadMode::Constant(0.0));

@@ -6,20 +6,13 @@ use std::collections::BTreeMap;
 use burn::module::{Module, ModuleMapper, ModuleVisitor, Param};
 use burn::tensor::{Distribution, Tensor};
 
-/// One parameter: its shape and values (row-major).
-#[derive(Debug, Clone, PartialEq)]
-pub struct NamedTensor {
-    /// Dimensions in burn's layout (`Linear` weights are `[in, out]`).
-    pub shape: Vec<usize>,
-    /// Values, row-major.
-    pub values: Vec<f32>,
-}
+use sinmdm::network::WeightTensor;
 
 /// Every float parameter of `module` by dotted path (`block1.in_conv.weight`).
-pub fn named_tensors<M: Module>(module: &M) -> BTreeMap<String, NamedTensor> {
+pub fn named_tensors<M: Module>(module: &M) -> BTreeMap<String, WeightTensor> {
     struct Collect {
         path: Vec<String>,
-        out: BTreeMap<String, NamedTensor>,
+        out: BTreeMap<String, WeightTensor>,
     }
     impl ModuleVisitor for Collect {
         fn enter_module(&mut self, name: &str, _container: &str) {
@@ -43,7 +36,7 @@ pub fn named_tensors<M: Module>(module: &M) -> BTreeMap<String, NamedTensor> {
                 .cloned()
                 .collect::<Vec<_>>()
                 .join(".");
-            self.out.insert(name, NamedTensor { shape, values });
+            self.out.insert(name, WeightTensor { shape, values });
         }
     }
     let mut collect = Collect {

@@ -129,6 +129,6 @@ impl Canvas {
 
     /// Writes the canvas as a PNG file, atomically.
     pub fn write_png(&self, path: &Path) -> std::io::Result<()> {
-        crate::files::write_atomically(path, &self.to_png())
+        sinmdm::files::write_atomically(path, &self.to_png())
     }
 }

@@ -1,24 +1,23 @@
 //! `sinmdm eval`: samples a model and scores the samples against its training clip.
 
-use std::fmt::Write as _;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use ndarray::{Array2, Axis};
+use ndarray::Axis;
 use serde::Serialize;
 
-use super::sampling::{
+use crate::sampling::{
     DEFAULT_STEPS, check_writable, parse_steps, progress_bar, reference_features,
 };
-use crate::eval::{COVERAGE_WINDOW, Report, evaluate, metric_features};
-use crate::features_file::write_features;
-use crate::files::write_atomically;
-use crate::model::{Model, ModelOptions};
-use crate::tasks::{self, Request, Task};
+use sinmdm::features_file::write_features;
+use sinmdm::files::write_atomically;
+use sinmdm::{Model, ModelOptions};
+use sinmdm::{Request, Task};
+use sinmdm_eval::{COVERAGE_WINDOW, ModelEvaluation, Report, evaluate_model};
 
-pub(super) const EXAMPLES: &str = "Examples:
+pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm eval -m onnx-models/human_walk_cmu.onnx --clip tests/data/bvh/human_walk_cmu_131_01.bvh
   sinmdm eval -m walk.onnx --clip walk.bvh --samples 20 --steps all --json out/walk_eval.json
 
@@ -35,7 +34,7 @@ pub struct EvalArgs {
     #[arg(long, value_name = "CLIP.bvh")]
     clip: PathBuf,
     #[command(flatten)]
-    up: super::sampling::ClipUpArg,
+    up: crate::sampling::ClipUpArg,
     /// Samples to generate (one batched run).
     #[arg(long, default_value_t = 20)]
     samples: usize,
@@ -78,34 +77,7 @@ struct EvalFile<'a> {
     report: &'a Report,
 }
 
-/// The scores as a Markdown table, with the paper's figures on its own benchmark beside them.
-pub fn report_table(report: &Report) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "| metric | mean | std | SinMDM paper (Mixamo) |");
-    let _ = writeln!(s, "|---|---|---|---|");
-    let rows = [
-        ("coverage (%) ↑", report.coverage, 1, "94.3"),
-        ("global diversity ↑", report.global_diversity, 3, "1.42"),
-        ("local diversity ↑", report.local_diversity, 3, "1.00"),
-        ("inter diversity ↑", report.inter_diversity, 3, "0.13"),
-    ];
-    for (name, stat, digits, paper) in rows {
-        let _ = writeln!(
-            s,
-            "| {name} | {:.digits$} | {:.digits$} | {paper} |",
-            stat.mean, stat.std
-        );
-    }
-    let _ = writeln!(
-        s,
-        "| intra diversity diff ↓ | {:.3} | | 0.03 |",
-        report.intra_diversity_diff
-    );
-    let _ = writeln!(s, "| harmonic mean ↑ | {:.3} | | |", report.harmonic_mean);
-    s
-}
-
-pub(super) fn run(args: &EvalArgs) -> Result<()> {
+pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     if args.samples == 0 {
         bail!("--samples must be at least 1");
     }
@@ -150,37 +122,35 @@ pub(super) fn run(args: &EvalArgs) -> Result<()> {
         seed: args.seed,
         steps,
     };
-    let plan = tasks::plan(model.metadata(), &request)?;
-    let bar = progress_bar(
-        args.quiet,
-        plan.schedule.len(),
-        format!("{} x {} frames", args.samples, frames),
-    );
-    let started = Instant::now();
-    let generated = tasks::run_plan(
-        &mut model,
-        &plan,
-        args.samples,
-        args.seed,
-        &mut |done, _| bar.set_position(done as u64),
-    )?;
-    let sampling_seconds = started.elapsed().as_secs_f64();
-    bar.finish_and_clear();
-
-    let layout = generated.layout();
-    let clip_metric = metric_features(layout, clip.view());
-    let samples: Vec<Array2<f64>> = generated
-        .features
-        .outer_iter()
-        .map(|sample| metric_features(layout, sample))
-        .collect();
     let threads = args.threads.unwrap_or_else(|| {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
-    let started = Instant::now();
-    let report = evaluate(clip_metric.view(), &samples, threads)
-        .with_context(|| format!("cannot score against {}", args.clip.display()))?;
-    let scoring_seconds = started.elapsed().as_secs_f64();
+    let bar = progress_bar(
+        args.quiet,
+        sinmdm::plan(model.metadata(), &request)?.steps(),
+        format!("{} x {} frames", args.samples, frames),
+    );
+    let metadata = model.metadata().clone();
+    let evaluation = evaluate_model(
+        &mut model,
+        &metadata,
+        &request,
+        clip.view(),
+        threads,
+        &mut |done, _| {
+            bar.set_position(done as u64);
+            ControlFlow::Continue(())
+        },
+    )
+    .with_context(|| format!("cannot score against {}", args.clip.display()))?;
+    bar.finish_and_clear();
+    let ModelEvaluation {
+        generated,
+        report,
+        sampling_seconds,
+        scoring_seconds,
+    } = evaluation;
+    let layout = generated.layout();
 
     let steps_text = steps.map_or("all".to_string(), |s| s.to_string());
     println!(
@@ -196,7 +166,7 @@ pub(super) fn run(args: &EvalArgs) -> Result<()> {
         args.samples, frames, steps_text, args.seed, sampling_seconds, scoring_seconds
     );
     println!();
-    print!("{}", report_table(&report));
+    print!("{}", report.markdown_table());
 
     if let Some(path) = &args.features_json {
         write_features(path, layout, generated.features.view())?;

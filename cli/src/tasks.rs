@@ -5,33 +5,33 @@ use std::path::PathBuf;
 use anyhow::{Result, bail};
 use clap::Args;
 
-use super::sampling::{
+use crate::sampling::{
     ClipUpArg, SamplingArgs, parse_position, parse_span, reference_features, run_task,
 };
-use crate::tasks::{
+use sinmdm::tasks::{
     EXPAND_RAMP, HARMONIZE_FACTOR, HARMONIZE_FREE_SHARE, INBETWEEN_RAMP, Task, joints_by_name,
     subtree,
 };
 
-pub(super) const GENERATE_EXAMPLES: &str = "Examples:
+pub(crate) const GENERATE_EXAMPLES: &str = "Examples:
   sinmdm generate -m onnx-models/walk.onnx -o out/walk.bvh
   sinmdm generate -m onnx-models/walk.onnx --seconds 20 -o out/long.bvh
   sinmdm generate -m onnx-models/walk.onnx --count 8 --seed 7 -o out/crowd.bvh   # crowd_000..007.bvh
   sinmdm generate -m onnx-models/walk.onnx --steps all -o out/full.bvh           # all 1000 steps";
 
-pub(super) const INBETWEEN_EXAMPLES: &str = "Examples:
+pub(crate) const INBETWEEN_EXAMPLES: &str = "Examples:
   sinmdm inbetween -m onnx-models/walk.onnx --reference walk.bvh --keep 0:60 --keep 180: -o out/inbetween.bvh
   sinmdm inbetween -m onnx-models/walk.onnx --reference walk.bvh --keep 0s:2s --keep 6s: -o out/ib.bvh --count 4";
 
-pub(super) const EXPAND_EXAMPLES: &str = "Examples:
+pub(crate) const EXPAND_EXAMPLES: &str = "Examples:
   sinmdm expand -m onnx-models/walk.onnx --reference walk.bvh --prefix 2s --suffix 2s -o out/expanded.bvh
   sinmdm expand -m onnx-models/walk.onnx --reference walk.bvh --suffix 300 -o out/longer.bvh";
 
-pub(super) const COMPOSE_EXAMPLES: &str = "Examples:
+pub(crate) const COMPOSE_EXAMPLES: &str = "Examples:
   sinmdm compose -m onnx-models/walk.onnx --reference walk.bvh --part LeftUpLeg --part RightUpLeg --root -o out/new_upper_body.bvh
   sinmdm compose -m onnx-models/walk.onnx --reference walk.bvh --joints Head,Neck --frames 0:120 -o out/c.bvh";
 
-pub(super) const HARMONIZE_EXAMPLES: &str = "Examples:
+pub(crate) const HARMONIZE_EXAMPLES: &str = "Examples:
   sinmdm harmonize -m onnx-models/hop.onnx --content walk.bvh -o out/walk_in_hop_style.bvh
   sinmdm harmonize -m onnx-models/hop.onnx --content walk.bvh --factor 4 --free-share 0.05 -o out/t.bvh";
 
@@ -134,7 +134,7 @@ pub struct HarmonizeArgs {
     free_share: f64,
 }
 
-pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
+pub(crate) fn generate(args: &GenerateArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
     let meta = model.metadata();
     let frames = match (args.frames, args.seconds) {
@@ -151,7 +151,7 @@ pub(super) fn generate(args: &GenerateArgs) -> Result<()> {
     Ok(())
 }
 
-pub(super) fn inbetween(args: &InbetweenArgs) -> Result<()> {
+pub(crate) fn inbetween(args: &InbetweenArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
     let reference = reference_features(&model, &args.reference, args.up.up)?;
     let fps = model.metadata().layout.fps;
@@ -169,7 +169,7 @@ pub(super) fn inbetween(args: &InbetweenArgs) -> Result<()> {
     Ok(())
 }
 
-pub(super) fn expand(args: &ExpandArgs) -> Result<()> {
+pub(crate) fn expand(args: &ExpandArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
     let reference = reference_features(&model, &args.reference, args.up.up)?;
     let fps = model.metadata().layout.fps;
@@ -183,7 +183,7 @@ pub(super) fn expand(args: &ExpandArgs) -> Result<()> {
     Ok(())
 }
 
-pub(super) fn compose(args: &ComposeArgs) -> Result<()> {
+pub(crate) fn compose(args: &ComposeArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
     let reference = reference_features(&model, &args.reference, args.up.up)?;
     let layout = &model.metadata().layout;
@@ -208,7 +208,7 @@ pub(super) fn compose(args: &ComposeArgs) -> Result<()> {
     Ok(())
 }
 
-pub(super) fn harmonize(args: &HarmonizeArgs) -> Result<()> {
+pub(crate) fn harmonize(args: &HarmonizeArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
     let content = reference_features(&model, &args.content, args.up.up)?;
     let task = Task::Harmonize {

@@ -1,14 +1,14 @@
 //! Stick-figure renders of motion: forward kinematics, an orthographic camera from the front
 //! left and above, a ground grid, contacts highlighted, several clips side by side.
 //!
-//! Figures are drawn in the canonical Y-up frame ([`crate::motion::up`]): a Z-up clip is turned
+//! Figures are drawn in the canonical Y-up frame ([`sinmdm::motion::up`]): a Z-up clip is turned
 //! upright first, so the camera and the grid never depend on the file's convention.
 
 use super::canvas::{Canvas, Rgb};
-use crate::motion::contacts::{choose_contact_joints, label_contacts, travelling_root};
-use crate::motion::math::{Vec3, dot, sub};
-use crate::motion::up::{GROUND_PLANE, UpAxis, height_of, on_ground, to_canonical};
-use crate::motion::{GlobalPose, LocalMotion, global_poses, skeleton_height};
+use sinmdm::motion::contacts::{choose_contact_joints, label_contacts, travelling_root};
+use sinmdm::motion::math::{Vec3, dot, sub};
+use sinmdm::motion::up::{GROUND_PLANE, UpAxis, height_of, on_ground, to_canonical};
+use sinmdm::motion::{GlobalPose, LocalMotion, global_poses, skeleton_height};
 
 /// Background colour.
 pub const BACKGROUND: Rgb = [250, 250, 246];

@@ -110,7 +110,7 @@ impl DiagonalSums {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::eval::test_data::{frame_distance as dist, random_motion as motion};
+    use crate::test_data::{frame_distance as dist, random_motion as motion};
 
     #[test]
     fn window_sums_match_direct_sums() {

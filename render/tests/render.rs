@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use sinmdm::bvh::{parse_bvh, read_bvh, to_bvh_string};
 use sinmdm::motion::detect_up;
 use sinmdm::motion::up::{UpAxis, reorient};
-use sinmdm::render::figure::{FIGURE_COLOURS, projected_height};
-use sinmdm::render::{Camera, Figure, RenderOptions, contact_sheet, gif_bytes};
+use sinmdm_render::figure::{FIGURE_COLOURS, projected_height};
+use sinmdm_render::{Camera, Figure, RenderOptions, contact_sheet, gif_bytes};
 
 fn walk() -> Figure {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))

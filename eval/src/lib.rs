@@ -1,4 +1,4 @@
-//! Quality metrics of generated motion against the training clip (the single-motion benchmark
+//! sinmdm-eval: quality metrics of generated motion against the training clip (the single-motion benchmark
 //! of GANimator and SinMDM).
 //!
 //! Every metric compares frames by the Euclidean distance of their *metric features*: all 6D
@@ -26,6 +26,9 @@
 //! their maximum count as the maximum; the lower-is-better intra difference counts as
 //! `1 - difference / maximum`.
 
+#![warn(missing_docs)]
+
+mod model_eval;
 mod patched_nn;
 #[cfg(test)]
 mod test_data;
@@ -35,8 +38,9 @@ use ndarray::{Array2, ArrayView2, Axis};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::motion::{ColumnKind, FeatureLayout};
+use sinmdm::motion::{ColumnKind, FeatureLayout};
 
+pub use model_eval::{ModelEvalError, ModelEvaluation, evaluate_model};
 pub use patched_nn::patched_nearest_neighbour;
 pub use window_match::DiagonalSums;
 

@@ -6,14 +6,15 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 
-use crate::bvh::{read_bvh, write_bvh};
-use crate::files::write_atomically;
-use crate::motion::up::{UP, file_axis_name};
-use crate::motion::{
-    ContactConfig, EncodeOptions, decode, encode, fk, global_poses, math, skeleton::Channel,
+use sinmdm::bvh::{read_bvh, write_bvh};
+use sinmdm::files::write_atomically;
+use sinmdm::motion::up::{UP, file_axis_name};
+use sinmdm::motion::{
+    ContactConfig, EncodeOptions, decode, encode, fk, global_poses, math, max_position_error,
+    skeleton::Channel,
 };
 
-pub(super) const EXAMPLES: &str = "Examples:
+pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm inspect tests/data/bvh/human_walk_cmu_131_01.bvh
   sinmdm inspect walk.bvh --fps 30 --roundtrip walk_30fps.bvh
   sinmdm inspect dog.bvh --contact-joints LeftHand,RightHand,LeftFoot,RightFoot
@@ -40,7 +41,7 @@ pub struct InspectArgs {
     #[arg(long, default_value_t = ContactConfig::default().speed_threshold)]
     pub contact_speed: f64,
     #[command(flatten)]
-    pub up: super::sampling::ClipUpArg,
+    pub up: crate::sampling::ClipUpArg,
 }
 
 /// A plain-words guess of the file's length unit from the skeleton height.
@@ -55,7 +56,7 @@ pub fn units_guess(height: f64) -> &'static str {
     }
 }
 
-pub(super) fn run(args: &InspectArgs) -> Result<()> {
+pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     if let Some(fps) = args.fps
         && !(fps.is_finite() && fps > 0.0)
     {
@@ -208,14 +209,8 @@ pub(super) fn run(args: &InspectArgs) -> Result<()> {
             trim_float(layout.fps)
         );
         if (layout.fps - clip.fps).abs() < 1e-9 {
-            let original = global_poses(&clip.to_local());
-            let decoded = global_poses(&written.to_local());
-            let worst = original
-                .iter()
-                .zip(&decoded)
-                .flat_map(|(a, b)| a.points().zip(b.points()))
-                .map(|(p, q)| math::norm(math::sub(p, q)))
-                .fold(0.0, f64::max);
+            let worst = max_position_error(&clip.to_local(), &written.to_local())
+                .context("the round trip changed the frame or joint count")?;
             println!(
                 "; largest joint position error {:.2e} x height",
                 worst / height.max(1e-12)
@@ -229,7 +224,7 @@ pub(super) fn run(args: &InspectArgs) -> Result<()> {
 
 /// Global joint positions of every frame as JSON: `{"fps", "joints": [names], "positions":
 /// [frame][joint][xyz]}`.
-fn positions_json(clip: &crate::motion::ChannelClip) -> Result<String> {
+fn positions_json(clip: &sinmdm::motion::ChannelClip) -> Result<String> {
     let poses = global_poses(&clip.to_local());
     let positions: Vec<&Vec<math::Vec3>> =
         poses.iter().map(|p: &fk::GlobalPose| &p.joints).collect();
@@ -248,12 +243,12 @@ fn positions_json(clip: &crate::motion::ChannelClip) -> Result<String> {
 
 fn short_channel(c: Channel) -> &'static str {
     match c {
-        Channel::Position(crate::motion::Axis::X) => "Xpos",
-        Channel::Position(crate::motion::Axis::Y) => "Ypos",
-        Channel::Position(crate::motion::Axis::Z) => "Zpos",
-        Channel::Rotation(crate::motion::Axis::X) => "Xrot",
-        Channel::Rotation(crate::motion::Axis::Y) => "Yrot",
-        Channel::Rotation(crate::motion::Axis::Z) => "Zrot",
+        Channel::Position(sinmdm::motion::Axis::X) => "Xpos",
+        Channel::Position(sinmdm::motion::Axis::Y) => "Ypos",
+        Channel::Position(sinmdm::motion::Axis::Z) => "Zpos",
+        Channel::Rotation(sinmdm::motion::Axis::X) => "Xrot",
+        Channel::Rotation(sinmdm::motion::Axis::Y) => "Yrot",
+        Channel::Rotation(sinmdm::motion::Axis::Z) => "Zrot",
     }
 }
 

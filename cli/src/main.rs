@@ -1,5 +1,5 @@
-//! The `sinmdm` command line (feature `cli`): argument parsing and printing; the work is done by
-//! the library.
+//! The `sinmdm` command line: argument parsing and printing; the work is done by the libraries
+//! (`sinmdm`, `sinmdm-render`, `sinmdm-eval`).
 
 mod eval;
 mod info;
@@ -59,8 +59,7 @@ pub enum Command {
     Encode(info::EncodeArgs),
 }
 
-/// Runs the command line; returns the process exit status.
-pub fn main() -> std::process::ExitCode {
+fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Inspect(args) => inspect::run(&args),

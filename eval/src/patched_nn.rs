@@ -65,7 +65,7 @@ pub fn patched_nearest_neighbour(sums: &DiagonalSums, min_segment: usize) -> Opt
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::eval::test_data::{frame_distance, random_motion as motion};
+    use crate::test_data::{frame_distance, random_motion as motion};
     use ndarray::{Array2, s};
 
     /// Every cut of `a` into segments of >= m frames, each matched to `b` at every offset, with

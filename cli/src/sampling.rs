@@ -1,22 +1,23 @@
 //! What every generating subcommand shares: the model, seed, steps, crowd size, output files
 //! and the progress bar.
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use ndarray::Array2;
 
-use crate::bvh::{read_bvh, to_bvh_string};
-use crate::features_file::write_features;
-use crate::files::write_atomically;
-use crate::model::{Model, ModelOptions};
-use crate::motion::up::{Confidence, UpAxis, detect_up, reorient, reorient_problem};
-use crate::motion::{encode_for, math};
-use crate::render::{Camera, Figure};
-use crate::tasks::{self, Generated, Request, Span, Task};
+use sinmdm::bvh::{read_bvh, to_bvh_string};
+use sinmdm::features_file::write_features;
+use sinmdm::files::write_atomically;
+use sinmdm::motion::up::{Confidence, UpAxis, detect_up, reorient, reorient_problem};
+use sinmdm::motion::{encode_for, math};
+use sinmdm::{Generated, Plan, Request, Span, Task};
+use sinmdm::{Model, ModelOptions};
+use sinmdm_render::{Camera, Figure};
 
-use super::render::write_picture;
+use crate::render::write_picture;
 
 /// Default respaced sampling steps of the command line (see the README for the measurement).
 pub const DEFAULT_STEPS: &str = "100";
@@ -226,7 +227,7 @@ pub fn check_writable(paths: &[PathBuf]) -> Result<()> {
 }
 
 /// Runs a task with the shared options: checks the request and the outputs, samples with a
-/// progress bar, and writes every BVH (and the features JSON) atomically.
+/// progress bar, and writes every BVH (and the features JSON, and the picture) atomically.
 pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Generated> {
     let request = Request {
         task,
@@ -234,24 +235,15 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         seed: args.seed,
         steps: args.steps()?,
     };
-    let plan = tasks::plan(model.metadata(), &request)?;
-    let mut outputs: Vec<PathBuf> = (0..args.count)
-        .map(|i| args.output_path(i, args.count))
+    let plan = sinmdm::plan(model.metadata(), &request)?;
+    let mut outputs: Vec<PathBuf> = (0..plan.count())
+        .map(|i| args.output_path(i, plan.count()))
         .collect();
     outputs.extend(args.features_json.iter().cloned());
     outputs.extend(args.render.iter().cloned());
     check_writable(&outputs)?;
 
-    let bar = progress_bar(
-        args.quiet,
-        plan.schedule.len(),
-        format!("{} x {} frames", args.count, plan.frames),
-    );
-    let generated = tasks::run_plan(model, &plan, request.count, request.seed, &mut |done, _| {
-        bar.set_position(done as u64)
-    })?;
-    bar.finish_and_clear();
-
+    let generated = run_with_progress(model, &plan, args.quiet)?;
     for i in 0..generated.count() {
         let path = args.output_path(i, generated.count());
         let motion = generated
@@ -267,19 +259,7 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
     }
     if let Some(path) = &args.render {
         let layout = generated.layout();
-        let kept = plan.guidance.inpainting.as_ref().map(|inpaint| {
-            (0..plan.frames)
-                .map(|frame| {
-                    (0..layout.skeleton.len())
-                        .map(|joint| {
-                            let columns = layout.joint_columns(joint);
-                            !columns.is_empty()
-                                && columns.iter().all(|&c| inpaint.mask[[c, frame]] >= 1.0)
-                        })
-                        .collect()
-                })
-                .collect::<Vec<Vec<bool>>>()
-        });
+        let kept = plan.kept_joints();
         let mut figures = Vec::new();
         for i in 0..generated.count() {
             let mut figure = Figure::new(
@@ -293,5 +273,20 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         }
         write_picture(path, &figures, Camera::Follow, 320, 8)?;
     }
+    Ok(generated)
+}
+
+/// Runs a checked plan on the model with a progress bar over its steps.
+pub fn run_with_progress(model: &mut Model, plan: &Plan, quiet: bool) -> Result<Generated> {
+    let bar = progress_bar(
+        quiet,
+        plan.steps(),
+        format!("{} x {} frames", plan.count(), plan.frames()),
+    );
+    let generated = plan.run(model, &mut |done, _| {
+        bar.set_position(done as u64);
+        ControlFlow::Continue(())
+    })?;
+    bar.finish_and_clear();
     Ok(generated)
 }

@@ -5,12 +5,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 
-use crate::bvh::read_bvh;
-use crate::files::write_atomically;
-use crate::motion::{Confidence, ContactConfig, detect_up};
-use crate::render::{Camera, Figure, RenderOptions, contact_sheet, gif_bytes};
+use sinmdm::bvh::read_bvh;
+use sinmdm::files::write_atomically;
+use sinmdm::motion::{Confidence, ContactConfig, detect_up};
+use sinmdm_render::{Camera, Figure, RenderOptions, contact_sheet, gif_bytes};
 
-pub(super) const EXAMPLES: &str = "Examples:
+pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm render tests/data/bvh/human_walk_cmu_131_01.bvh -o out/walk.gif
   sinmdm render out/crowd_000.bvh out/crowd_001.bvh out/crowd_002.bvh -o out/crowd.gif
   sinmdm render out/walk.bvh -o out/walk_sheet.png --sheet-frames 10 --camera fixed";
@@ -43,7 +43,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 8)]
     pub sheet_frames: usize,
     #[command(flatten)]
-    pub up: super::sampling::ClipUpArg,
+    pub up: crate::sampling::ClipUpArg,
 }
 
 /// Writes `figures` as a GIF or PNG chosen by the extension of `path`.
@@ -79,7 +79,7 @@ pub fn write_picture(
     Ok(())
 }
 
-pub(super) fn run(args: &RenderArgs) -> Result<()> {
+pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     let mut figures = Vec::new();
     for path in &args.clips {
         let clip = read_bvh(path)?;

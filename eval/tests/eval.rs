@@ -3,8 +3,8 @@
 
 use ndarray::{Array2, Axis, concatenate, s};
 use sinmdm::bvh::read_bvh;
-use sinmdm::eval::{Report, evaluate, metric_features};
 use sinmdm::motion::{EncodeOptions, encode};
+use sinmdm_eval::{Report, evaluate, metric_features};
 
 fn walk() -> Array2<f64> {
     let path = concat!(
@@ -118,126 +118,4 @@ fn thread_count_does_not_change_the_result() {
     let one = evaluate(clip.view(), &samples, 1).unwrap();
     let two = evaluate(clip.view(), &samples, 2).unwrap();
     assert_eq!(one, two);
-}
-
-fn repo_file(relative: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join(relative)
-}
-
-fn test_model() -> std::path::PathBuf {
-    std::env::var_os("SINMDM_TEST_MODEL")
-        .map(Into::into)
-        .unwrap_or_else(|| repo_file("tests/data/models/walk_tiny.onnx"))
-}
-
-fn sinmdm(args: &[&std::ffi::OsStr]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_sinmdm"))
-        .args(args)
-        .output()
-        .expect("run sinmdm")
-}
-
-#[test]
-fn eval_command_prints_the_table_and_writes_json() {
-    let dir = std::env::temp_dir().join(format!("sinmdm-eval-{}", std::process::id()));
-    let json = dir.join("scores.json");
-    let model = test_model();
-    let clip = repo_file("tests/data/bvh/human_walk_cmu_131_01.bvh");
-    let out = sinmdm(&[
-        "eval".as_ref(),
-        "-m".as_ref(),
-        model.as_os_str(),
-        "--clip".as_ref(),
-        clip.as_os_str(),
-        "--samples".as_ref(),
-        "3".as_ref(),
-        "--steps".as_ref(),
-        "4".as_ref(),
-        "--quiet".as_ref(),
-        "--json".as_ref(),
-        json.as_os_str(),
-    ]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    for row in [
-        "| coverage (%) ↑ |",
-        "| global diversity ↑ |",
-        "| local diversity ↑ |",
-        "| inter diversity ↑ |",
-        "| intra diversity diff ↓ |",
-        "| harmonic mean ↑ |",
-    ] {
-        assert!(stdout.contains(row), "missing {row} in\n{stdout}");
-    }
-    let value: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    assert_eq!(value["format"], "sinmdm-eval");
-    assert_eq!(value["samples"], 3);
-    // Twice the clip: 249 frames at 30 fps.
-    assert_eq!(value["frames"], 498);
-    let report: Report = serde_json::from_value(value["report"].clone()).unwrap();
-    assert_eq!(report.per_sample.len(), 3);
-    assert_eq!(report.sample_frames, 498);
-    assert!((0.0..=100.0).contains(&report.coverage.mean));
-    assert!((0.0..=1.0).contains(&report.harmonic_mean));
-    assert!(report.global_diversity.mean.is_finite() && report.global_diversity.mean >= 0.0);
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
-#[test]
-fn eval_command_refuses_bad_input_and_writes_nothing() {
-    let dir = std::env::temp_dir().join(format!("sinmdm-eval-bad-{}", std::process::id()));
-    let json = dir.join("scores.json");
-    let model = test_model();
-    let walk = repo_file("tests/data/bvh/human_walk_cmu_131_01.bvh");
-    let fox = repo_file("tests/data/bvh/fox_survey_khronos.bvh");
-    let cases: [(&[&std::ffi::OsStr], &str); 3] = [
-        (
-            &[
-                "--clip".as_ref(),
-                walk.as_os_str(),
-                "--samples".as_ref(),
-                "0".as_ref(),
-            ],
-            "--samples must be at least 1",
-        ),
-        (
-            &["--clip".as_ref(), fox.as_os_str()],
-            "skeleton differs from the model's",
-        ),
-        (
-            &[
-                "--clip".as_ref(),
-                walk.as_os_str(),
-                "--frames".as_ref(),
-                "12".as_ref(),
-                "--steps".as_ref(),
-                "2".as_ref(),
-            ],
-            "--frames must be at least 30",
-        ),
-    ];
-    for (extra, message) in cases {
-        let mut args: Vec<&std::ffi::OsStr> = vec![
-            "eval".as_ref(),
-            "-m".as_ref(),
-            model.as_os_str(),
-            "--quiet".as_ref(),
-            "--json".as_ref(),
-            json.as_os_str(),
-        ];
-        args.extend_from_slice(extra);
-        let out = sinmdm(&args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{extra:?} was accepted");
-        assert!(stderr.contains(message), "{extra:?}: {stderr}");
-        assert!(!json.exists(), "{extra:?} left {}", json.display());
-    }
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -7,16 +7,16 @@ use anyhow::Result;
 use clap::Args;
 use ndarray::Axis;
 
-use super::sampling::reference_features;
-use crate::features_file::write_features;
-use crate::model::{Model, ModelOptions};
-use crate::model_file::ModelMetadata;
+use crate::sampling::reference_features;
+use sinmdm::features_file::write_features;
+use sinmdm::model_file::ModelMetadata;
+use sinmdm::{Model, ModelOptions};
 
-pub(super) const INFO_EXAMPLES: &str = "Examples:
+pub(crate) const INFO_EXAMPLES: &str = "Examples:
   sinmdm info onnx-models/walk.onnx
   sinmdm info onnx-models/walk.onnx --json > walk_metadata.json";
 
-pub(super) const ENCODE_EXAMPLES: &str = "Examples:
+pub(crate) const ENCODE_EXAMPLES: &str = "Examples:
   sinmdm encode walk.bvh -m onnx-models/walk.onnx -o walk_features.json";
 
 /// Arguments of `sinmdm info`.
@@ -41,7 +41,7 @@ pub struct EncodeArgs {
     #[arg(short, long, value_name = "OUT.json")]
     pub output: PathBuf,
     #[command(flatten)]
-    pub up: super::sampling::ClipUpArg,
+    pub up: crate::sampling::ClipUpArg,
 }
 
 /// A readable summary of a model's metadata.
@@ -119,7 +119,7 @@ pub fn describe(path: &std::path::Path, m: &ModelMetadata) -> String {
     s
 }
 
-pub(super) fn info(args: &InfoArgs) -> Result<()> {
+pub(crate) fn info(args: &InfoArgs) -> Result<()> {
     let model = Model::open(&args.model, &ModelOptions { threads: Some(1) })?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(model.metadata())?);
@@ -129,7 +129,7 @@ pub(super) fn info(args: &InfoArgs) -> Result<()> {
     Ok(())
 }
 
-pub(super) fn encode(args: &EncodeArgs) -> Result<()> {
+pub(crate) fn encode(args: &EncodeArgs) -> Result<()> {
     let model = Model::open(&args.model, &ModelOptions { threads: Some(1) })?;
     let features = reference_features(&model, &args.clip, args.up.up)?;
     write_features(

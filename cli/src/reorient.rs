@@ -5,11 +5,11 @@ use std::path::PathBuf;
 use anyhow::{Result, bail};
 use clap::Args;
 
-use crate::bvh::{read_bvh, write_bvh};
-use crate::motion::math;
-use crate::motion::up::{UP, UpAxis, detect_up, reorient, reorient_problem};
+use sinmdm::bvh::{read_bvh, write_bvh};
+use sinmdm::motion::math;
+use sinmdm::motion::up::{UP, UpAxis, detect_up, reorient, reorient_problem};
 
-pub(super) const EXAMPLES: &str = "Examples:
+pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm reorient zup_clip.bvh --to y -o yup_clip.bvh         # for a Y-up engine
   sinmdm reorient walk.bvh --to z -o walk_zup.bvh             # as a Z-up pipeline writes it
   sinmdm reorient walk.bvh --turn 90 -o walk_turned.bvh       # a quarter turn about up";
@@ -35,7 +35,7 @@ pub struct ReorientArgs {
     pub turn: f64,
 }
 
-pub(super) fn run(args: &ReorientArgs) -> Result<()> {
+pub(crate) fn run(args: &ReorientArgs) -> Result<()> {
     if !args.turn.is_finite() {
         bail!("--turn must be a number of degrees, got {}", args.turn);
     }

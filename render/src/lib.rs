@@ -1,5 +1,7 @@
-//! Pictures (feature `render`): an RGB canvas with PNG output, a 5x7 label font, charts, and
+//! Pictures of motion for sinmdm: an RGB canvas with PNG output, a 5x7 label font, charts, and
 //! stick-figure renders of motion as GIF animations or PNG contact sheets.
+
+#![warn(missing_docs)]
 
 pub mod animation;
 pub mod canvas;

@@ -1,0 +1,345 @@
+//! Checking a request against a model and building its sampling run: length, masks, low-pass
+//! targets and schedule; then running it on a denoiser.
+
+use std::ops::ControlFlow;
+
+use ndarray::Array2;
+
+use super::Generated;
+use super::mask::{Span, covered, soft_mask};
+use super::{MAX_COUNT, MAX_FRAMES, MAX_VALUES, Request, Task, TaskError};
+use crate::diffusion::Schedule;
+use crate::diffusion::sampler::{Denoiser, Guidance, Harmonization, Inpainting, Sampler};
+use crate::model::Model;
+use crate::model_file::ModelMetadata;
+
+/// A request checked against a model: its length, guidance, schedule, sample count and seed,
+/// ready to run. Made only by [`plan`], so what runs is what was checked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    metadata: ModelMetadata,
+    count: usize,
+    seed: u64,
+    frames: usize,
+    guidance: Guidance,
+    schedule: Schedule,
+}
+
+impl Plan {
+    /// Samples in the batch.
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
+    /// Seed of the portable noise.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Frames per sample.
+    pub fn frames(&self) -> usize {
+        self.frames
+    }
+
+    /// Denoising steps the run takes.
+    pub fn steps(&self) -> usize {
+        self.schedule.len()
+    }
+
+    /// Masks and low-pass targets, normalised.
+    pub fn guidance(&self) -> &Guidance {
+        &self.guidance
+    }
+
+    /// The (respaced) schedule.
+    pub fn schedule(&self) -> &Schedule {
+        &self.schedule
+    }
+
+    /// Per frame and joint, whether the task keeps that joint of the reference unchanged (every
+    /// column of the joint fully masked); `None` for tasks without a reference mask. Joints
+    /// without feature columns (end sites) are never kept.
+    pub fn kept_joints(&self) -> Option<Vec<Vec<bool>>> {
+        let inpaint = self.guidance.inpainting.as_ref()?;
+        let layout = &self.metadata.layout;
+        Some(
+            (0..self.frames)
+                .map(|frame| {
+                    (0..layout.skeleton.len())
+                        .map(|joint| {
+                            let columns = layout.joint_columns(joint);
+                            !columns.is_empty()
+                                && columns.iter().all(|&c| inpaint.mask[[c, frame]] >= 1.0)
+                        })
+                        .collect()
+                })
+                .collect(),
+        )
+    }
+
+    /// A sampler for this plan, to step by hand.
+    pub fn sampler(&self) -> Result<Sampler<'_>, TaskError> {
+        Ok(Sampler::new(
+            &self.schedule,
+            &self.guidance,
+            self.count,
+            self.metadata.network.features,
+            self.frames,
+            self.seed,
+        )?)
+    }
+
+    /// Runs the plan on a denoiser. `progress` is called after each step with (steps done,
+    /// steps in all); returning [`ControlFlow::Break`] stops the run with
+    /// [`TaskError::Cancelled`].
+    pub fn run<D: Denoiser>(
+        &self,
+        denoiser: &mut D,
+        progress: &mut dyn FnMut(usize, usize) -> ControlFlow<()>,
+    ) -> Result<Generated, TaskError>
+    where
+        TaskError: From<D::Error>,
+    {
+        let mut sampler = self.sampler()?;
+        while !sampler.is_finished() {
+            sampler.step(denoiser)?;
+            if progress(sampler.done(), sampler.steps()).is_break() && !sampler.is_finished() {
+                return Err(TaskError::Cancelled {
+                    done: sampler.done(),
+                    steps: sampler.steps(),
+                });
+            }
+        }
+        Ok(Generated::from_normalized(
+            self.metadata.clone(),
+            sampler.into_sample(),
+        ))
+    }
+}
+
+/// Checks `request` against `model` and runs it; `progress` as in [`Plan::run`].
+pub fn run(
+    model: &mut Model,
+    request: &Request,
+    progress: &mut dyn FnMut(usize, usize) -> ControlFlow<()>,
+) -> Result<Generated, TaskError> {
+    plan(model.metadata(), request)?.run(model, progress)
+}
+
+fn check_spans(spans: &[Span], frames: usize) -> Result<Vec<Span>, TaskError> {
+    let mut sorted = spans.to_vec();
+    sorted.sort();
+    for span in &sorted {
+        if span.is_empty() {
+            return Err(TaskError::EmptySpan(*span));
+        }
+        if span.end > frames {
+            return Err(TaskError::SpanOutOfRange {
+                span: *span,
+                frames,
+            });
+        }
+    }
+    for pair in sorted.windows(2) {
+        if pair[1].start < pair[0].end {
+            return Err(TaskError::SpansOverlap(pair[0], pair[1]));
+        }
+    }
+    Ok(sorted)
+}
+
+fn check_length(frames: usize) -> Result<(), TaskError> {
+    if frames == 0 {
+        return Err(TaskError::Length {
+            frames,
+            reason: "ask for at least one frame".into(),
+        });
+    }
+    if frames > MAX_FRAMES {
+        return Err(TaskError::Length {
+            frames,
+            reason: format!("the limit is {MAX_FRAMES} frames per sample"),
+        });
+    }
+    Ok(())
+}
+
+fn normalized(metadata: &ModelMetadata, raw: &Array2<f32>) -> Result<Array2<f32>, TaskError> {
+    if raw.nrows() != metadata.network.features {
+        return Err(TaskError::ReferenceWidth {
+            expected: metadata.network.features,
+            got: raw.nrows(),
+        });
+    }
+    Ok(metadata.normalizer.normalize(raw.view()))
+}
+
+/// Broadcasts a per-frame weight over all rows, or over `rows` only.
+fn frame_mask(features: usize, weights: &[f32], rows: Option<&[usize]>) -> Array2<f32> {
+    let mut m = Array2::<f32>::zeros((features, weights.len()));
+    let mut fill = |r: usize| {
+        for (i, &w) in weights.iter().enumerate() {
+            m[[r, i]] = w;
+        }
+    };
+    match rows {
+        Some(rows) => rows.iter().for_each(|&r| fill(r)),
+        None => (0..features).for_each(fill),
+    }
+    m
+}
+
+/// Checks a request against a model and builds its sampling plan.
+pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskError> {
+    let f = metadata.network.features;
+    if request.count == 0 || request.count > MAX_COUNT {
+        return Err(TaskError::Count(request.count));
+    }
+    let schedule = match request.steps {
+        Some(s) => Schedule::respaced(metadata.diffusion.steps, s)?,
+        None => Schedule::cosine(metadata.diffusion.steps)?,
+    };
+    let (frames, guidance) = match &request.task {
+        Task::Generate { frames } => (*frames, Guidance::default()),
+        Task::Inbetween {
+            reference,
+            keep,
+            ramp,
+        } => {
+            let y = normalized(metadata, reference)?;
+            let n = y.ncols();
+            if keep.is_empty() {
+                return Err(TaskError::NothingToDo(
+                    "in-betweening needs at least one span of the reference to keep".into(),
+                ));
+            }
+            let keep = check_spans(keep, n)?;
+            let weights = soft_mask(&covered(n, &keep), *ramp);
+            let mask = frame_mask(f, &weights, None);
+            (
+                n,
+                Guidance {
+                    inpainting: Some(Inpainting { reference: y, mask }),
+                    harmonization: None,
+                },
+            )
+        }
+        Task::Expand {
+            reference,
+            prefix,
+            suffix,
+            ramp,
+        } => {
+            let y = normalized(metadata, reference)?;
+            if prefix + suffix == 0 {
+                return Err(TaskError::NothingToDo(
+                    "expansion needs a prefix or a suffix of at least one frame".into(),
+                ));
+            }
+            let n = prefix + y.ncols() + suffix;
+            check_length(n)?;
+            let mut padded = Array2::<f32>::zeros((f, n));
+            padded
+                .slice_mut(ndarray::s![.., *prefix..prefix + y.ncols()])
+                .assign(&y);
+            let keep = covered(n, &[Span::new(*prefix, prefix + y.ncols())]);
+            let mask = frame_mask(f, &soft_mask(&keep, *ramp), None);
+            (
+                n,
+                Guidance {
+                    inpainting: Some(Inpainting {
+                        reference: padded,
+                        mask,
+                    }),
+                    harmonization: None,
+                },
+            )
+        }
+        Task::Compose {
+            reference,
+            joints,
+            root,
+            spans,
+            ramp,
+        } => {
+            let y = normalized(metadata, reference)?;
+            let n = y.ncols();
+            let layout = &metadata.layout;
+            let mut rows: Vec<usize> = joints
+                .iter()
+                .flat_map(|&j| layout.joint_columns(j))
+                .collect();
+            if *root && let Some(r) = &layout.root {
+                rows.extend(0..r.axes.len());
+            }
+            rows.sort_unstable();
+            rows.dedup();
+            if rows.is_empty() {
+                return Err(TaskError::NothingToDo(
+                    "composition needs joints or the root to take from the reference".into(),
+                ));
+            }
+            let weights = if spans.is_empty() {
+                vec![1.0; n]
+            } else {
+                let spans = check_spans(spans, n)?;
+                soft_mask(&covered(n, &spans), *ramp)
+            };
+            let mask = frame_mask(f, &weights, Some(&rows));
+            (
+                n,
+                Guidance {
+                    inpainting: Some(Inpainting { reference: y, mask }),
+                    harmonization: None,
+                },
+            )
+        }
+        Task::Harmonize {
+            content,
+            factor,
+            free_share,
+        } => {
+            let y = normalized(metadata, content)?;
+            if *factor < 1 || *factor > y.ncols().max(1) {
+                return Err(TaskError::Harmonization(format!(
+                    "the down-sampling factor must be between 1 and the content's {} frames, got {factor}",
+                    y.ncols()
+                )));
+            }
+            if !(0.0..=1.0).contains(free_share) {
+                return Err(TaskError::Harmonization(format!(
+                    "the free share of final steps must be between 0 and 1, got {free_share}"
+                )));
+            }
+            (
+                y.ncols(),
+                Guidance {
+                    inpainting: None,
+                    harmonization: Some(Harmonization {
+                        content: y,
+                        factor: *factor,
+                        free_share: *free_share,
+                    }),
+                },
+            )
+        }
+    };
+    check_length(frames)?;
+    let values = request.count.saturating_mul(f).saturating_mul(frames);
+    if values > MAX_VALUES {
+        return Err(TaskError::TooLarge {
+            count: request.count,
+            frames,
+            features: f,
+            gib: values as f64 * 4.0 / (1u64 << 30) as f64,
+        });
+    }
+    Ok(Plan {
+        metadata: metadata.clone(),
+        count: request.count,
+        seed: request.seed,
+        frames,
+        guidance,
+        schedule,
+    })
+}
