@@ -1,0 +1,368 @@
+//! A clip to features: resample, turn into the canonical frame, label contacts, fill columns.
+
+use ndarray::Array2;
+
+use super::error::MotionError;
+use super::layout::{FeatureLayout, RootFeatures};
+use crate::motion::clip::{ChannelClip, LocalMotion};
+use crate::motion::contacts::{ContactConfig, choose_contact_joints, label_contacts};
+use crate::motion::fk::{global_pose, global_poses, skeleton_height};
+use crate::motion::math::{self, IDENTITY, Vec3};
+use crate::motion::resample::resample;
+use crate::motion::rotation::mat_to_6d;
+use crate::motion::skeleton::{Axis, Channel, Skeleton};
+use crate::motion::up::{UP, UpAxis, UpDetection, choose_up, to_canonical};
+
+/// How a clip becomes features.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EncodeOptions {
+    /// Target frame rate; `None` keeps the clip's own.
+    pub fps: Option<f64>,
+    /// Contact joints and threshold.
+    pub contacts: ContactConfig,
+    /// The clip's up axis; `None` detects it from the motion ([`super::up::detect_up`]).
+    pub up: Option<UpAxis>,
+}
+
+impl Default for EncodeOptions {
+    fn default() -> Self {
+        EncodeOptions {
+            fps: Some(30.0),
+            contacts: ContactConfig::default(),
+            up: None,
+        }
+    }
+}
+
+/// A clip turned into features.
+#[derive(Debug, Clone)]
+pub struct EncodedClip {
+    /// The column description (with the skeleton and static data).
+    pub layout: FeatureLayout,
+    /// Unnormalised features `[F, N]`.
+    pub features: Array2<f32>,
+    /// Share of frames in contact for each contact joint.
+    pub contact_share: Vec<f64>,
+    /// The up-axis detection and its evidence (`None` when the axis was given).
+    pub up_detection: Option<UpDetection>,
+    /// The clip is an in-place cycle (its root does not travel) and its contacts were labelled
+    /// relative to the treadmill.
+    pub in_place: bool,
+}
+
+/// The longest feature sequence `encode` makes (over nine hours at 30 fps).
+pub const MAX_FRAMES: usize = 1_000_000;
+
+/// Relative change under which a channel counts as constant.
+const CONSTANT_TOLERANCE: f64 = 1e-9;
+
+/// Whether each channel of the clip (in channel order) changes over the clip.
+fn varying_channels(clip: &ChannelClip) -> Vec<bool> {
+    let width = clip.skeleton.channel_count();
+    let first = clip.frame(0);
+    let mut varies = vec![false; width];
+    for f in 1..clip.frame_count() {
+        for (c, (&v, &v0)) in clip.frame(f).iter().zip(first).enumerate() {
+            if (v - v0).abs() > CONSTANT_TOLERANCE * (1.0 + v0.abs()) {
+                varies[c] = true;
+            }
+        }
+    }
+    varies
+}
+
+/// The joint that carries the clip's travel: the root, or, while a joint has no varying position
+/// channel and exactly one child that has one, that child.
+fn motion_root(skeleton: &Skeleton, varying_position: &[bool]) -> usize {
+    let mut joint = 0;
+    loop {
+        if varying_position[joint] {
+            return joint;
+        }
+        match skeleton.children(joint).as_slice() {
+            [only] if varying_position[*only] => joint = *only,
+            _ => return joint,
+        }
+    }
+}
+
+/// Refuses a resampling to `fps` that would make more than [`MAX_FRAMES`] frames.
+fn check_resampled_length(clip: &ChannelClip, fps: f64) -> Result<(), MotionError> {
+    let resampled = (clip.frame_count() as f64 - 1.0) * fps / clip.fps + 1.0;
+    if resampled.is_nan() || resampled > MAX_FRAMES as f64 {
+        return Err(MotionError::TooManyFrames {
+            frames: clip.frame_count(),
+            from_fps: clip.fps,
+            to_fps: fps,
+            limit: MAX_FRAMES,
+        });
+    }
+    Ok(())
+}
+
+/// Turns a clip into features: resampled to `options.fps`, root displacement and height, 6D
+/// rotations, varying positions and contact labels.
+pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip, MotionError> {
+    if clip.frame_count() == 0 {
+        return Err(MotionError::NoFrames);
+    }
+    let fps = options.fps.unwrap_or(clip.fps);
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(MotionError::BadFrameRate(fps));
+    }
+    for (what, value) in [
+        ("speed threshold", options.contacts.speed_threshold),
+        ("ground fraction", options.contacts.ground_fraction),
+    ] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(MotionError::BadContactSetting { what, value });
+        }
+    }
+    check_resampled_length(clip, fps)?;
+    let skeleton = &clip.skeleton;
+    let varies = varying_channels(clip);
+    let starts = skeleton.channel_starts();
+    let position_varies = |j: usize, axis: Axis| {
+        skeleton.joints[j]
+            .channels
+            .iter()
+            .position(|c| *c == Channel::Position(axis))
+            .is_some_and(|c| varies[starts[j] + c])
+    };
+    let any_position_varies: Vec<bool> = (0..skeleton.len())
+        .map(|j| {
+            [Axis::X, Axis::Y, Axis::Z]
+                .iter()
+                .any(|&a| position_varies(j, a))
+        })
+        .collect();
+    let root_joint = motion_root(skeleton, &any_position_varies);
+
+    let file_local = clip.to_local();
+    let (up, up_detection) = choose_up(&file_local, options.up);
+    let canonical_from_file = up.canonical_from_file();
+    let local = to_canonical(&resample(&file_local, fps), up);
+    let joints = skeleton.len();
+
+    let first = clip.frame(0);
+    let rest_translations: Vec<Vec3> = skeleton
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(j, joint)| {
+            let mut translation = joint.offset;
+            for (c, channel) in joint.channels.iter().enumerate() {
+                if let Channel::Position(axis) = channel {
+                    translation[axis.index()] = first[starts[j] + c];
+                }
+            }
+            if joint.parent.is_none() {
+                translation = math::mat_vec(&canonical_from_file, translation);
+            }
+            translation
+        })
+        .collect();
+    // A motion root below the top joint sits in its container's frame; take that frame (at
+    // frame 0: the container is static) to the canonical one.
+    // Entries within 1e-9 of 0 or +-1 are snapped, so a container turned by a quarter turn
+    // written as text (cos 90 = 6e-17) gives an exact axis permutation.
+    let frame = match skeleton.joints[root_joint].parent {
+        Some(parent) => global_pose(&local, 0).rotations[parent].map(|row| {
+            row.map(|v| {
+                if (v - v.round()).abs() < 1e-9 {
+                    v.round() + 0.0
+                } else {
+                    v
+                }
+            })
+        }),
+        None => IDENTITY,
+    };
+    let to_canonical_axes = if root_joint == 0 {
+        canonical_from_file
+    } else {
+        frame
+    };
+    let mut root_axes: Vec<usize> = skeleton.joints[root_joint]
+        .position_axes()
+        .iter()
+        .map(|a| {
+            let column = [0, 1, 2].map(|i| to_canonical_axes[i][a.index()].abs());
+            (0..3)
+                .max_by(|&x, &y| column[x].total_cmp(&column[y]))
+                .unwrap_or(a.index())
+        })
+        .collect();
+    root_axes.sort_unstable();
+    root_axes.dedup();
+    let root = (!root_axes.is_empty()).then(|| RootFeatures {
+        joint: root_joint,
+        axes: root_axes.into_iter().map(Axis::from_index).collect(),
+        start_position: math::mat_vec(&frame, local.translations[root_joint]),
+        frame,
+    });
+    let rotation_joints: Vec<usize> = (0..joints)
+        .filter(|&j| skeleton.joints[j].rotates())
+        .collect();
+    let position_channels: Vec<(usize, Axis)> = (0..joints)
+        .filter(|&j| j != root_joint || root.is_none())
+        .flat_map(|j| {
+            [Axis::X, Axis::Y, Axis::Z]
+                .into_iter()
+                .filter(move |&a| position_varies(j, a))
+                .map(move |a| (j, a))
+        })
+        .collect();
+
+    let poses = global_poses(&local);
+    let height = skeleton_height(&poses);
+    let contact_joints = match &options.contacts.joints {
+        Some(names) => names
+            .iter()
+            .map(|name| {
+                skeleton
+                    .find(name)
+                    .ok_or_else(|| MotionError::UnknownContactJoint {
+                        name: name.clone(),
+                        available: skeleton
+                            .joints
+                            .iter()
+                            .map(|j| j.name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?,
+        None => choose_contact_joints(skeleton, &poses, height, options.contacts.ground_fraction),
+    };
+
+    let layout = FeatureLayout {
+        skeleton: skeleton.clone(),
+        fps,
+        root,
+        rotation_joints,
+        position_channels,
+        contact_joints,
+        rest_translations,
+        contact_speed_threshold: options.contacts.speed_threshold,
+        skeleton_height: height,
+        up,
+    };
+
+    let filled = fill_features(&layout, &local, &poses);
+    Ok(EncodedClip {
+        layout,
+        features: filled.features,
+        contact_share: filled.contact_share,
+        up_detection,
+        in_place: filled.in_place,
+    })
+}
+
+/// What [`fill_features`] makes.
+struct Filled {
+    features: Array2<f32>,
+    contact_share: Vec<f64>,
+    in_place: bool,
+}
+
+/// Writes the columns of `layout` for `local` (canonical frame, already at the layout's frame
+/// rate, `poses` its global poses), with each contact joint's share of frames in contact.
+fn fill_features(
+    layout: &FeatureLayout,
+    local: &LocalMotion,
+    poses: &[crate::motion::fk::GlobalPose],
+) -> Filled {
+    let frames = local.frame_count();
+    let joints = layout.skeleton.len();
+    let fps = layout.fps;
+    let height = layout.skeleton_height;
+    let mut features = Array2::<f32>::zeros((layout.width(), frames));
+    let mut row = 0;
+    if let Some(root) = &layout.root {
+        for &axis in &root.axes {
+            let a = axis.index();
+            let at = |f: usize| {
+                let t = local.translations[f * joints + root.joint];
+                if root.turned() {
+                    math::mat_vec(&root.frame, t)[a]
+                } else {
+                    t[a]
+                }
+            };
+            for f in 0..frames {
+                features[[row, f]] = if a == UP {
+                    at(f) as f32
+                } else if frames < 2 {
+                    0.0
+                } else {
+                    let g = f.max(1);
+                    (at(g) - at(g - 1)) as f32
+                };
+            }
+            row += 1;
+        }
+    }
+    let root_turn = layout
+        .root
+        .as_ref()
+        .filter(|r| r.turned())
+        .map(|r| (r.joint, r.frame));
+    for &joint in &layout.rotation_joints {
+        for f in 0..frames {
+            let rotation = &local.rotations[f * joints + joint];
+            let six = match root_turn {
+                Some((j, frame)) if j == joint => mat_to_6d(&math::mat_mul(&frame, rotation)),
+                _ => mat_to_6d(rotation),
+            };
+            for (c, value) in six.iter().enumerate() {
+                features[[row + c, f]] = *value as f32;
+            }
+        }
+        row += 6;
+    }
+    for &(joint, axis) in &layout.position_channels {
+        for f in 0..frames {
+            features[[row, f]] = local.translations[f * joints + joint][axis.index()] as f32;
+        }
+        row += 1;
+    }
+    let mut contact_share = Vec::with_capacity(layout.contact_joints.len());
+    let labelled = label_contacts(
+        poses,
+        layout.root.as_ref().map_or(0, |r| r.joint),
+        &layout.contact_joints,
+        fps,
+        height,
+        layout.contact_speed_threshold,
+    );
+    for labels in labelled.labels {
+        contact_share.push(labels.iter().map(|&l| f64::from(l)).sum::<f64>() / frames as f64);
+        for (f, label) in labels.into_iter().enumerate() {
+            features[[row, f]] = label;
+        }
+        row += 1;
+    }
+    debug_assert_eq!(row, layout.width());
+    Filled {
+        features,
+        contact_share,
+        in_place: labelled.in_place,
+    }
+}
+
+/// Encodes a clip of the same skeleton in an existing layout (a model's): resampled to the
+/// layout's frame rate, read with the layout's up axis, with the layout's columns, contact joints
+/// and contact threshold, so the result lines up with the features the model was trained on.
+pub fn encode_for(clip: &ChannelClip, layout: &FeatureLayout) -> Result<Array2<f32>, MotionError> {
+    if clip.frame_count() == 0 {
+        return Err(MotionError::NoFrames);
+    }
+    if let Some(problem) = layout.skeleton.difference(&clip.skeleton) {
+        return Err(MotionError::SkeletonMismatch(problem));
+    }
+    check_resampled_length(clip, layout.fps)?;
+    let local = to_canonical(&resample(&clip.to_local(), layout.fps), layout.up);
+    let poses = global_poses(&local);
+    Ok(fill_features(layout, &local, &poses).features)
+}

@@ -1,0 +1,63 @@
+//! Why a clip could not become features, or features a clip.
+
+use thiserror::Error;
+
+/// Errors while turning a clip into features or features into a clip.
+#[derive(Debug, Error, PartialEq)]
+pub enum MotionError {
+    /// The clip has no frames.
+    #[error("the clip has no frames")]
+    NoFrames,
+    /// A contact joint named in the configuration is not in the skeleton.
+    #[error("contact joint '{name}' is not in the skeleton (joints: {available})")]
+    UnknownContactJoint {
+        /// The name that was asked for.
+        name: String,
+        /// The skeleton's joint names, comma-separated.
+        available: String,
+    },
+    /// A contact threshold or ground fraction that is negative or not a number.
+    #[error("contact {what} must be a finite number >= 0, got {value}")]
+    BadContactSetting {
+        /// Which setting.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// A target frame rate that is zero, negative or not a number.
+    #[error("frame rate must be a positive number, got {0}")]
+    BadFrameRate(f64),
+    /// A feature array whose row count does not match the layout.
+    #[error("features have {got} rows but the layout describes {expected}")]
+    WidthMismatch {
+        /// Rows the layout expects.
+        expected: usize,
+        /// Rows given.
+        got: usize,
+    },
+    /// Resampling would make an absurdly long clip (a frame time of minutes, say).
+    #[error(
+        "resampling {frames} frames from {from_fps} fps to {to_fps} fps would give more than {limit} frames; check the clip's Frame Time"
+    )]
+    TooManyFrames {
+        /// Frames in the clip.
+        frames: usize,
+        /// The clip's rate.
+        from_fps: f64,
+        /// The target rate.
+        to_fps: f64,
+        /// The largest clip accepted.
+        limit: usize,
+    },
+    /// A clip whose skeleton is not the one the features are laid out for.
+    #[error("the clip's skeleton differs from the model's: {0}")]
+    SkeletonMismatch(String),
+    /// A feature array holding NaN or infinity.
+    #[error("features contain a non-finite value at row {row}, frame {frame}")]
+    NonFinite {
+        /// Feature row.
+        row: usize,
+        /// Frame.
+        frame: usize,
+    },
+}

@@ -1,0 +1,163 @@
+//! The feature layout: which column holds what, and the skeleton facts to decode them.
+
+use serde::{Deserialize, Serialize};
+
+use crate::motion::math::{IDENTITY, Mat3, Vec3};
+use crate::motion::skeleton::{Axis, Skeleton};
+use crate::motion::up::{UP, UpAxis};
+
+/// The root's share of the features.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RootFeatures {
+    /// The joint that carries the clip's travel (the BVH root, or its only child when the root is
+    /// a static container such as Bandai-Namco's `joint_Root`).
+    pub joint: usize,
+    /// Its position axes in the canonical frame, in X, Y, Z order: X and Z (the ground plane)
+    /// become displacements, Y (up) stays absolute.
+    pub axes: Vec<Axis>,
+    /// Its local translation at frame 0 (canonical frame), where decoding starts integrating.
+    pub start_position: Vec3,
+    /// The rotation from the joint's parent frame to the canonical frame, when the joint hangs
+    /// below a static container whose frame is turned (a Z-up rig whose `root` container holds
+    /// the pelvis): its translation and rotation features are taken in the canonical frame, so
+    /// height is height whatever the container's axes. Identity (and not written) otherwise.
+    #[serde(default = "identity", skip_serializing_if = "is_identity")]
+    pub frame: Mat3,
+}
+
+fn identity() -> Mat3 {
+    IDENTITY
+}
+
+fn is_identity(m: &Mat3) -> bool {
+    *m == IDENTITY
+}
+
+impl RootFeatures {
+    /// Whether the features need the [`RootFeatures::frame`] turn.
+    pub(crate) fn turned(&self) -> bool {
+        !is_identity(&self.frame)
+    }
+}
+
+/// What one feature column holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ColumnKind {
+    /// Root displacement per frame along X or Z.
+    RootDisplacement(Axis),
+    /// Root height (absolute Y).
+    RootHeight,
+    /// Component 0..6 of a joint's 6D rotation (`R00 R01 R02 R10 R11 R12`).
+    Rotation6d(u8),
+    /// A varying non-root position channel (absolute value).
+    Position(Axis),
+    /// A contact label.
+    Contact,
+}
+
+/// One feature column: which joint and what.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Column {
+    /// Joint index in the skeleton.
+    pub joint: usize,
+    /// What the column holds.
+    pub kind: ColumnKind,
+}
+
+/// Which feature column is which, plus the static data needed to decode.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FeatureLayout {
+    /// The skeleton the features belong to.
+    pub skeleton: Skeleton,
+    /// Frame rate of the feature sequence.
+    pub fps: f64,
+    /// Root features, absent when the motion root has no position channels.
+    pub root: Option<RootFeatures>,
+    /// Joints with a 6D rotation, in column order.
+    pub rotation_joints: Vec<usize>,
+    /// Varying non-root position channels, in column order.
+    pub position_channels: Vec<(usize, Axis)>,
+    /// Contact joints, in column order.
+    pub contact_joints: Vec<usize>,
+    /// Per joint: the OFFSET with constant position channels applied (the translation used when
+    /// no feature animates it).
+    pub rest_translations: Vec<Vec3>,
+    /// Contact threshold in skeleton heights per second.
+    pub contact_speed_threshold: f64,
+    /// The skeleton height the thresholds are relative to (file units).
+    pub skeleton_height: f64,
+    /// The file's up axis: features are in the canonical Y-up frame, and decoding turns them
+    /// back into this one. Model files written before the field existed are Y-up.
+    #[serde(default)]
+    pub up: UpAxis,
+}
+
+impl FeatureLayout {
+    /// Number of feature columns (F).
+    pub fn width(&self) -> usize {
+        self.root.as_ref().map_or(0, |r| r.axes.len())
+            + 6 * self.rotation_joints.len()
+            + self.position_channels.len()
+            + self.contact_joints.len()
+    }
+
+    /// Every column in order.
+    pub fn columns(&self) -> Vec<Column> {
+        let mut out = Vec::with_capacity(self.width());
+        if let Some(root) = &self.root {
+            for &axis in &root.axes {
+                let kind = if axis.index() == UP {
+                    ColumnKind::RootHeight
+                } else {
+                    ColumnKind::RootDisplacement(axis)
+                };
+                out.push(Column {
+                    joint: root.joint,
+                    kind,
+                });
+            }
+        }
+        for &joint in &self.rotation_joints {
+            out.extend((0..6).map(|c| Column {
+                joint,
+                kind: ColumnKind::Rotation6d(c),
+            }));
+        }
+        for &(joint, axis) in &self.position_channels {
+            out.push(Column {
+                joint,
+                kind: ColumnKind::Position(axis),
+            });
+        }
+        for &joint in &self.contact_joints {
+            out.push(Column {
+                joint,
+                kind: ColumnKind::Contact,
+            });
+        }
+        out
+    }
+
+    /// Column indices that belong to `joint` (its rotation, varying positions, root channels and
+    /// contact label).
+    pub fn joint_columns(&self, joint: usize) -> Vec<usize> {
+        self.columns()
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.joint == joint)
+            .map(|(i, _)| i)
+            .collect()
+    }
+
+    /// A short human-readable name of a column, such as `LeftFoot.rot6d[2]`.
+    pub fn column_name(&self, column: &Column) -> String {
+        let joint = &self.skeleton.joints[column.joint].name;
+        match column.kind {
+            ColumnKind::RootDisplacement(axis) => format!("{joint}.d{axis}"),
+            ColumnKind::RootHeight => format!("{joint}.Y"),
+            ColumnKind::Rotation6d(c) => format!("{joint}.rot6d[{c}]"),
+            ColumnKind::Position(axis) => format!("{joint}.{axis}position"),
+            ColumnKind::Contact => format!("{joint}.contact"),
+        }
+    }
+}

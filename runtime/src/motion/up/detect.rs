@@ -1,0 +1,259 @@
+//! Reading the up axis from the motion: limbs hang under gravity, so the chain ends sit below
+//! the body's centre; up is the signed axis most opposed to them.
+
+use serde::{Deserialize, Serialize};
+
+use super::UpAxis;
+use crate::motion::clip::LocalMotion;
+use crate::motion::contacts::travelling_root;
+use crate::motion::fk::global_poses;
+use crate::motion::math::{self, Vec3};
+use crate::motion::skeleton::Skeleton;
+
+/// How sure [`detect_up`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Confidence {
+    /// The evidence is clear.
+    Sure,
+    /// The evidence is weak; check the figure and pass the axis explicitly if it is wrong.
+    Unsure,
+}
+
+/// What [`detect_up`] found, with its evidence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UpDetection {
+    /// The detected up axis.
+    pub axis: UpAxis,
+    /// How sure the detection is.
+    pub confidence: Confidence,
+    /// Cosine between the limbs' mean hanging direction and the detected down axis (1 = exactly
+    /// along it).
+    pub alignment: f64,
+    /// Length of the mean hanging vector relative to the figure's size (its mean bounding-box
+    /// diagonal).
+    pub strength: f64,
+    /// The mean hanging vector in file coordinates, relative to the figure's size.
+    pub hang: Vec3,
+    /// Frames the evidence comes from.
+    pub frames: usize,
+    /// Why the detection is unsure, in plain words (empty when sure).
+    pub doubts: Vec<String>,
+}
+
+impl UpDetection {
+    /// One line of evidence for a person: `+Z (sure: limbs hang along -Z, cosine 0.97, ...)`.
+    pub fn describe(&self) -> String {
+        let h = self.hang;
+        let sure = match self.confidence {
+            Confidence::Sure => "sure".to_string(),
+            Confidence::Unsure => format!("UNSURE: {}", self.doubts.join("; ")),
+        };
+        format!(
+            "{} ({sure}; limbs hang along ({:.2}, {:.2}, {:.2}), cosine {:.2} with {}, strength {:.2} of the figure's size, {} frames)",
+            self.axis,
+            h[0],
+            h[1],
+            h[2],
+            self.alignment,
+            opposite(self.axis),
+            self.strength,
+            self.frames,
+        )
+    }
+}
+
+fn opposite(axis: UpAxis) -> UpAxis {
+    match axis {
+        UpAxis::PosX => UpAxis::NegX,
+        UpAxis::NegX => UpAxis::PosX,
+        UpAxis::PosY => UpAxis::NegY,
+        UpAxis::NegY => UpAxis::PosY,
+        UpAxis::PosZ => UpAxis::NegZ,
+        UpAxis::NegZ => UpAxis::PosZ,
+    }
+}
+
+/// Below this cosine between the hanging direction and the chosen axis the detection is unsure
+/// (the figure is tilted, or lies down with its limbs spread).
+pub const MIN_ALIGNMENT: f64 = 0.85;
+/// Below this hanging length (share of the figure's size) the detection is unsure.
+pub const MIN_STRENGTH: f64 = 0.05;
+/// Fewer frames than this (a third of a second at 30 fps) make the detection unsure: a pose or
+/// two can be anything.
+pub const MIN_FRAMES: usize = 10;
+
+/// Each chain end's weight: the length of the limb that carries it, from the nearest joint where
+/// the skeleton branches (or `top`) to the end (its End Site included). Fingers and toes weigh
+/// little, legs and tails a lot. Only chain ends below `top` count.
+fn limb_weights(skeleton: &Skeleton, top: usize) -> Vec<(usize, f64)> {
+    let children: Vec<usize> = (0..skeleton.len())
+        .map(|j| skeleton.children(j).len())
+        .collect();
+    skeleton
+        .leaves()
+        .into_iter()
+        .map(|leaf| {
+            let joint = &skeleton.joints[leaf];
+            let mut length = joint.end_site.map_or(0.0, math::norm);
+            let mut j = leaf;
+            while let Some(p) = skeleton.joints[j].parent {
+                if j == top {
+                    break;
+                }
+                length += math::norm(skeleton.joints[j].offset);
+                if children[p] > 1 || p == top {
+                    break;
+                }
+                j = p;
+            }
+            (leaf, length)
+        })
+        .filter(|&(leaf, _)| is_below(skeleton, leaf, top))
+        .collect()
+}
+
+/// Whether `joint` is `top` or below it.
+fn is_below(skeleton: &Skeleton, joint: usize, top: usize) -> bool {
+    let mut j = joint;
+    loop {
+        if j == top {
+            return true;
+        }
+        match skeleton.joints[j].parent {
+            Some(p) => j = p,
+            None => return false,
+        }
+    }
+}
+
+/// Detects the up axis of a clip (in its file's frame) from where its limbs hang; see the module
+/// documentation for the rule.
+pub fn detect_up(motion: &LocalMotion) -> UpDetection {
+    let skeleton = &motion.skeleton;
+    let poses = global_poses(motion);
+    // A static container above the hips (some rigs) is no part of the body.
+    let top = travelling_root(skeleton, &poses);
+    let weights = limb_weights(skeleton, top);
+    let in_body: Vec<bool> = (0..skeleton.len())
+        .map(|j| is_below(skeleton, j, top))
+        .collect();
+    let total_weight: f64 = weights.iter().map(|(_, w)| w).sum();
+    let mut hang = [0.0; 3];
+    let mut size = 0.0;
+    for pose in &poses {
+        // The body's centre: bone midpoints weighted by bone length.
+        let mut centre = [0.0; 3];
+        let mut mass = 0.0;
+        for (j, joint) in skeleton.joints.iter().enumerate() {
+            if let Some(p) = joint
+                .parent
+                .filter(|_| j != top && is_below(skeleton, j, top))
+            {
+                let length = math::norm(math::sub(pose.joints[j], pose.joints[p]));
+                let mid = math::scale(math::add(pose.joints[j], pose.joints[p]), 0.5);
+                centre = math::add(centre, math::scale(mid, length));
+                mass += length;
+            }
+        }
+        let centre = if mass > 0.0 {
+            math::scale(centre, 1.0 / mass)
+        } else {
+            pose.joints.first().copied().unwrap_or([0.0; 3])
+        };
+        if total_weight > 0.0 {
+            for &(leaf, weight) in &weights {
+                let d = math::sub(pose.contact_point(leaf), centre);
+                hang = math::add(hang, math::scale(d, weight / total_weight));
+            }
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        let body = pose
+            .joints
+            .iter()
+            .enumerate()
+            .filter(|&(j, _)| in_body[j])
+            .map(|(_, p)| *p)
+            .chain(
+                pose.end_sites
+                    .iter()
+                    .filter(|(j, _)| in_body[*j])
+                    .map(|(_, p)| *p),
+            );
+        for p in body {
+            for i in 0..3 {
+                lo[i] = lo[i].min(p[i]);
+                hi[i] = hi[i].max(p[i]);
+            }
+        }
+        size += math::norm(math::sub(hi, lo));
+    }
+    let frames = poses.len();
+    let (hang, size) = if frames > 0 {
+        (math::scale(hang, 1.0 / frames as f64), size / frames as f64)
+    } else {
+        ([0.0; 3], 0.0)
+    };
+    let hang = if size > 0.0 && size.is_finite() {
+        math::scale(hang, 1.0 / size)
+    } else {
+        [0.0; 3]
+    };
+    let length = math::norm(hang);
+    // Up is the signed axis most opposed to the hanging direction; ties and a zero vector give +Y.
+    let axis = UpAxis::ALL
+        .into_iter()
+        .map(|a| (a, -math::dot(a.direction(), hang)))
+        .fold((UpAxis::PosY, f64::NEG_INFINITY), |best, (a, s)| {
+            if s > best.1 + 1e-12 || (a == UpAxis::PosY && s >= best.1 - 1e-12) {
+                (a, s)
+            } else {
+                best
+            }
+        })
+        .0;
+    let alignment = if length > 0.0 && length.is_finite() {
+        -math::dot(axis.direction(), hang) / length
+    } else {
+        0.0
+    };
+    let mut doubts = Vec::new();
+    if frames < MIN_FRAMES {
+        doubts.push(format!(
+            "only {frames} frame(s), fewer than {MIN_FRAMES}: a pose alone can be anything"
+        ));
+    }
+    if alignment < MIN_ALIGNMENT {
+        doubts.push(format!(
+            "the limbs hang at an angle to every axis (cosine {alignment:.2} < {MIN_ALIGNMENT}): tilted or lying down?"
+        ));
+    }
+    if length < MIN_STRENGTH {
+        doubts.push(format!(
+            "the limbs barely hang below the body ({length:.3} < {MIN_STRENGTH} of its size)"
+        ));
+    }
+    UpDetection {
+        axis,
+        confidence: if doubts.is_empty() {
+            Confidence::Sure
+        } else {
+            Confidence::Unsure
+        },
+        alignment,
+        strength: length,
+        hang,
+        frames,
+        doubts,
+    }
+}
+
+/// The up axis to use for a clip: `explicit` when given, else the detected one.
+pub fn choose_up(motion: &LocalMotion, explicit: Option<UpAxis>) -> (UpAxis, Option<UpDetection>) {
+    match explicit {
+        Some(axis) => (axis, None),
+        None => {
+            let found = detect_up(motion);
+            (found.axis, Some(found))
+        }
+    }
+}
