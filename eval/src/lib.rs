@@ -91,9 +91,13 @@ pub enum EvalError {
     },
 }
 
+/// Metric features of one motion, laid out `[N, D]`: one row per frame (the transpose of the
+/// model's `[F, N]` features, since every metric compares frames).
+pub type FrameRows = Array2<f64>;
+
 /// The metric features of a motion: rows are frames, columns every 6D rotation component and
 /// every contact label of `layout`, from features `[F, N]` in file units.
-pub fn metric_features(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> Array2<f64> {
+pub fn metric_features(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> FrameRows {
     let columns: Vec<usize> = layout
         .columns()
         .iter()
@@ -265,7 +269,7 @@ fn score_sample(sample: ArrayView2<'_, f64>, clip: ArrayView2<'_, f64>) -> Sampl
 /// spreading the samples over `threads` threads.
 pub fn evaluate(
     clip: ArrayView2<'_, f64>,
-    samples: &[Array2<f64>],
+    samples: &[FrameRows],
     threads: usize,
 ) -> Result<Report, EvalError> {
     if samples.is_empty() {

@@ -55,5 +55,3 @@ pub fn glyph(c: char) -> [u8; 7] {
 
 /// Width of a glyph cell in pixels at scale 1 (5 columns and a gap).
 pub const ADVANCE: usize = 6;
-/// Height of a glyph in pixels at scale 1.
-pub const HEIGHT: usize = 7;

@@ -123,3 +123,27 @@ pub fn read_features(path: &Path) -> Result<(Array3<f32>, f64), FeaturesFileErro
     }
     Ok((out, doc.fps))
 }
+
+#[cfg(all(test, feature = "bvh"))]
+mod tests {
+    use super::*;
+    use crate::motion::{EncodeOptions, encode};
+
+    #[test]
+    fn written_features_read_back_exactly() {
+        let clip = crate::bvh::parse_bvh(
+            "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n JOINT Leg\n {\n  OFFSET 0 -1 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n  End Site\n  {\n   OFFSET 0 -1 0\n  }\n }\n}\nMOTION\nFrames: 3\nFrame Time: 0.1\n0 2 0 0 0 0 10 0 0\n0.5 2 0 5 0 0 20 0 0\n1 2.1 0 10 0 0 30 0 0\n",
+            "clip.bvh",
+        )
+        .unwrap();
+        let encoded = encode(&clip, &EncodeOptions::default()).unwrap();
+        let batch = encoded.features.clone().insert_axis(ndarray::Axis(0));
+        let path =
+            std::env::temp_dir().join(format!("sinmdm-features-{}.json", std::process::id()));
+        write_features(&path, &encoded.layout, batch.view()).unwrap();
+        let (back, fps) = read_features(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(back, batch);
+        assert_eq!(fps, encoded.layout.fps);
+    }
+}

@@ -24,7 +24,7 @@
 //!     steps: Some(10),
 //! };
 //! let generated = sinmdm::run(&mut model, &request, &mut |_done, _steps| ControlFlow::Continue(()))?;
-//! let poses = generated.poses(0)?; // per frame: root position, local rotations [x, y, z, w]
+//! let poses = generated.poses(0)?; // per frame: root position, local rotations, translations
 //! assert_eq!(poses.len(), 60);
 //! assert_eq!(poses[0].rotations.len(), model.skeleton().len());
 //! # Ok(())
@@ -55,7 +55,7 @@ pub mod tasks;
 pub use diffusion::{Denoiser, Sampler, SamplerError};
 pub use model::{Model, ModelError, ModelOptions};
 pub use model_file::ModelMetadata;
-pub use motion::{Joint, Pose, Skeleton, UpAxis};
+pub use motion::{Joint, Pose, Quaternion, Skeleton, UpAxis};
 pub use onnxruntime::{
     ONNXRUNTIME_VERSION, OnnxRuntime, RuntimeLibraryError, init as init_onnxruntime,
     load_onnxruntime,

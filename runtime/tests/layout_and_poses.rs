@@ -4,7 +4,7 @@
 mod common;
 
 use sinmdm::bvh::read_bvh;
-use sinmdm::motion::math::{self, mat_from_quat};
+use sinmdm::motion::math::{self, mat_from_quat_wxyz};
 use sinmdm::motion::{
     ColumnKind, EncodeOptions, FeatureLayout, Normalizer, decode, encode, global_poses, poses,
 };
@@ -40,11 +40,34 @@ fn normalised_features_decode_after_denormalising() {
     let encoded = encode(&clip, &EncodeOptions::default()).unwrap();
     let stats = Normalizer::fit(encoded.features.view());
     let z = stats.normalize(encoded.features.view());
-    // Standardised rows have zero mean; varying rows have unit variance.
-    for row in z.rows() {
-        let mean = row.mean().unwrap();
-        assert!(mean.abs() < 1e-3, "{mean}");
+    // Standardised rows have zero mean; rows whose spread is above the std floor have unit
+    // variance, the floored (near-constant) ones less.
+    let mut unit = 0;
+    for (r, (zr, xr)) in z
+        .rows()
+        .into_iter()
+        .zip(encoded.features.rows())
+        .enumerate()
+    {
+        let mean = f64::from(zr.mean().unwrap());
+        assert!(mean.abs() < 1e-3, "row {r}: mean {mean}");
+        let variance = zr.mapv(|v| (f64::from(v) - mean).powi(2)).mean().unwrap();
+        let raw_std = xr.mapv(f64::from).std(0.0);
+        if raw_std >= f64::from(stats.std[r]) * (1.0 - 1e-4) {
+            assert!(
+                (variance - 1.0).abs() < 1e-3,
+                "row {r}: variance {variance}"
+            );
+            unit += 1;
+        } else {
+            assert!(variance < 1.0, "floored row {r}: variance {variance}");
+        }
     }
+    assert!(
+        unit > z.nrows() / 2,
+        "only {unit} of {} rows vary",
+        z.nrows()
+    );
     let back = stats.denormalize(z.view());
     let a = global_poses(&decode(&encoded.layout, encoded.features.view()).unwrap());
     let b = global_poses(&decode(&encoded.layout, back.view()).unwrap());
@@ -65,14 +88,18 @@ fn engine_poses_rebuild_the_decoded_skeleton() {
     let frames = poses(&motion);
     assert_eq!(frames.len(), motion.frame_count());
     let reference = global_poses(&motion);
+    // The clip is 120 fps and the features 30 fps: every 4th original frame, whose root the
+    // poses must put where the file has it.
+    let original = global_poses(&clip.to_local());
+    let height = encoded.layout.skeleton_height;
     let skeleton = &motion.skeleton;
-    for (pose, want) in frames.iter().zip(&reference) {
+    for (f, (pose, want)) in frames.iter().zip(&reference).enumerate() {
         // Independent FK from the quaternions ([x, y, z, w]) and translations alone.
         let mut positions: Vec<[f64; 3]> = Vec::new();
         let mut rotations = Vec::new();
         for (j, joint) in skeleton.joints.iter().enumerate() {
-            let [x, y, z, w] = pose.rotations[j].map(f64::from);
-            let local = mat_from_quat([w, x, y, z]);
+            let q = pose.rotations[j];
+            let local = mat_from_quat_wxyz([q.w, q.x, q.y, q.z].map(f64::from));
             let t = pose.translations[j].map(f64::from);
             let (p, r) = match joint.parent {
                 None => (t, local),
@@ -84,7 +111,12 @@ fn engine_poses_rebuild_the_decoded_skeleton() {
             positions.push(p);
             rotations.push(r);
         }
-        assert_eq!(pose.root_position, pose.translations[0]);
+        let root = pose.root_position.map(f64::from);
+        let file_root = original[4 * f].joints[0];
+        assert!(
+            math::norm(math::sub(root, file_root)) < 1e-4 * height,
+            "frame {f}: root {root:?}, file {file_root:?}"
+        );
         for (p, q) in positions.iter().zip(&want.joints) {
             assert!(math::norm(math::sub(*p, *q)) < 1e-4 * encoded.layout.skeleton_height);
         }

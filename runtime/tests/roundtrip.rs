@@ -97,6 +97,12 @@ fn our_reader_agrees_with_bvh_anim() {
         let their_frames: Vec<Vec<f32>> = theirs.frames().map(|f| f.as_slice().to_vec()).collect();
         assert_eq!(their_frames.len(), ours.frame_count());
         for (f, frame) in their_frames.iter().enumerate() {
+            assert_eq!(
+                ours.frame(f).len(),
+                frame.len(),
+                "{} frame {f}",
+                path.display()
+            );
             for (a, b) in ours.frame(f).iter().zip(frame) {
                 assert!((a - f64::from(*b)).abs() <= 1e-6 * (1.0 + a.abs()));
             }

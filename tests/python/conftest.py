@@ -1,4 +1,4 @@
-"""Shared fixtures: the project root, the release binary and the clips to check."""
+"""Shared fixtures: the project root, the release binaries (built fresh) and the clips to check."""
 
 import pathlib
 import subprocess
@@ -9,21 +9,42 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SINMDM = ROOT / "target" / "release" / "sinmdm"
+TRAIN = ROOT / "target" / "release" / "sinmdm-train"
+EXPORT = ROOT / "target" / "release" / "sinmdm-export"
+SHIPPED_CLIPS = ["fox_survey_khronos.bvh", "human_dance_rokoko_jesse.bvh",
+                 "human_hop_cmu_131_03.bvh", "human_walk_cmu_131_01.bvh"]
+
+
+def tiny_config(steps):
+    """configs/tiny.yaml with its training steps set to `steps` (an error if the file no longer
+    says `steps: 300`, so a test cannot silently train for the full length)."""
+    text = (ROOT / "configs" / "tiny.yaml").read_text()
+    assert "steps: 300" in text, "configs/tiny.yaml no longer trains 300 steps; update the tests"
+    return text.replace("steps: 300", f"steps: {steps}")
 
 
 def clips():
     """The shipped clips, plus every clip of the shared data folder beside the checkout."""
     shipped = sorted((ROOT / "tests" / "data" / "bvh").glob("*.bvh"))
     names = {p.name for p in shipped}
+    missing = [n for n in SHIPPED_CLIPS if n not in names]
+    assert not missing, f"tests/data/bvh lacks {missing}: a test over the clips would check nothing"
     shared = sorted((ROOT.parent / "shared" / "data" / "bvh").glob("*.bvh"))
     return shipped + [p for p in shared if p.name not in names]
+
+
+@pytest.fixture(scope="session", autouse=True)
+def release_build():
+    """Builds the workspace in release before any test, so no test skips for a missing binary
+    or runs a stale one (cargo does nothing when the binaries are up to date)."""
+    subprocess.run(["cargo", "build", "--release", "--workspace", "--quiet"], cwd=ROOT, check=True)
+    for exe in (SINMDM, TRAIN, EXPORT):
+        assert exe.is_file(), f"{exe} is missing after the release build"
 
 
 @pytest.fixture(scope="session")
 def sinmdm():
     """Runs the release `sinmdm` binary and returns its standard output."""
-    if not SINMDM.exists():
-        subprocess.run(["cargo", "build", "--release", "-p", "sinmdm"], cwd=ROOT, check=True)
 
     def run(*args):
         done = subprocess.run([str(SINMDM), *map(str, args)], capture_output=True, text=True)

@@ -9,19 +9,15 @@ import onnx
 import onnxruntime as ort
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, EXPORT, TRAIN, tiny_config
 
-TRAIN = ROOT / "target" / "release" / "sinmdm-train"
-EXPORT = ROOT / "target" / "release" / "sinmdm-export"
 
 
 @pytest.fixture(scope="module")
 def model_file(tmp_path_factory):
-    if not TRAIN.exists() or not EXPORT.exists():
-        pytest.skip("build the workspace in release first (scripts/setup.sh)")
     work = tmp_path_factory.mktemp("export")
     config = work / "tiny.yaml"
-    text = (ROOT / "configs" / "tiny.yaml").read_text().replace("steps: 300", "steps: 5")
+    text = tiny_config(5)
     config.write_text(text)
     clip = ROOT / "tests" / "data" / "bvh" / "fox_survey_khronos.bvh"
     subprocess.run([TRAIN, clip, "--config", config, "--out", work / "run"], check=True,
@@ -65,10 +61,8 @@ def test_runs_with_dynamic_batch_and_length(model_file):
 
 def test_train_export_flag_and_info(tmp_path):
     """`sinmdm-train --export` writes the model at the end of training; `sinmdm info` reads it."""
-    if not TRAIN.exists():
-        pytest.skip("build the workspace in release first (scripts/setup.sh)")
     config = tmp_path / "tiny.yaml"
-    config.write_text((ROOT / "configs" / "tiny.yaml").read_text().replace("steps: 300", "steps: 3"))
+    config.write_text(tiny_config(3))
     clip = ROOT / "tests" / "data" / "bvh" / "human_walk_cmu_131_01.bvh"
     out = tmp_path / "models" / "walk.onnx"
     subprocess.run([TRAIN, clip, "--config", config, "--out", tmp_path / "run", "--export", out],

@@ -45,8 +45,6 @@ def python(*args):
 
 @pytest.fixture(scope="module")
 def references(tmp_path_factory):
-    if not SINMDM.exists():
-        pytest.skip("build the workspace in release first (scripts/setup.sh)")
     work = tmp_path_factory.mktemp("parity")
     out = {}
     for name, clip in [("walk", WALK), ("hop", HOP)]:
@@ -112,8 +110,6 @@ def run_fails(tmp_path, *args):
 
 
 def test_bad_input_is_refused_with_a_clear_error(tmp_path):
-    if not SINMDM.exists():
-        pytest.skip("build the workspace in release first (scripts/setup.sh)")
     out = tmp_path / "out" / "x.bvh"
     err = run_fails(tmp_path, "generate", "-m", tmp_path / "nothing.onnx", "-o", out)
     assert "nothing.onnx' does not exist" in err
@@ -176,8 +172,6 @@ def test_bad_input_is_refused_with_a_clear_error(tmp_path):
 
 
 def test_outputs_are_bvh_files_of_the_model_skeleton(tmp_path):
-    if not SINMDM.exists():
-        pytest.skip("build the workspace in release first (scripts/setup.sh)")
     import bvhio
 
     out = tmp_path / "crowd.bvh"

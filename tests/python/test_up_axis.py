@@ -8,9 +8,8 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import ROOT, bvhio_joint_positions, clips
+from conftest import ROOT, TRAIN, bvhio_joint_positions, clips, tiny_config
 
-TRAIN = ROOT / "target" / "release" / "sinmdm-train"
 WALK = ROOT / "tests" / "data" / "bvh" / "human_walk_cmu_131_01.bvh"
 # Canonical Y-up to Z-up: (x, y, z) -> (x, -z, y).
 Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
@@ -65,7 +64,7 @@ def test_training_and_every_task_on_a_z_up_clip(tmp_path, sinmdm):
     zup = tmp_path / "walk_zup.bvh"
     sinmdm("reorient", WALK, "--to", "z", "-o", zup)
     config = tmp_path / "tiny.yaml"
-    config.write_text((ROOT / "configs" / "tiny.yaml").read_text().replace("steps: 300", "steps: 20"))
+    config.write_text(tiny_config(20))
     model = tmp_path / "zup.onnx"
     done = subprocess.run([TRAIN, zup, "--config", config, "--out", tmp_path / "run",
                            "--export", model, "--threads", "2"], capture_output=True, text=True)

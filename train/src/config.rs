@@ -83,6 +83,19 @@ pub struct DataConfig {
 }
 
 impl TrainConfig {
+    /// Why a checkpoint trained under `self` cannot continue under `asked`: the first setting
+    /// (by its YAML key) that differs, comparing the whole configurations except
+    /// `training.steps` and `training.checkpoint_every`, the only two a resume may change.
+    pub fn resume_difference(&self, asked: &TrainConfig) -> Option<String> {
+        let mut asked = asked.clone();
+        asked.training.steps = self.training.steps;
+        asked.training.checkpoint_every = self.training.checkpoint_every;
+        let as_value = |c: &TrainConfig| serde_json::to_value(c).unwrap_or_default();
+        first_difference(&as_value(self), &as_value(&asked), String::new()).map(|(key, a, b)| {
+            format!("the checkpoint was trained with {key} = {a}, the config asks for {b}")
+        })
+    }
+
     /// Reads and checks a YAML file.
     pub fn load(path: &Path) -> Result<TrainConfig, TrainError> {
         let text = std::fs::read_to_string(path).map_err(|source| TrainError::Io {
@@ -197,6 +210,36 @@ impl ModelConfig {
     }
 }
 
+/// The first leaf (dotted key, saved value, asked value) where two JSON trees differ.
+fn first_difference(
+    a: &serde_json::Value,
+    b: &serde_json::Value,
+    key: String,
+) -> Option<(String, String, String)> {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
+            keys.sort();
+            keys.dedup();
+            keys.into_iter().find_map(|k| {
+                let child = if key.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{key}.{k}")
+                };
+                first_difference(
+                    x.get(k).unwrap_or(&Value::Null),
+                    y.get(k).unwrap_or(&Value::Null),
+                    child,
+                )
+            })
+        }
+        _ if a == b => None,
+        _ => Some((key, a.to_string(), b.to_string())),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -250,5 +293,25 @@ mod tests {
         let err =
             TrainConfig::parse(&TINY.replacen("batch_size: 4", "batch_size: -4", 1)).unwrap_err();
         assert!(err.contains("batch_size"), "{err}");
+    }
+
+    #[test]
+    fn resume_compares_every_setting_but_the_step_counts() {
+        let saved = TrainConfig::parse(include_str!("../../configs/tiny.yaml")).unwrap();
+        let mut asked = saved.clone();
+        asked.training.steps += 100;
+        asked.training.checkpoint_every += 1;
+        assert_eq!(saved.resume_difference(&asked), None);
+        // A setting the old hand-written list did not name is still caught.
+        asked.data.contact_speed *= 2.0;
+        let message = saved.resume_difference(&asked).expect("a difference");
+        assert!(message.contains("data.contact_speed"), "{message}");
+        let mut asked = saved.clone();
+        asked.model.heads *= 2;
+        let message = saved.resume_difference(&asked).expect("a difference");
+        assert!(
+            message.starts_with("the checkpoint was trained with model.heads = "),
+            "{message}"
+        );
     }
 }

@@ -15,6 +15,7 @@ pub mod loss_log;
 pub mod loss_plot;
 pub mod memory;
 pub mod model;
+mod shards;
 pub mod trainer;
 
 pub use config::TrainConfig;

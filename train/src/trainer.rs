@@ -5,10 +5,9 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use burn::module::{Module, ModuleMapper, ModuleVisitor, Param};
-use burn::nn::loss::{MseLoss, Reduction};
-use burn::optim::{AdamWConfig, GradientsParams, ModuleOptimizer};
-use burn::tensor::{Device, Distribution, Tensor, TensorData};
+use burn::module::Module;
+use burn::optim::{AdamWConfig, ModuleOptimizer};
+use burn::tensor::{Device, Tensor, TensorData};
 
 use sinmdm::diffusion::Schedule;
 
@@ -18,8 +17,8 @@ use crate::config::TrainConfig;
 use crate::data::make_batch;
 use crate::error::{TrainError, io};
 use crate::loss_log::LossLog;
-use crate::model::dropout::DropoutKey;
 use crate::model::{QnaUnet, on_cpu};
+use crate::shards::sharded_gradients;
 
 /// Copy of the clip inside the run folder, so a run resumes without the original file.
 pub const CLIP_COPY: &str = "clip.bvh";
@@ -108,200 +107,9 @@ pub fn optimisation_step(
     }
 }
 
-/// The batch's mean loss and its gradients (none when the loss is not finite), computed in
-/// `shards` shards on as many threads.
-fn sharded_gradients(
-    model: &QnaUnet,
-    x_t: Tensor<3>,
-    t: Tensor<1>,
-    x0: Tensor<3>,
-    shards: usize,
-) -> (f64, Option<GradientsParams>) {
-    let batch = x_t.dims()[0];
-    let seed = dropout_seed(&x_t.device());
-    let shards = shard_ranges(batch, shards);
-    let shard_step = |&(first, len): &(usize, usize)| {
-        // Each shard differentiates its own leaves (same parameter ids and values): shards
-        // sharing leaf nodes share one autodiff tape, which the first backward pass consumes.
-        let model = model.clone().map(&mut FreshLeaves);
-        let key = DropoutKey {
-            seed,
-            first_item: first,
-        };
-        let prediction = model.forward_training(
-            x_t.clone().narrow(0, first, len),
-            t.clone().narrow(0, first, len),
-            Some(key),
-        );
-        let target = x0.clone().narrow(0, first, len);
-        let loss = MseLoss::new().forward(prediction, target, Reduction::Mean);
-        let share = len as f64 / batch as f64;
-        let value = f64::from(loss.clone().into_scalar::<f32>()) * share;
-        if !value.is_finite() {
-            return (value, None);
-        }
-        let grads = GradientsParams::from_grads((loss * share).backward(), &model);
-        (value, Some(grads))
-    };
-    // Plain threads, not rayon tasks: a shard blocks on burn's graph lock, and a rayon worker
-    // blocked there could be the one another shard's matrix product is waiting for.
-    let results: Vec<(f64, Option<GradientsParams>)> = std::thread::scope(|scope| {
-        let others: Vec<_> = shards[1..]
-            .iter()
-            .map(|shard| scope.spawn(move || shard_step(shard)))
-            .collect();
-        let mut results = vec![shard_step(&shards[0])];
-        results.extend(
-            others
-                .into_iter()
-                .map(|handle| handle.join().expect("a training shard panicked")),
-        );
-        results
-    });
-    let value: f64 = results.iter().map(|(v, _)| v).sum();
-    if !value.is_finite() {
-        return (value, None);
-    }
-    let mut parts = results.into_iter().filter_map(|(_, g)| g);
-    let mut grads = parts.next().expect("a batch has at least one shard");
-    for part in parts {
-        model.visit(&mut AddGradients {
-            total: &mut grads,
-            part,
-        });
-    }
-    (value, Some(grads))
-}
-
-/// `(first item, items)` of each shard of a batch split `threads` ways, larger shards first.
-fn shard_ranges(batch: usize, threads: usize) -> Vec<(usize, usize)> {
-    let shards = threads.clamp(1, batch.max(1));
-    let (size, extra) = (batch / shards, batch % shards);
-    let mut first = 0;
-    (0..shards)
-        .map(|i| {
-            let len = size + usize::from(i < extra);
-            first += len;
-            (first - len, len)
-        })
-        .collect()
-}
-
-/// The dropout seed of a step, from the device generator (which the trainer seeds every step).
-fn dropout_seed(device: &Device) -> u64 {
-    let draw = Tensor::<1>::random([2], Distribution::Default, device)
-        .into_data()
-        .try_to_vec::<f32>()
-        .expect("f32 draw");
-    (u64::from(draw[0].to_bits()) << 32) | u64::from(draw[1].to_bits())
-}
-
-/// Replaces every parameter's autodiff node with a new leaf of the same id and value.
-struct FreshLeaves;
-
-impl ModuleMapper for FreshLeaves {
-    fn map_float<const D: usize>(&mut self, param: Param<Tensor<D>>) -> Param<Tensor<D>> {
-        param.map(|tensor| tensor.detach().require_grad())
-    }
-}
-
-/// Adds the gradients of `part` to `total`, parameter by parameter.
-struct AddGradients<'a> {
-    total: &'a mut GradientsParams,
-    part: GradientsParams,
-}
-
-impl ModuleVisitor for AddGradients<'_> {
-    fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
-        if let Some(grad) = self.part.remove::<D>(param.id) {
-            let sum = match self.total.remove::<D>(param.id) {
-                Some(total) => total + grad,
-                None => grad,
-            };
-            self.total.register(param.id, sum);
-        }
-    }
-}
-
 /// The schedule of a configuration.
 fn schedule(config: &TrainConfig) -> Schedule {
     Schedule::cosine(config.diffusion.steps).expect("validated configuration has T >= 2")
-}
-
-/// The fields two configurations must share for a checkpoint of one to continue under the
-/// other: everything except the step count and checkpoint interval.
-fn incompatible_field(saved: &TrainConfig, asked: &TrainConfig) -> Option<String> {
-    let m = (&saved.model, &asked.model);
-    let checks: [(&str, String, String); 12] = [
-        (
-            "model.channels",
-            m.0.channels.to_string(),
-            m.1.channels.to_string(),
-        ),
-        ("model.heads", m.0.heads.to_string(), m.1.heads.to_string()),
-        (
-            "model.window",
-            m.0.window.to_string(),
-            m.1.window.to_string(),
-        ),
-        (
-            "model.dropout",
-            m.0.dropout.to_string(),
-            m.1.dropout.to_string(),
-        ),
-        (
-            "diffusion.steps",
-            saved.diffusion.steps.to_string(),
-            asked.diffusion.steps.to_string(),
-        ),
-        (
-            "training.batch_size",
-            saved.training.batch_size.to_string(),
-            asked.training.batch_size.to_string(),
-        ),
-        (
-            "training.learning_rate",
-            saved.training.learning_rate.to_string(),
-            asked.training.learning_rate.to_string(),
-        ),
-        (
-            "training.lr_decay",
-            saved.training.lr_decay.to_string(),
-            asked.training.lr_decay.to_string(),
-        ),
-        (
-            "training.weight_decay",
-            saved.training.weight_decay.to_string(),
-            asked.training.weight_decay.to_string(),
-        ),
-        (
-            "training.resample_min/max",
-            format!(
-                "{}..{}",
-                saved.training.resample_min, saved.training.resample_max
-            ),
-            format!(
-                "{}..{}",
-                asked.training.resample_min, asked.training.resample_max
-            ),
-        ),
-        (
-            "training.seed",
-            saved.training.seed.to_string(),
-            asked.training.seed.to_string(),
-        ),
-        (
-            "data",
-            format!("{:?}", saved.data),
-            format!("{:?}", asked.data),
-        ),
-    ];
-    checks
-        .into_iter()
-        .find(|(_, a, b)| a != b)
-        .map(|(key, a, b)| {
-            format!("the checkpoint was trained with {key} = {a}, the config asks for {b}")
-        })
 }
 
 impl Trainer {
@@ -374,7 +182,7 @@ impl Trainer {
         })?;
         let mut state = checkpoint::load_state(&dir)?;
         if let Some(asked) = &config {
-            if let Some(message) = incompatible_field(&state.config, asked) {
+            if let Some(message) = state.config.resume_difference(asked) {
                 return Err(TrainError::Checkpoint { path: dir, message });
             }
             state.config.training.steps = asked.training.steps;
@@ -542,80 +350,5 @@ impl Trainer {
     /// The loss log's path.
     pub fn loss_log(&self) -> &Path {
         self.log.path()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::weights::perturb;
-    use burn::tensor::Distribution;
-
-    #[test]
-    fn shards_split_batches_evenly_with_larger_ones_first() {
-        assert_eq!(shard_ranges(4, 1), vec![(0, 4)]);
-        assert_eq!(shard_ranges(4, 3), vec![(0, 2), (2, 1), (3, 1)]);
-        assert_eq!(shard_ranges(2, 8), vec![(0, 1), (1, 1)]);
-    }
-
-    #[test]
-    fn sharded_gradients_equal_the_whole_batch_gradients() {
-        // The tiny network with dropout on and perturbed weights (so no gradient is trivially
-        // zero), the whole batch against uneven shards: the same loss and gradients.
-        let mut config: TrainConfig =
-            TrainConfig::parse(include_str!("../../configs/tiny.yaml")).unwrap();
-        config.model.dropout = 0.5;
-        let device = Device::flex().autodiff();
-        device.seed(4);
-        let (batch, f, n) = (5, 12, 30);
-        let model = perturb(QnaUnet::new(f, &config.model, &device), 0.2);
-        let normal = Distribution::Normal(0.0, 1.0);
-        let x_t = Tensor::<3>::random([batch, f, n], normal, &device);
-        let x0 = Tensor::<3>::random([batch, f, n], normal, &device);
-        let t = Tensor::<1>::from_data(
-            TensorData::new(vec![3.0f32, 400.0, 999.0, 20.0, 650.0], [batch]),
-            &device,
-        );
-        let gradients = |shards| {
-            device.seed(9);
-            let (loss, grads) =
-                sharded_gradients(&model, x_t.clone(), t.clone(), x0.clone(), shards);
-            (loss, grads.expect("finite loss"))
-        };
-        let (whole_loss, whole) = gradients(1);
-        let (split_loss, split) = gradients(3);
-        assert!(
-            (whole_loss - split_loss).abs() < 1e-6 * whole_loss,
-            "{whole_loss} {split_loss}"
-        );
-        struct Compare<'a>(&'a GradientsParams, &'a GradientsParams, usize);
-        impl ModuleVisitor for Compare<'_> {
-            fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
-                let read = |g: &GradientsParams| {
-                    g.get::<D>(param.id)
-                        .expect("every parameter has a gradient")
-                        .into_data()
-                        .try_to_vec::<f32>()
-                        .unwrap()
-                };
-                let (a, b) = (read(self.0), read(self.1));
-                let scale = a.iter().fold(0f32, |m, v| m.max(v.abs()));
-                let worst = a
-                    .iter()
-                    .zip(&b)
-                    .map(|(x, y)| (x - y).abs())
-                    .fold(0f32, f32::max);
-                assert!(
-                    worst <= 1e-4 * scale + 1e-7,
-                    "max |diff| {worst}, scale {scale}"
-                );
-                // Softmax ignores a constant added to every score, so the key bias has a zero
-                // gradient up to rounding; the absolute term covers it.
-                self.2 += usize::from(scale > 1e-6);
-            }
-        }
-        let mut compare = Compare(&whole, &split, 0);
-        model.visit(&mut compare);
-        assert!(compare.2 > 20, "only {} tensors have gradients", compare.2);
     }
 }

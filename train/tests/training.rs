@@ -104,6 +104,10 @@ fn ctrl_c_saves_and_resume_finishes_like_an_uninterrupted_run() {
     let text = std::fs::read_to_string(root().join("configs/tiny.yaml"))
         .unwrap()
         .replace("steps: 300", "steps: 400");
+    assert!(
+        text.contains("steps: 400"),
+        "configs/tiny.yaml no longer says steps: 300"
+    );
     std::fs::write(&config, text).unwrap();
     let train = |out: &Path, resume: bool| {
         let mut cmd = Command::new(bin);
@@ -278,12 +282,13 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
         .unwrap()
         .replace("heads: 4", "heads: 4\n  hedas: 2");
     std::fs::write(&bad, text).unwrap();
+    let never = scratch("never");
     let out = Command::new(bin)
         .arg(walk())
         .arg("--config")
         .arg(&bad)
         .arg("--out")
-        .arg(scratch("never"))
+        .arg(&never)
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
@@ -292,6 +297,6 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
         err.contains("unknown field `hedas`") && err.contains("bad.yaml"),
         "{err}"
     );
-    assert!(!scratch("never").exists());
+    assert!(!never.exists());
     std::fs::remove_file(bad).unwrap();
 }

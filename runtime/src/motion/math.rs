@@ -7,8 +7,9 @@
 pub type Vec3 = [f64; 3];
 /// A row-major 3x3 matrix (`m[row][col]`).
 pub type Mat3 = [[f64; 3]; 3];
-/// A unit quaternion `[w, x, y, z]`.
-pub type Quat = [f64; 4];
+/// A unit quaternion with its components in the order `[w, x, y, z]` (scalar first), as the
+/// name says; engine poses use [`super::pose::Quaternion`] with named fields instead.
+pub type QuatWxyz = [f64; 4];
 
 /// The identity matrix.
 pub const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
@@ -94,7 +95,7 @@ pub fn axis_rotation(axis: usize, radians: f64) -> Mat3 {
 
 /// The unit quaternion of a rotation matrix (Shepperd's method: the largest diagonal term picks
 /// the numerically stable branch). The result has `w >= 0`.
-pub fn quat_from_mat(m: &Mat3) -> Quat {
+pub fn quat_wxyz_from_mat(m: &Mat3) -> QuatWxyz {
     let trace = m[0][0] + m[1][1] + m[2][2];
     let q = if trace > 0.0 {
         let s = (trace + 1.0).sqrt() * 2.0;
@@ -138,7 +139,7 @@ pub fn quat_from_mat(m: &Mat3) -> Quat {
 }
 
 /// The rotation matrix of a (not necessarily unit) quaternion.
-pub fn mat_from_quat(q: Quat) -> Mat3 {
+pub fn mat_from_quat_wxyz(q: QuatWxyz) -> Mat3 {
     let [w, x, y, z] = quat_normalize(q);
     [
         [
@@ -160,7 +161,7 @@ pub fn mat_from_quat(q: Quat) -> Mat3 {
 }
 
 /// `q / |q|` (identity for a zero quaternion).
-pub fn quat_normalize(q: Quat) -> Quat {
+pub fn quat_normalize(q: QuatWxyz) -> QuatWxyz {
     let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
     if n > 1e-12 {
         [q[0] / n, q[1] / n, q[2] / n, q[3] / n]
@@ -170,7 +171,7 @@ pub fn quat_normalize(q: Quat) -> Quat {
 }
 
 /// Spherical linear interpolation from `a` (at `t = 0`) to `b` (at `t = 1`) along the shorter arc.
-pub fn slerp(a: Quat, b: Quat, t: f64) -> Quat {
+pub fn slerp(a: QuatWxyz, b: QuatWxyz, t: f64) -> QuatWxyz {
     let mut cos = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
     let b = if cos < 0.0 {
         cos = -cos;
@@ -231,7 +232,7 @@ mod tests {
     fn quaternion_of_axis_rotation_is_half_angle() {
         // Rotation by theta about Z is (cos(theta/2), 0, 0, sin(theta/2)).
         let theta = 1.234_f64;
-        let q = quat_from_mat(&axis_rotation(2, theta));
+        let q = quat_wxyz_from_mat(&axis_rotation(2, theta));
         let expected = [(theta / 2.0).cos(), 0.0, 0.0, (theta / 2.0).sin()];
         for i in 0..4 {
             assert!((q[i] - expected[i]).abs() < 1e-12, "{q:?} vs {expected:?}");
@@ -247,7 +248,7 @@ mod tests {
                     &axis_rotation(axis, angle),
                     &axis_rotation((axis + 1) % 3, 0.2),
                 );
-                let back = mat_from_quat(quat_from_mat(&m));
+                let back = mat_from_quat_wxyz(quat_wxyz_from_mat(&m));
                 assert!(mat_max_abs_diff(&m, &back) < 1e-12);
             }
         }
@@ -255,9 +256,9 @@ mod tests {
 
     #[test]
     fn slerp_halfway_is_half_the_angle() {
-        let a = quat_from_mat(&IDENTITY);
-        let b = quat_from_mat(&axis_rotation(1, 1.0));
-        let mid = mat_from_quat(slerp(a, b, 0.5));
+        let a = quat_wxyz_from_mat(&IDENTITY);
+        let b = quat_wxyz_from_mat(&axis_rotation(1, 1.0));
+        let mid = mat_from_quat_wxyz(slerp(a, b, 0.5));
         assert!(mat_max_abs_diff(&mid, &axis_rotation(1, 0.5)) < 1e-12);
     }
 }

@@ -16,11 +16,11 @@ pub mod up;
 pub use clip::{ChannelClip, LocalMotion, fps_from_frame_time};
 pub use contacts::ContactConfig;
 pub use features::{
-    Column, ColumnKind, EncodeOptions, EncodedClip, FeatureLayout, MotionError, RootFeatures,
-    decode, encode, encode_for,
+    Column, ColumnKind, EncodeOptions, EncodedClip, FeatureLayout, FeatureMatrix, MotionError,
+    RootFeatures, decode, encode, encode_for,
 };
 pub use fk::{GlobalPose, global_pose, global_poses, max_position_error, skeleton_height};
 pub use normalize::Normalizer;
-pub use pose::{Pose, poses};
+pub use pose::{Pose, Quaternion, poses};
 pub use skeleton::{Axis, Channel, Joint, Skeleton};
 pub use up::{Confidence, UpAxis, UpDetection, detect_up};

@@ -2,7 +2,22 @@
 //! quaternion, without touching the file system.
 
 use super::clip::LocalMotion;
-use super::math::quat_from_mat;
+use super::math::quat_wxyz_from_mat;
+
+/// A unit quaternion with named components (`w` the scalar part), laid out `x, y, z, w` in
+/// memory as engines (Unity, Unreal, glTF) store it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quaternion {
+    /// `x` of the vector part.
+    pub x: f32,
+    /// `y` of the vector part.
+    pub y: f32,
+    /// `z` of the vector part.
+    pub z: f32,
+    /// The scalar part.
+    pub w: f32,
+}
 
 /// One frame of a skeleton pose, in the clip's units and its file's right-handed frame (its up axis is
 /// [`super::FeatureLayout::up`]).
@@ -10,8 +25,8 @@ use super::math::quat_from_mat;
 pub struct Pose {
     /// World position of the root joint.
     pub root_position: [f32; 3],
-    /// Local rotation of every joint relative to its parent, as a unit quaternion `[x, y, z, w]`.
-    pub rotations: Vec<[f32; 4]>,
+    /// Local rotation of every joint relative to its parent.
+    pub rotations: Vec<Quaternion>,
     /// Local translation of every joint from its parent (the OFFSET, or the animated position
     /// where a joint has position channels).
     pub translations: Vec<[f32; 3]>,
@@ -29,8 +44,13 @@ pub fn poses(motion: &LocalMotion) -> Vec<Pose> {
                 rotations: motion.rotations[range.clone()]
                     .iter()
                     .map(|m| {
-                        let [w, x, y, z] = quat_from_mat(m);
-                        [x as f32, y as f32, z as f32, w as f32]
+                        let [w, x, y, z] = quat_wxyz_from_mat(m);
+                        Quaternion {
+                            x: x as f32,
+                            y: y as f32,
+                            z: z as f32,
+                            w: w as f32,
+                        }
                     })
                     .collect(),
                 translations: motion.translations[range]

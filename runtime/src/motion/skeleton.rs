@@ -195,11 +195,6 @@ impl Skeleton {
         (0..self.joints.len()).filter(|&j| !has_child[j]).collect()
     }
 
-    /// Whether `other` has the same joint names, parents and channel lists (offsets may differ).
-    pub fn same_structure(&self, other: &Skeleton) -> bool {
-        self.difference(other).is_none()
-    }
-
     /// The first structural difference between `self` (the expected skeleton) and `other`, in
     /// words: joint count, a joint's name, parent or channel list. Offsets may differ.
     pub fn difference(&self, other: &Skeleton) -> Option<String> {

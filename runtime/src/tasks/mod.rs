@@ -13,13 +13,12 @@ mod plan;
 
 use std::convert::Infallible;
 
-use ndarray::Array2;
 use thiserror::Error;
 
 use crate::diffusion::ScheduleError;
 use crate::diffusion::sampler::{SamplerError, StepError};
 use crate::model::ModelError;
-use crate::motion::MotionError;
+use crate::motion::{FeatureMatrix, MotionError};
 pub use generated::Generated;
 pub use joints::{joints_by_name, subtree};
 pub use mask::Span;
@@ -155,7 +154,7 @@ pub enum Task {
     /// Keep `keep` spans of the reference, generate the gaps; soft borders of `ramp` frames.
     Inbetween {
         /// Raw (unnormalised) reference features `[F, N]` in the model's layout.
-        reference: Array2<f32>,
+        reference: FeatureMatrix,
         /// Frame spans to keep.
         keep: Vec<Span>,
         /// Soft border on the kept side, in frames.
@@ -164,7 +163,7 @@ pub enum Task {
     /// The reference in the middle, `prefix` new frames before and `suffix` after.
     Expand {
         /// Raw reference features `[F, N]`.
-        reference: Array2<f32>,
+        reference: FeatureMatrix,
         /// New frames before the reference.
         prefix: usize,
         /// New frames after it.
@@ -176,7 +175,7 @@ pub enum Task {
     /// when empty); generate the rest of the body.
     Compose {
         /// Raw reference features `[F, N]`.
-        reference: Array2<f32>,
+        reference: FeatureMatrix,
         /// Joints whose columns come from the reference (indices into the model's skeleton).
         joints: Vec<usize>,
         /// Whether the root's travel and height come from the reference.
@@ -189,7 +188,7 @@ pub enum Task {
     /// Style transfer: the content's low frequencies in the model's style.
     Harmonize {
         /// Raw content features `[F, N]`.
-        content: Array2<f32>,
+        content: FeatureMatrix,
         /// Down-sampling factor of the low-pass.
         factor: usize,
         /// Share of final steps left free.

@@ -89,6 +89,11 @@ impl Plan {
         )?)
     }
 
+    /// The batch of a sampler made by [`Plan::sampler`] (finished, or stopped early).
+    pub fn finish(&self, sampler: Sampler<'_>) -> Generated {
+        Generated::from_normalized(self.metadata.clone(), sampler.into_sample())
+    }
+
     /// Runs the plan on a denoiser. `progress` is called after each step with (steps done,
     /// steps in all); returning [`ControlFlow::Break`] stops the run with
     /// [`TaskError::Cancelled`].
@@ -110,10 +115,7 @@ impl Plan {
                 });
             }
         }
-        Ok(Generated::from_normalized(
-            self.metadata.clone(),
-            sampler.into_sample(),
-        ))
+        Ok(self.finish(sampler))
     }
 }
 

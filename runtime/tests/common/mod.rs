@@ -11,9 +11,24 @@ pub fn workspace() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// The clips shipped with the project.
+/// The clips shipped with the project (it is an error if any of the four is missing, so a test
+/// that loops over them cannot pass over none).
 pub fn shipped_clips() -> Vec<PathBuf> {
-    bvh_files(workspace().join("tests/data/bvh"))
+    let dir = workspace().join("tests/data/bvh");
+    let clips = bvh_files(dir.clone());
+    for name in [
+        "fox_survey_khronos.bvh",
+        "human_dance_rokoko_jesse.bvh",
+        "human_hop_cmu_131_03.bvh",
+        "human_walk_cmu_131_01.bvh",
+    ] {
+        assert!(
+            clips.iter().any(|p| p.ends_with(name)),
+            "{} lacks {name}",
+            dir.display()
+        );
+    }
+    clips
 }
 
 /// The shipped clips plus, when the team's shared data folder sits beside the checkout, every

@@ -2,6 +2,7 @@
 
 use ndarray::Array2;
 
+use super::FeatureMatrix;
 use super::error::MotionError;
 use super::layout::{FeatureLayout, RootFeatures};
 use crate::motion::clip::{ChannelClip, LocalMotion};
@@ -40,7 +41,7 @@ pub struct EncodedClip {
     /// The column description (with the skeleton and static data).
     pub layout: FeatureLayout,
     /// Unnormalised features `[F, N]`.
-    pub features: Array2<f32>,
+    pub features: FeatureMatrix,
     /// Share of frames in contact for each contact joint.
     pub contact_share: Vec<f64>,
     /// The up-axis detection and its evidence (`None` when the axis was given).
@@ -354,7 +355,10 @@ fn fill_features(
 /// Encodes a clip of the same skeleton in an existing layout (a model's): resampled to the
 /// layout's frame rate, read with the layout's up axis, with the layout's columns, contact joints
 /// and contact threshold, so the result lines up with the features the model was trained on.
-pub fn encode_for(clip: &ChannelClip, layout: &FeatureLayout) -> Result<Array2<f32>, MotionError> {
+pub fn encode_for(
+    clip: &ChannelClip,
+    layout: &FeatureLayout,
+) -> Result<FeatureMatrix, MotionError> {
     if clip.frame_count() == 0 {
         return Err(MotionError::NoFrames);
     }

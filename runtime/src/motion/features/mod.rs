@@ -16,6 +16,11 @@
 //! turns the motion back into the file's frame. So a Z-up clip and its Y-up twin have the same
 //! features, and the root's axes below are canonical axes (Y = up).
 
+/// Features of one motion, laid out `[F, N]`: one row per feature column (see
+/// [`FeatureLayout::columns`]), one column per frame. Batches add a leading sample axis,
+/// `[B, F, N]`, the layout of the network's `x_t` and `x0`.
+pub type FeatureMatrix = ndarray::Array2<f32>;
+
 mod decode;
 mod encode;
 mod error;

@@ -114,14 +114,6 @@ impl UpAxis {
     pub fn canonical_from_file(self) -> Mat3 {
         math::transpose(&self.file_from_canonical())
     }
-
-    /// The canonical coordinate axis (0, 1 or 2) that file axis `index` maps to.
-    pub fn canonical_index(self, index: usize) -> usize {
-        let mut v = [0.0; 3];
-        v[index] = 1.0;
-        let c = math::mat_vec(&self.canonical_from_file(), v);
-        (0..3).find(|&i| c[i] != 0.0).unwrap_or(index)
-    }
 }
 
 /// The file's name of canonical axis `index` (0, 1 or 2) under up axis `up`, such as `-Y`.
@@ -269,7 +261,14 @@ mod tests {
                 math::mat_mul(&a, &axis.canonical_from_file()),
                 math::IDENTITY
             );
-            assert_eq!(axis.canonical_index(axis.index_and_sign().0), UP);
+            // The file's up direction becomes canonical +Y.
+            let (index, sign) = axis.index_and_sign();
+            let mut file_up = [0.0; 3];
+            file_up[index] = sign;
+            assert_eq!(
+                math::mat_vec(&axis.canonical_from_file(), file_up),
+                [0.0, 1.0, 0.0]
+            );
         }
     }
 
