@@ -13,6 +13,7 @@ use sinmdm::features_file::write_features;
 use sinmdm::files::write_atomically;
 use sinmdm::motion::up::{Confidence, UpAxis, detect_up, reorient, reorient_problem};
 use sinmdm::motion::{encode_for, math};
+use sinmdm::tasks::MAX_COUNT;
 use sinmdm::{Generated, Plan, Request, Span, Task};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_render::{Camera, Figure};
@@ -229,6 +230,9 @@ pub fn check_writable(paths: &[PathBuf]) -> Result<()> {
 /// Runs a task with the shared options: checks the request and the outputs, samples with a
 /// progress bar, and writes every BVH (and the features JSON, and the picture) atomically.
 pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Generated> {
+    if !(1..=MAX_COUNT).contains(&args.count) {
+        bail!("--count must be between 1 and {MAX_COUNT}, got {}", args.count);
+    }
     let request = Request {
         task,
         count: args.count,

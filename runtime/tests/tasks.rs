@@ -285,7 +285,7 @@ fn bad_requests_are_refused_with_what_is_wrong() {
     let e = plan_error(Task::Generate { frames: 10_000_000 }, 1, Some(10));
     assert!(message(e).contains("the limit is"));
     let e = plan_error(Task::Generate { frames: 50 }, 0, Some(10));
-    assert!(message(e).contains("--count must be between 1"));
+    assert!(message(e).contains("the number of samples must be between 1 and 1024, got 0"));
     let e = plan_error(Task::Generate { frames: 50 }, 1, Some(5000));
     assert!(e.to_string().contains("5000"), "{e}");
     let e = tasks::joints_by_name(&m.metadata().layout, &["Tail".to_string()]).unwrap_err();

@@ -302,7 +302,7 @@ mod tests {
         asked.training.steps += 100;
         asked.training.checkpoint_every += 1;
         assert_eq!(saved.resume_difference(&asked), None);
-        // A setting the old hand-written list did not name is still caught.
+        // Any other setting, found by its YAML key.
         asked.data.contact_speed *= 2.0;
         let message = saved.resume_difference(&asked).expect("a difference");
         assert!(message.contains("data.contact_speed"), "{message}");
