@@ -11,8 +11,8 @@ use ndarray::Array2;
 use sinmdm::bvh::{read_bvh, to_bvh_string};
 use sinmdm::features_file::write_features;
 use sinmdm::files::write_atomically;
-use sinmdm::motion::up::{Confidence, UpAxis, detect_up, reorient, reorient_problem};
-use sinmdm::motion::{encode_for, math};
+use sinmdm::motion::encode_for_model;
+use sinmdm::motion::up::UpAxis;
 use sinmdm::tasks::MAX_COUNT;
 use sinmdm::{Generated, Plan, Request, Span, Task};
 use sinmdm::{Model, ModelOptions};
@@ -150,44 +150,27 @@ pub struct ClipUpArg {
     pub up: Option<UpAxis>,
 }
 
-/// Reads a BVH clip of the model's skeleton as raw features in the model's layout. The clip's up
-/// axis is `up`, else the detected one when the detection is sure, else the model's; a clip
-/// whose up differs from the model's is turned into the model's convention first.
+/// Reads a BVH clip of the model's skeleton as raw features in the model's layout
+/// ([`encode_for_model`]), saying so when the clip was turned into the model's up convention.
 pub fn reference_features(model: &Model, clip: &Path, up: Option<UpAxis>) -> Result<Array2<f32>> {
-    let mut channels = read_bvh(clip)?;
-    let model_up = model.metadata().layout.up;
-    let clip_up = up.unwrap_or_else(|| {
-        let found = detect_up(&channels.to_local());
-        if found.confidence == Confidence::Sure {
-            found.axis
-        } else {
-            model_up
-        }
-    });
-    if clip_up != model_up {
-        if let Some(problem) = reorient_problem(&channels.skeleton) {
-            bail!(
-                "{}: up axis {clip_up}, the model's is {model_up}, and {problem}",
-                clip.display()
-            );
-        }
-        eprintln!(
-            "{}: up axis {clip_up}, the model's is {model_up}: turning the clip into the model's convention",
-            clip.display()
-        );
-        let turn = math::mat_mul(
-            &model_up.file_from_canonical(),
-            &clip_up.canonical_from_file(),
-        );
-        channels = reorient(&channels.to_local(), &turn).to_channels();
-    }
-    encode_for(&channels, &model.metadata().layout).with_context(|| {
+    let channels = read_bvh(clip)?;
+    let layout = &model.metadata().layout;
+    let encoded = encode_for_model(&channels, layout, up).with_context(|| {
         format!(
             "{}: cannot use it with model {}",
             clip.display(),
             model.path().display()
         )
-    })
+    })?;
+    if encoded.turned {
+        eprintln!(
+            "{}: up axis {}, the model's is {}: turned the clip into the model's convention",
+            clip.display(),
+            encoded.clip_up,
+            layout.up
+        );
+    }
+    Ok(encoded.features)
 }
 
 /// A progress bar over sampling steps (hidden with `quiet`; indicatif hides it off a terminal).
@@ -231,7 +214,10 @@ pub fn check_writable(paths: &[PathBuf]) -> Result<()> {
 /// progress bar, and writes every BVH (and the features JSON, and the picture) atomically.
 pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Generated> {
     if !(1..=MAX_COUNT).contains(&args.count) {
-        bail!("--count must be between 1 and {MAX_COUNT}, got {}", args.count);
+        bail!(
+            "--count must be between 1 and {MAX_COUNT}, got {}",
+            args.count
+        );
     }
     let request = Request {
         task,

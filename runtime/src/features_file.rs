@@ -73,7 +73,10 @@ pub fn write_features(
             .map(|s| s.outer_iter().map(|row| row.to_vec()).collect())
             .collect(),
     };
-    let text = serde_json::to_string(&doc).expect("features serialise");
+    let text = serde_json::to_string(&doc).map_err(|e| FeaturesFileError::Format {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
     write_atomically(path, text.as_bytes()).map_err(|source| FeaturesFileError::Io {
         path: path.to_path_buf(),
         source,

@@ -138,6 +138,14 @@ pub struct OnnxRuntime {
     pub environment: ort::environment::Environment,
 }
 
+impl std::fmt::Debug for OnnxRuntime {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("OnnxRuntime")
+            .field("path", &self.path)
+            .finish_non_exhaustive()
+    }
+}
+
 static LOADED: OnceLock<OnnxRuntime> = OnceLock::new();
 static LOADING: Mutex<()> = Mutex::new(());
 

@@ -290,6 +290,30 @@ fn bad_requests_are_refused_with_what_is_wrong() {
     assert!(e.to_string().contains("5000"), "{e}");
     let e = tasks::joints_by_name(&m.metadata().layout, &["Tail".to_string()]).unwrap_err();
     assert!(message(e).contains("joint 'Tail' is not in the model's skeleton (joints: Hips"));
+    let e = plan_error(
+        Task::Compose {
+            reference: reference.clone(),
+            joints: vec![1, 999],
+            root: false,
+            spans: vec![],
+            ramp: 10,
+        },
+        1,
+        Some(10),
+    );
+    assert!(
+        matches!(e, TaskError::JointIndex { index: 999, .. }),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn asking_a_batch_for_a_sample_it_lacks_is_an_error() {
+    let mut m = model();
+    let out = run(&mut m, Task::Generate { frames: 20 }, 2, 3);
+    assert!(out.poses(1).is_ok());
+    let e = out.poses(2).unwrap_err();
+    assert_eq!(e.to_string(), "there is no sample 2 in a batch of 2");
 }
 
 #[test]

@@ -16,8 +16,8 @@ pub mod up;
 pub use clip::{ChannelClip, LocalMotion, fps_from_frame_time};
 pub use contacts::ContactConfig;
 pub use features::{
-    Column, ColumnKind, EncodeOptions, EncodedClip, FeatureLayout, FeatureMatrix, MotionError,
-    RootFeatures, decode, encode, encode_for,
+    ClipForModel, Column, ColumnKind, EncodeOptions, EncodedClip, FeatureLayout, FeatureMatrix,
+    MotionError, RootFeatures, decode, encode, encode_for, encode_for_model,
 };
 pub use fk::{GlobalPose, global_pose, global_poses, max_position_error, skeleton_height};
 pub use normalize::Normalizer;

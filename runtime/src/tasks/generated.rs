@@ -47,6 +47,12 @@ impl Generated {
 
     /// Sample `index` as local joint transforms.
     pub fn motion(&self, index: usize) -> Result<LocalMotion, MotionError> {
+        if index >= self.count() {
+            return Err(MotionError::NoSuchSample {
+                index,
+                count: self.count(),
+            });
+        }
         decode(
             &self.metadata.layout,
             self.features.index_axis(Axis(0), index),

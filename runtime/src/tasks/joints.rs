@@ -25,9 +25,12 @@ pub fn joints_by_name(layout: &FeatureLayout, names: &[String]) -> Result<Vec<us
         .collect()
 }
 
-/// `joint` and every joint below it.
+/// `joint` and every joint below it (nothing for an index past the skeleton).
 pub fn subtree(layout: &FeatureLayout, joint: usize) -> Vec<usize> {
     let joints = &layout.skeleton.joints;
+    if joint >= joints.len() {
+        return Vec::new();
+    }
     let mut inside = vec![false; joints.len()];
     inside[joint] = true;
     // Parents precede children, so one pass in order marks every descendant.

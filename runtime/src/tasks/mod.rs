@@ -112,6 +112,14 @@ pub enum TaskError {
         /// The skeleton's joints.
         available: String,
     },
+    /// A joint index past the end of the model's skeleton.
+    #[error("joint index {index} is not in the model's skeleton of {joints} joints")]
+    JointIndex {
+        /// The index given.
+        index: usize,
+        /// Joints in the skeleton.
+        joints: usize,
+    },
     /// A reference of the wrong width.
     #[error("the reference has {got} feature rows, the model {expected}")]
     ReferenceWidth {

@@ -267,6 +267,12 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
             let y = normalized(metadata, reference)?;
             let n = y.ncols();
             let layout = &metadata.layout;
+            if let Some(&index) = joints.iter().find(|&&j| j >= layout.skeleton.len()) {
+                return Err(TaskError::JointIndex {
+                    index,
+                    joints: layout.skeleton.len(),
+                });
+            }
             let mut rows: Vec<usize> = joints
                 .iter()
                 .flat_map(|&j| layout.joint_columns(j))

@@ -21,7 +21,7 @@ pub struct EncodeOptions {
     pub fps: Option<f64>,
     /// Contact joints and threshold.
     pub contacts: ContactConfig,
-    /// The clip's up axis; `None` detects it from the motion ([`super::up::detect_up`]).
+    /// The clip's up axis; `None` detects it from the motion ([`crate::motion::up::detect_up`]).
     pub up: Option<UpAxis>,
 }
 

@@ -2,6 +2,8 @@
 
 use thiserror::Error;
 
+use crate::motion::up::UpAxis;
+
 /// Errors while turning a clip into features or features into a clip.
 #[derive(Debug, Error, PartialEq)]
 pub enum MotionError {
@@ -52,6 +54,24 @@ pub enum MotionError {
     /// A clip whose skeleton is not the one the features are laid out for.
     #[error("the clip's skeleton differs from the model's: {0}")]
     SkeletonMismatch(String),
+    /// A clip in another up convention than the model's that cannot be turned.
+    #[error("up axis {clip_up}, the model's is {model_up}, and {problem}")]
+    CannotReorient {
+        /// The clip's up axis.
+        clip_up: UpAxis,
+        /// The model's.
+        model_up: UpAxis,
+        /// Why the clip cannot be turned.
+        problem: String,
+    },
+    /// A sample index past the end of a batch.
+    #[error("there is no sample {index} in a batch of {count}")]
+    NoSuchSample {
+        /// The index asked for.
+        index: usize,
+        /// Samples in the batch.
+        count: usize,
+    },
     /// A feature array holding NaN or infinity.
     #[error("features contain a non-finite value at row {row}, frame {frame}")]
     NonFinite {

@@ -25,8 +25,10 @@ mod decode;
 mod encode;
 mod error;
 mod layout;
+mod reference;
 
 pub use decode::decode;
 pub use encode::{EncodeOptions, EncodedClip, MAX_FRAMES, encode, encode_for};
 pub use error::MotionError;
 pub use layout::{Column, ColumnKind, FeatureLayout, RootFeatures};
+pub use reference::{ClipForModel, encode_for_model};
