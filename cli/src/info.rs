@@ -3,14 +3,14 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Result, bail};
 use clap::Args;
 use ndarray::Axis;
 
 use crate::sampling::reference_features;
 use sinmdm::features_file::write_features;
 use sinmdm::model_file::ModelMetadata;
-use sinmdm::{Model, ModelOptions};
+use sinmdm::{Model, ModelError, ModelOptions};
 
 pub(crate) const INFO_EXAMPLES: &str = "Examples:
   sinmdm info onnx-models/walk.onnx
@@ -50,6 +50,13 @@ pub fn describe(path: &std::path::Path, m: &ModelMetadata) -> String {
     let n = &m.network;
     let l = &m.layout;
     let t = &m.training;
+    // A file that failed validation is still described: a bad index shows as such.
+    let joint_name = |j: usize| {
+        l.skeleton
+            .joints
+            .get(j)
+            .map_or("(no such joint)", |joint| joint.name.as_str())
+    };
     let _ = writeln!(s, "model        {}", path.display());
     let _ = writeln!(
         s,
@@ -78,14 +85,12 @@ pub fn describe(path: &std::path::Path, m: &ModelMetadata) -> String {
         let _ = writeln!(
             s,
             "root motion  joint '{}', axes {:?}, starts at {:?}",
-            l.skeleton.joints[root.joint].name, root.axes, root.start_position
+            joint_name(root.joint),
+            root.axes,
+            root.start_position
         );
     }
-    let contacts: Vec<&str> = l
-        .contact_joints
-        .iter()
-        .map(|&j| l.skeleton.joints[j].name.as_str())
-        .collect();
+    let contacts: Vec<&str> = l.contact_joints.iter().map(|&j| joint_name(j)).collect();
     let _ = writeln!(
         s,
         "contacts     {} (speed threshold {} heights/s)",
@@ -120,13 +125,33 @@ pub fn describe(path: &std::path::Path, m: &ModelMetadata) -> String {
 }
 
 pub(crate) fn info(args: &InfoArgs) -> Result<()> {
-    let model = Model::open(&args.model, &ModelOptions { threads: Some(1) })?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(model.metadata())?);
-    } else {
-        print!("{}", describe(&args.model, model.metadata()));
+    let show = |metadata: &ModelMetadata| -> Result<()> {
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(metadata)?);
+        } else {
+            print!("{}", describe(&args.model, metadata));
+        }
+        Ok(())
+    };
+    match Model::open(&args.model, &ModelOptions { threads: Some(1) }) {
+        Ok(model) => show(model.metadata()),
+        Err(ModelError::Invalid {
+            problems, metadata, ..
+        }) => {
+            // Show what the file holds, then why it cannot be used.
+            show(&metadata)?;
+            eprintln!("{}: the metadata breaks these rules:", args.model.display());
+            for problem in &problems {
+                eprintln!("  - {problem}");
+            }
+            bail!(
+                "{} is not a usable model ({} problems)",
+                args.model.display(),
+                problems.len()
+            )
+        }
+        Err(e) => Err(e.into()),
     }
-    Ok(())
 }
 
 pub(crate) fn encode(args: &EncodeArgs) -> Result<()> {

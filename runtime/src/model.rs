@@ -64,6 +64,17 @@ pub enum ModelError {
         /// What is wrong, naming the field.
         message: String,
     },
+    /// Metadata that breaks the rules of [`crate::model_file::problems`]: every problem, each
+    /// naming its field, and the metadata as read (to show what is readable).
+    #[error("'{path}' has invalid sinmdm metadata: {}", problems.join("; "))]
+    Invalid {
+        /// The model file.
+        path: PathBuf,
+        /// Every problem found, each naming the field and its value.
+        problems: Vec<String>,
+        /// The metadata as read.
+        metadata: Box<ModelMetadata>,
+    },
     /// The graph's inputs or outputs are not the contract's.
     #[error("'{path}' does not have the denoiser's interface: {message}")]
     BadGraph {
@@ -121,6 +132,57 @@ impl std::fmt::Debug for Model {
     }
 }
 
+/// Checks the graph's inputs and outputs against the contract of [`crate::network`]: `x_t`
+/// f32 `[B, F, N]`, `t` i64 `[B]` in, `x0` f32 `[B, F, N]` out, with F the metadata's.
+fn check_interface(session: &Session, features: usize) -> Result<(), String> {
+    use ort::value::TensorElementType::{Float32, Int64};
+    let names = |outlets: &[ort::value::Outlet]| {
+        outlets
+            .iter()
+            .map(|o| o.name().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let (inputs, outputs) = (session.inputs(), session.outputs());
+    let find = |outlets: &[ort::value::Outlet], name: &str| {
+        outlets
+            .iter()
+            .find(|o| o.name() == name)
+            .map(|o| o.dtype().clone())
+    };
+    let (Some(x), Some(t), Some(x0), 2) = (
+        find(inputs, INPUT_FEATURES),
+        find(inputs, INPUT_STEP),
+        find(outputs, OUTPUT_FEATURES),
+        inputs.len(),
+    ) else {
+        return Err(format!(
+            "inputs [{}] and outputs [{}], expected inputs [{INPUT_FEATURES}, {INPUT_STEP}] and output {OUTPUT_FEATURES}",
+            names(inputs),
+            names(outputs)
+        ));
+    };
+    let f = features as i64;
+    let expect = |name: &str, dtype: &ort::value::ValueType, ty, rank: usize, rows: Option<i64>| {
+        let shape = dtype.tensor_shape().map(|s| s.to_vec());
+        let fits = dtype.tensor_type() == Some(ty)
+            && shape
+                .as_ref()
+                .is_some_and(|s| s.len() == rank && rows.is_none_or(|r| s[1] == r || s[1] < 0));
+        if fits {
+            Ok(())
+        } else {
+            Err(format!(
+                "'{name}' is {dtype:?}; the contract is {ty:?} of rank {rank}{}",
+                rows.map_or(String::new(), |r| format!(" with {r} feature rows"))
+            ))
+        }
+    };
+    expect(INPUT_FEATURES, &x, Float32, 3, Some(f))?;
+    expect(INPUT_STEP, &t, Int64, 1, None)?;
+    expect(OUTPUT_FEATURES, &x0, Float32, 3, Some(f))
+}
+
 /// A session over `bytes` with `threads` intra-op threads and no spinning when idle.
 fn open_session(
     environment: &ort::environment::Environment,
@@ -175,22 +237,12 @@ impl Model {
             let meta = session.metadata().map_err(|e| not_onnx(e.to_string()))?;
             parse_metadata(&path, |key| meta.custom(key))?
         };
-        let inputs: Vec<&str> = session.inputs().iter().map(|o| o.name()).collect();
-        let outputs: Vec<&str> = session.outputs().iter().map(|o| o.name()).collect();
-        if inputs.len() != 2
-            || !inputs.contains(&INPUT_FEATURES)
-            || !inputs.contains(&INPUT_STEP)
-            || !outputs.contains(&OUTPUT_FEATURES)
-        {
-            return Err(ModelError::BadGraph {
-                path,
-                message: format!(
-                    "inputs [{}] and outputs [{}], expected inputs [{INPUT_FEATURES}, {INPUT_STEP}] and output {OUTPUT_FEATURES}",
-                    inputs.join(", "),
-                    outputs.join(", ")
-                ),
-            });
-        }
+        check_interface(&session, metadata.network.features).map_err(|message| {
+            ModelError::BadGraph {
+                path: path.clone(),
+                message,
+            }
+        })?;
         Ok(Model {
             session,
             metadata,

@@ -28,7 +28,8 @@ pub use plan::{Plan, plan, run};
 pub const MAX_FRAMES: usize = 100_000;
 /// The largest crowd one run makes.
 pub const MAX_COUNT: usize = 1024;
-/// The largest batch one run holds, in feature values (`count x F x frames`; 1 GiB of f32).
+/// The largest working set one run may need, in f32 values (1 GiB): `count x frames x` the
+/// larger of `F + 8 C` (the network's layers) and `12 x joints` (the decoded motion).
 pub const MAX_VALUES: usize = 1 << 28;
 /// Default soft border of in-betweening and composition spans, in frames.
 pub const INBETWEEN_RAMP: usize = 10;
@@ -75,7 +76,7 @@ pub enum TaskError {
     Count(usize),
     /// A batch too large to hold.
     #[error(
-        "{count} samples of {frames} frames x {features} features need {gib:.1} GiB; ask for fewer or shorter samples"
+        "{count} samples of {frames} frames of this model ({features} features) need about {gib:.1} GiB; ask for fewer or shorter samples"
     )]
     TooLarge {
         /// Samples.

@@ -333,7 +333,16 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
         }
     };
     check_length(frames)?;
-    let values = request.count.saturating_mul(f).saturating_mul(frames);
+    // The network's working set per frame of each sample: the features and about eight layers'
+    // worth of channels (hidden state, residual, concatenation, attention), and the decoded
+    // motion's transforms per joint.
+    let per_frame = f
+        .saturating_add(8usize.saturating_mul(metadata.network.channels))
+        .max(12usize.saturating_mul(metadata.layout.skeleton.len()));
+    let values = request
+        .count
+        .saturating_mul(per_frame)
+        .saturating_mul(frames);
     if values > MAX_VALUES {
         return Err(TaskError::TooLarge {
             count: request.count,

@@ -5,6 +5,14 @@ use serde::{Deserialize, Serialize};
 
 use std::path::Path;
 
+mod json_path;
+mod validate;
+
+pub use validate::{
+    MAX_DIFFUSION_STEPS, MAX_FEATURES, MAX_FPS, MAX_JOINTS, MAX_NAME_BYTES, MAX_NETWORK_CHANNELS,
+    MAX_WINDOW, problems,
+};
+
 use crate::model::ModelError;
 use crate::motion::{FeatureLayout, Normalizer};
 use crate::network::NetworkShape;
@@ -125,51 +133,22 @@ pub fn parse_metadata(
         message,
     };
     let json = lookup(METADATA_KEY).ok_or_else(|| bad(format!("no '{METADATA_KEY}' entry")))?;
-    let metadata: ModelMetadata =
-        serde_json::from_str(&json).map_err(|e| bad(format!("'{METADATA_KEY}': {e}")))?;
-    check_consistent(&metadata).map_err(bad)?;
+    let metadata: ModelMetadata = serde_json::from_str(&json).map_err(|e| {
+        let path = json_path::path_at(&json, json_path::offset_of(&json, e.line(), e.column()));
+        let field = if path.is_empty() {
+            String::new()
+        } else {
+            format!(" at field {path}")
+        };
+        bad(format!("'{METADATA_KEY}'{field}: {e}"))
+    })?;
+    let problems = validate::problems(&metadata);
+    if !problems.is_empty() {
+        return Err(ModelError::Invalid {
+            path: path.to_path_buf(),
+            problems,
+            metadata: Box::new(metadata),
+        });
+    }
     Ok(metadata)
-}
-
-/// Cross-checks of the metadata's parts against each other.
-fn check_consistent(m: &ModelMetadata) -> Result<(), String> {
-    let width = m.layout.width();
-    if m.network.features != width {
-        return Err(format!(
-            "network.features is {} but the feature layout has {width} columns",
-            m.network.features
-        ));
-    }
-    if m.normalizer.mean.len() != width || m.normalizer.std.len() != width {
-        return Err(format!(
-            "the normalizer has {} means and {} stds for {width} features",
-            m.normalizer.mean.len(),
-            m.normalizer.std.len()
-        ));
-    }
-    if let Some(i) = m
-        .normalizer
-        .std
-        .iter()
-        .position(|s| !(s.is_finite() && *s > 0.0))
-    {
-        return Err(format!("normalizer.std[{i}] is not a positive number"));
-    }
-    m.network
-        .shape()
-        .check()
-        .map_err(|e| format!("network: {e}"))?;
-    if m.diffusion.schedule != SCHEDULE || m.diffusion.prediction != PREDICTION {
-        return Err(format!(
-            "diffusion.schedule '{}' / prediction '{}': this runtime runs '{SCHEDULE}' / '{PREDICTION}'",
-            m.diffusion.schedule, m.diffusion.prediction
-        ));
-    }
-    if m.diffusion.steps < 2 {
-        return Err(format!("diffusion.steps is {}", m.diffusion.steps));
-    }
-    if !(m.layout.fps.is_finite() && m.layout.fps > 0.0) {
-        return Err(format!("layout.fps is {}", m.layout.fps));
-    }
-    Ok(())
 }

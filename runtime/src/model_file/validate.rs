@@ -1,0 +1,268 @@
+//! Every rule a model file's metadata must follow before the runtime uses it: each field
+//! against its bounds and against the others. A file from a modder, a pipeline or a download
+//! can hold anything; after these checks no index is out of range, no number is non-finite
+//! where it is used, and no size makes an allocation the runtime would not make for a real model.
+
+use std::collections::HashSet;
+
+use super::{ModelMetadata, PREDICTION, SCHEDULE};
+use crate::motion::math::{self, Mat3};
+use crate::motion::skeleton::{Channel, Skeleton};
+
+/// Most joints a model's skeleton may have.
+pub const MAX_JOINTS: usize = 4096;
+/// Longest joint name, in bytes.
+pub const MAX_NAME_BYTES: usize = 256;
+/// Most feature rows F.
+pub const MAX_FEATURES: usize = 6 * MAX_JOINTS + 3 * MAX_JOINTS;
+/// Most channels C.
+pub const MAX_NETWORK_CHANNELS: usize = 8192;
+/// Widest QnA window, in frames.
+pub const MAX_WINDOW: usize = 255;
+/// Most diffusion steps T (the schedule holds a few f64 per step).
+pub const MAX_DIFFUSION_STEPS: usize = 100_000;
+/// Highest frame rate.
+pub const MAX_FPS: f64 = 10_000.0;
+
+/// Every problem of `m`, each naming the field and the value; empty when the metadata is sound.
+pub fn problems(m: &ModelMetadata) -> Vec<String> {
+    let mut p = Problems::default();
+    skeleton(&mut p, &m.layout.skeleton);
+    if p.0.is_empty() {
+        // The layout's indices are checked only against a sound skeleton.
+        layout(&mut p, m);
+    }
+    network_and_normalizer(&mut p, m);
+    let d = &m.diffusion;
+    if !(2..=MAX_DIFFUSION_STEPS).contains(&d.steps) {
+        p.add(format!(
+            "diffusion.steps is {}; it must be between 2 and {MAX_DIFFUSION_STEPS}",
+            d.steps
+        ));
+    }
+    if d.schedule != SCHEDULE || d.prediction != PREDICTION {
+        p.add(format!(
+            "diffusion.schedule '{}' / prediction '{}': this runtime runs '{SCHEDULE}' / '{PREDICTION}'",
+            d.schedule, d.prediction
+        ));
+    }
+    if m.training.clip_frames > crate::tasks::MAX_FRAMES {
+        p.add(format!(
+            "training.clip_frames is {}; the most a model can make is {} frames",
+            m.training.clip_frames,
+            crate::tasks::MAX_FRAMES
+        ));
+    }
+    p.0
+}
+
+#[derive(Default)]
+struct Problems(Vec<String>);
+
+impl Problems {
+    fn add(&mut self, message: String) {
+        self.0.push(message);
+    }
+
+    fn finite(&mut self, field: &str, values: &[f64]) {
+        if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+            self.add(format!("{field} holds {v}; it must be a finite number"));
+        }
+    }
+
+    fn positive(&mut self, field: &str, value: f64, most: f64) {
+        if !(value.is_finite() && value > 0.0 && value <= most) {
+            self.add(format!(
+                "{field} is {value}; it must be a positive number up to {most}"
+            ));
+        }
+    }
+}
+
+fn skeleton(p: &mut Problems, s: &Skeleton) {
+    let joints = &s.joints;
+    if joints.is_empty() || joints.len() > MAX_JOINTS {
+        p.add(format!(
+            "layout.skeleton.joints has {} joints; it must have 1 to {MAX_JOINTS}",
+            joints.len()
+        ));
+        return;
+    }
+    let mut names = HashSet::new();
+    for (i, joint) in joints.iter().enumerate() {
+        let field = format!("layout.skeleton.joints[{i}]");
+        if joint.name.trim().is_empty() || joint.name.len() > MAX_NAME_BYTES {
+            p.add(format!(
+                "{field}.name is '{}'; a name has 1 to {MAX_NAME_BYTES} bytes",
+                joint.name.escape_debug()
+            ));
+        } else if !names.insert(joint.name.as_str()) {
+            p.add(format!("{field}.name '{}' is used twice", joint.name));
+        }
+        match (i, joint.parent) {
+            (0, Some(parent)) => p.add(format!(
+                "{field}.parent is {parent}; the first joint is the root and has none"
+            )),
+            (_, None) if i > 0 => p.add(format!(
+                "{field}.parent is missing; only the first joint is a root"
+            )),
+            (_, Some(parent)) if parent >= i => p.add(format!(
+                "{field}.parent is {parent}; a parent must come before its child (index below {i})"
+            )),
+            _ => {}
+        }
+        p.finite(&format!("{field}.offset"), &joint.offset);
+        if let Some(end) = joint.end_site {
+            p.finite(&format!("{field}.end_site"), &end);
+        }
+        let rotations = joint.rotation_order();
+        let positions = joint.position_axes();
+        let distinct =
+            |axes: &[crate::motion::Axis]| axes.iter().collect::<HashSet<_>>().len() == axes.len();
+        if !(rotations.is_empty() || rotations.len() == 3) || !distinct(&rotations) {
+            p.add(format!(
+                "{field}.channels has rotations {rotations:?}; a joint has none or three distinct axes"
+            ));
+        }
+        if !distinct(&positions) {
+            p.add(format!(
+                "{field}.channels repeats a position axis: {positions:?}"
+            ));
+        }
+    }
+}
+
+fn layout(p: &mut Problems, m: &ModelMetadata) {
+    let l = &m.layout;
+    let joints = &l.skeleton.joints;
+    let n = joints.len();
+    p.positive("layout.fps", l.fps, MAX_FPS);
+    p.positive("layout.skeleton_height", l.skeleton_height, f64::MAX);
+    p.positive(
+        "layout.contact_speed_threshold",
+        l.contact_speed_threshold,
+        f64::MAX,
+    );
+    if l.rest_translations.len() != n {
+        p.add(format!(
+            "layout.rest_translations has {} entries for {n} joints",
+            l.rest_translations.len()
+        ));
+    }
+    for (i, t) in l.rest_translations.iter().enumerate() {
+        p.finite(&format!("layout.rest_translations[{i}]"), t);
+    }
+    if let Some(root) = &l.root {
+        if root.joint >= n {
+            p.add(format!(
+                "layout.root.joint is {}; the skeleton has {n} joints",
+                root.joint
+            ));
+        }
+        let axes: HashSet<_> = root.axes.iter().collect();
+        if root.axes.is_empty() || axes.len() != root.axes.len() {
+            p.add(format!(
+                "layout.root.axes is {:?}; it must list 1 to 3 distinct axes",
+                root.axes
+            ));
+        }
+        p.finite("layout.root.start_position", &root.start_position);
+        if !is_rotation(&root.frame) {
+            p.add(format!(
+                "layout.root.frame is {:?}; it must be a rotation matrix",
+                root.frame
+            ));
+        }
+    }
+    let mut seen = HashSet::new();
+    for (i, &j) in l.rotation_joints.iter().enumerate() {
+        let field = format!("layout.rotation_joints[{i}]");
+        if j >= n {
+            p.add(format!("{field} is {j}; the skeleton has {n} joints"));
+        } else if joints[j].rotation_order().len() != 3 {
+            p.add(format!(
+                "{field} is joint '{}', which has no rotation channels",
+                joints[j].name
+            ));
+        } else if !seen.insert(j) {
+            p.add(format!("{field}: joint {j} is listed twice"));
+        }
+    }
+    let mut seen = HashSet::new();
+    for (i, &(j, axis)) in l.position_channels.iter().enumerate() {
+        let field = format!("layout.position_channels[{i}]");
+        if j >= n {
+            p.add(format!("{field} is joint {j}; the skeleton has {n} joints"));
+        } else if !joints[j].channels.contains(&Channel::Position(axis)) {
+            p.add(format!(
+                "{field} is {axis:?} of joint '{}', which has no such channel",
+                joints[j].name
+            ));
+        } else if !seen.insert((j, axis)) {
+            p.add(format!("{field}: listed twice"));
+        }
+    }
+    let mut seen = HashSet::new();
+    for (i, &j) in l.contact_joints.iter().enumerate() {
+        let field = format!("layout.contact_joints[{i}]");
+        if j >= n {
+            p.add(format!("{field} is {j}; the skeleton has {n} joints"));
+        } else if !seen.insert(j) {
+            p.add(format!("{field}: joint {j} is listed twice"));
+        }
+    }
+}
+
+fn network_and_normalizer(p: &mut Problems, m: &ModelMetadata) {
+    let net = &m.network;
+    let width = m.layout.width();
+    if net.features == 0 || net.features > MAX_FEATURES {
+        p.add(format!(
+            "network.features is {}; it must be between 1 and {MAX_FEATURES}",
+            net.features
+        ));
+    } else if net.features != width {
+        p.add(format!(
+            "network.features is {} but the feature layout has {width} columns",
+            net.features
+        ));
+    }
+    if net.channels > MAX_NETWORK_CHANNELS || net.window > MAX_WINDOW {
+        p.add(format!(
+            "network.channels {} / window {}: the most are {MAX_NETWORK_CHANNELS} / {MAX_WINDOW}",
+            net.channels, net.window
+        ));
+    }
+    if let Err(e) = net.shape().check() {
+        p.add(format!("network: {e}"));
+    }
+    let norm = &m.normalizer;
+    if norm.mean.len() != net.features || norm.std.len() != net.features {
+        p.add(format!(
+            "normalizer has {} means and {} stds for {} features",
+            norm.mean.len(),
+            norm.std.len(),
+            net.features
+        ));
+    }
+    if let Some(i) = norm.mean.iter().position(|v| !v.is_finite()) {
+        p.add(format!(
+            "normalizer.mean[{i}] is {}; it must be finite",
+            norm.mean[i]
+        ));
+    }
+    if let Some(i) = norm.std.iter().position(|s| !(s.is_finite() && *s > 0.0)) {
+        p.add(format!(
+            "normalizer.std[{i}] is {}; it must be a positive number",
+            norm.std[i]
+        ));
+    }
+}
+
+/// Whether `m` is a rotation: finite, orthonormal and right-handed, to 1e-6.
+fn is_rotation(m: &Mat3) -> bool {
+    let product = math::mat_mul(m, &math::transpose(m));
+    m.iter().flatten().all(|v| v.is_finite())
+        && math::mat_max_abs_diff(&product, &math::IDENTITY) < 1e-6
+        && (math::dot(m[0], math::cross(m[1], m[2])) - 1.0).abs() < 1e-6
+}
