@@ -15,7 +15,7 @@ use sinmdm::features_file::write_features;
 use sinmdm::files::write_atomically;
 use sinmdm::{Model, ModelOptions};
 use sinmdm::{Request, Task};
-use sinmdm_eval::{COVERAGE_WINDOW, ModelEvaluation, Report, evaluate_model};
+use sinmdm_eval::{COVERAGE_WINDOW, FeetReport, ModelEvaluation, Report, evaluate_model};
 
 pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm eval -m onnx-models/human_walk_cmu.onnx --clip tests/data/bvh/human_walk_cmu_131_01.bvh
@@ -75,6 +75,7 @@ struct EvalFile<'a> {
     seed: u64,
     sampling_seconds: f64,
     report: &'a Report,
+    feet: &'a FeetReport,
 }
 
 pub(crate) fn run(args: &EvalArgs) -> Result<()> {
@@ -147,6 +148,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     let ModelEvaluation {
         generated,
         report,
+        feet,
         sampling_seconds,
         scoring_seconds,
     } = evaluation;
@@ -167,6 +169,8 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     );
     println!();
     print!("{}", report.markdown_table());
+    println!();
+    print!("{}", feet.markdown_table());
 
     if let Some(path) = &args.features_json {
         write_features(path, layout, generated.features.view())?;
@@ -185,6 +189,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             seed: args.seed,
             sampling_seconds,
             report: &report,
+            feet: &feet,
         };
         let text = serde_json::to_string_pretty(&file)?;
         write_atomically(path, text.as_bytes())

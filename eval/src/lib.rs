@@ -28,6 +28,7 @@
 
 #![warn(missing_docs)]
 
+mod feet;
 mod model_eval;
 mod patched_nn;
 #[cfg(test)]
@@ -40,6 +41,10 @@ use thiserror::Error;
 
 use sinmdm::motion::{ColumnKind, FeatureLayout};
 
+pub use feet::{
+    FeetReference, FeetReport, FeetScores, GROUND_BAND, GROUND_PERCENTILE, PENETRATION_TOLERANCE,
+    SKATING_SPEED, SPEED_WINDOW, mean_scores,
+};
 pub use model_eval::{ModelEvalError, ModelEvaluation, evaluate_model};
 pub use patched_nn::patched_nearest_neighbour;
 pub use window_match::DiagonalSums;

@@ -5,10 +5,11 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use ndarray::{Array2, ArrayView2};
+use sinmdm::motion::{MotionError, decode};
 use sinmdm::{Denoiser, Generated, ModelMetadata, Request, TaskError};
 use thiserror::Error;
 
-use crate::{COVERAGE_WINDOW, EvalError, Report, evaluate, metric_features};
+use crate::{COVERAGE_WINDOW, EvalError, FeetReport, Report, evaluate, metric_features};
 
 /// Why a model could not be scored.
 #[derive(Debug, Error)]
@@ -19,6 +20,9 @@ pub enum ModelEvalError {
     /// The samples or the clip could not be scored.
     #[error(transparent)]
     Metrics(#[from] EvalError),
+    /// The samples or the clip could not be decoded into motion.
+    #[error(transparent)]
+    Motion(#[from] MotionError),
 }
 
 /// Samples, their scores, and how long each part took.
@@ -28,6 +32,8 @@ pub struct ModelEvaluation {
     pub generated: Generated,
     /// Their scores against the clip.
     pub report: Report,
+    /// Their feet and smoothness figures beside the clip's.
+    pub feet: FeetReport,
     /// Seconds spent sampling.
     pub sampling_seconds: f64,
     /// Seconds spent scoring.
@@ -35,7 +41,8 @@ pub struct ModelEvaluation {
 }
 
 /// Runs `request` on `denoiser` (a model with `metadata`) and scores the samples against
-/// `clip`, raw features `[F, N]` in the model's layout, with `threads` threads.
+/// `clip`, raw features `[F, N]` in the model's layout, with `threads` threads: the benchmark's
+/// coverage and diversity, and the feet and smoothness figures (SPEC section 9).
 pub fn evaluate_model<D: Denoiser>(
     denoiser: &mut D,
     metadata: &ModelMetadata,
@@ -68,9 +75,14 @@ where
         .map(|sample| metric_features(layout, sample))
         .collect();
     let report = evaluate(clip_metric.view(), &samples, threads.max(1))?;
+    let motions = (0..generated.count())
+        .map(|i| generated.motion(i))
+        .collect::<Result<Vec<_>, _>>()?;
+    let feet = FeetReport::new(layout, &decode(layout, clip)?, &motions);
     Ok(ModelEvaluation {
         generated,
         report,
+        feet,
         sampling_seconds,
         scoring_seconds: started.elapsed().as_secs_f64(),
     })
