@@ -5,6 +5,7 @@ pub mod clip;
 pub mod contacts;
 pub mod features;
 pub mod fk;
+pub mod ik;
 pub mod math;
 pub mod normalize;
 pub mod pose;
