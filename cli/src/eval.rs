@@ -126,9 +126,10 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     let threads = args.threads.unwrap_or_else(|| {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
+    // The run's step count comes with each progress call: the request is planned once, inside.
     let bar = progress_bar(
         args.quiet,
-        sinmdm::plan(model.metadata(), &request)?.steps(),
+        0,
         format!("{} x {} frames", args.samples, frames),
     );
     let metadata = model.metadata().clone();
@@ -138,7 +139,8 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         &request,
         clip.view(),
         threads,
-        &mut |done, _| {
+        &mut |done, steps| {
+            bar.set_length(steps as u64);
             bar.set_position(done as u64);
             ControlFlow::Continue(())
         },

@@ -2,28 +2,8 @@
 
 use sinmdm_eval::Report;
 
-/// A small valid clip: two joints, two frames.
-const VALID: &str = "HIERARCHY
-ROOT Hips
-{
-\tOFFSET 0 0 0
-\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
-\tJOINT Spine
-\t{
-\t\tOFFSET 0 10 0
-\t\tCHANNELS 3 Zrotation Xrotation Yrotation
-\t\tEnd Site
-\t\t{
-\t\t\tOFFSET 0 5 0
-\t\t}
-\t}
-}
-MOTION
-Frames: 2
-Frame Time: 0.0333333
-0 90 0 0 0 0 10 0 0
-1 90 0 0 0 0 20 0 0
-";
+/// A small valid clip (shared with the runtime's BVH tests): two joints, two frames.
+const VALID: &str = include_str!("../../tests/data/two_joints.bvh");
 
 fn repo_file(relative: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

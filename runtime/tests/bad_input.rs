@@ -2,28 +2,9 @@
 
 use sinmdm::bvh::{BvhErrorKind, parse_bvh, read_bvh};
 
-/// A small valid clip: a root with 6 channels, one child with 3, an End Site, two frames.
-const VALID: &str = "HIERARCHY
-ROOT Hips
-{
-\tOFFSET 0 0 0
-\tCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
-\tJOINT Spine
-\t{
-\t\tOFFSET 0 10 0
-\t\tCHANNELS 3 Zrotation Xrotation Yrotation
-\t\tEnd Site
-\t\t{
-\t\t\tOFFSET 0 5 0
-\t\t}
-\t}
-}
-MOTION
-Frames: 2
-Frame Time: 0.0333333
-0 90 0 0 0 0 10 0 0
-1 90 0 0 0 0 20 0 0
-";
+/// A small valid clip (shared with the other crates' tests): a root with 6 channels, one child
+/// with 3, an End Site, two frames.
+const VALID: &str = include_str!("../../tests/data/two_joints.bvh");
 
 fn error_of(text: &str) -> sinmdm::bvh::BvhError {
     parse_bvh(text, "clip.bvh").expect_err("the text should be rejected")
