@@ -13,8 +13,8 @@ use crate::sampling::{
 };
 use sinmdm::features_file::write_features;
 use sinmdm::files::write_atomically;
+use sinmdm::{Feet, Request, Task};
 use sinmdm::{Model, ModelOptions};
-use sinmdm::{Request, Task};
 use sinmdm_eval::{COVERAGE_WINDOW, FeetReport, ModelEvaluation, Report, evaluate_model};
 
 pub(crate) const EXAMPLES: &str = "Examples:
@@ -75,6 +75,7 @@ struct EvalFile<'a> {
     seed: u64,
     sampling_seconds: f64,
     report: &'a Report,
+    planted_report: &'a Report,
     feet: &'a FeetReport,
 }
 
@@ -122,6 +123,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         count: args.samples,
         seed: args.seed,
         steps,
+        feet: Feet::Planted,
     };
     let threads = args.threads.unwrap_or_else(|| {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
@@ -150,6 +152,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     let ModelEvaluation {
         generated,
         report,
+        planted_report,
         feet,
         sampling_seconds,
         scoring_seconds,
@@ -170,7 +173,11 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         args.samples, frames, steps_text, args.seed, sampling_seconds, scoring_seconds
     );
     println!();
+    println!("samples as the network made them (--feet raw):");
     print!("{}", report.markdown_table());
+    println!();
+    println!("samples with their feet planted (the default output):");
+    print!("{}", planted_report.markdown_table());
     println!();
     print!("{}", feet.markdown_table());
 
@@ -191,6 +198,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             seed: args.seed,
             sampling_seconds,
             report: &report,
+            planted_report: &planted_report,
             feet: &feet,
         };
         let text = serde_json::to_string_pretty(&file)?;

@@ -14,7 +14,7 @@ use sinmdm::files::write_atomically;
 use sinmdm::motion::encode_for_model;
 use sinmdm::motion::up::UpAxis;
 use sinmdm::tasks::MAX_COUNT;
-use sinmdm::{Generated, Plan, Request, Span, Task};
+use sinmdm::{Feet, Generated, Plan, Request, Span, Task};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_render::{Camera, Figure};
 
@@ -55,6 +55,29 @@ pub struct SamplingArgs {
     /// Do not show the progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Feet: `planted` holds each foot still while the model says it is on the ground and
+    /// keeps every joint above the ground (by turning the legs; bone lengths stay exact);
+    /// `raw` writes the network's motion untouched.
+    #[arg(long, value_enum, default_value_t = FeetArg::Planted)]
+    pub feet: FeetArg,
+}
+
+/// `--feet`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FeetArg {
+    /// Feet held still during contact, nothing below the ground.
+    Planted,
+    /// The network's motion untouched.
+    Raw,
+}
+
+impl From<FeetArg> for Feet {
+    fn from(arg: FeetArg) -> Feet {
+        match arg {
+            FeetArg::Planted => Feet::Planted,
+            FeetArg::Raw => Feet::Raw,
+        }
+    }
 }
 
 impl SamplingArgs {
@@ -224,6 +247,7 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         count: args.count,
         seed: args.seed,
         steps: args.steps()?,
+        feet: args.feet.into(),
     };
     let plan = sinmdm::plan(model.metadata(), &request)?;
     let mut outputs: Vec<PathBuf> = (0..plan.count())

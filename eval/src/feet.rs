@@ -4,6 +4,7 @@
 //! H, for the samples and for the clip itself (the level a model should reach).
 
 use serde::{Deserialize, Serialize};
+use sinmdm::motion::feet::ground_level;
 use sinmdm::motion::math::{self, Vec3};
 use sinmdm::motion::up::{height_of, horizontal, to_canonical};
 use sinmdm::motion::{FeatureLayout, GlobalPose, LocalMotion, global_poses};
@@ -14,8 +15,6 @@ pub const GROUND_BAND: f64 = 0.05;
 pub const SKATING_SPEED: f64 = 0.3;
 /// A joint more than this share of H below the ground counts as through the floor.
 pub const PENETRATION_TOLERANCE: f64 = 0.01;
-/// The ground is this percentile of the clip's per-frame lowest contact point.
-pub const GROUND_PERCENTILE: f64 = 5.0;
 /// Frames of the centred moving average of a contact point's speed.
 pub const SPEED_WINDOW: usize = 5;
 
@@ -45,29 +44,9 @@ impl FeetReference {
     /// layout has no contact joints).
     pub fn new(layout: &FeatureLayout, clip: &LocalMotion) -> FeetReference {
         let poses = canonical_poses(layout, clip);
-        let mut lowest: Vec<f64> = poses
-            .iter()
-            .map(|pose| {
-                let points: Vec<Vec3> = if layout.contact_joints.is_empty() {
-                    pose.points().collect()
-                } else {
-                    layout
-                        .contact_joints
-                        .iter()
-                        .map(|&j| pose.contact_point(j))
-                        .collect()
-                };
-                points
-                    .into_iter()
-                    .map(height_of)
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .collect();
-        lowest.sort_by(f64::total_cmp);
-        let ground = percentile(&lowest, GROUND_PERCENTILE);
         FeetReference {
             layout: layout.clone(),
-            ground,
+            ground: ground_level(&layout.contact_joints, &poses),
         }
     }
 
@@ -156,16 +135,6 @@ fn share(n: usize, test: impl Fn(usize) -> bool) -> f64 {
     (0..n).filter(|&i| test(i)).count() as f64 / n as f64
 }
 
-/// The `p`-th percentile of sorted values, linearly interpolated (numpy's default).
-fn percentile(sorted: &[f64], p: f64) -> f64 {
-    if sorted.is_empty() {
-        return 0.0;
-    }
-    let rank = p / 100.0 * (sorted.len() - 1) as f64;
-    let (lo, hi) = (rank.floor() as usize, rank.ceil() as usize);
-    sorted[lo] + (sorted[hi] - sorted[lo]) * (rank - lo as f64)
-}
-
 /// The mean of each figure over several motions.
 pub fn mean_scores(scores: &[FeetScores]) -> FeetScores {
     let n = scores.len().max(1) as f64;
@@ -178,80 +147,91 @@ pub fn mean_scores(scores: &[FeetScores]) -> FeetScores {
     }
 }
 
-/// The feet figures of a batch of samples beside the clip's.
+/// A row of the Markdown table: name, figure, decimals.
+type TableRow = (&'static str, fn(&FeetScores) -> f64, usize);
+
+/// The feet figures of a batch of samples.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct FeetReport {
-    /// The clip itself: the level a model should reach.
-    pub clip: FeetScores,
+pub struct SampleFeet {
     /// The mean over the samples.
-    pub samples: FeetScores,
+    pub mean: FeetScores,
     /// Every sample's figures.
     pub per_sample: Vec<FeetScores>,
     /// The samples' jitter over the clip's.
     pub jitter_ratio: f64,
 }
 
+/// The feet figures of a batch of samples, as the network made them and with their feet
+/// planted, beside the clip's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FeetReport {
+    /// The clip itself: the level a model should reach.
+    pub clip: FeetScores,
+    /// The samples as the network made them.
+    pub raw: SampleFeet,
+    /// The same samples with their feet planted.
+    pub planted: SampleFeet,
+}
+
 impl FeetReport {
-    /// The feet figures of `samples` against `clip`, both decoded motions of `layout`.
-    pub fn new(layout: &FeatureLayout, clip: &LocalMotion, samples: &[LocalMotion]) -> FeetReport {
+    /// The feet figures of `raw` and `planted` samples against `clip`, all decoded motions of
+    /// `layout`.
+    pub fn new(
+        layout: &FeatureLayout,
+        clip: &LocalMotion,
+        raw: &[LocalMotion],
+        planted: &[LocalMotion],
+    ) -> FeetReport {
         let reference = FeetReference::new(layout, clip);
-        let per_sample: Vec<FeetScores> = samples.iter().map(|m| reference.scores(m)).collect();
         let clip = reference.scores(clip);
-        let samples = mean_scores(&per_sample);
+        let batch = |motions: &[LocalMotion]| {
+            let per_sample: Vec<FeetScores> = motions.iter().map(|m| reference.scores(m)).collect();
+            let mean = mean_scores(&per_sample);
+            SampleFeet {
+                jitter_ratio: mean.jitter / clip.jitter.max(f64::MIN_POSITIVE),
+                mean,
+                per_sample,
+            }
+        };
         FeetReport {
-            jitter_ratio: samples.jitter / clip.jitter.max(f64::MIN_POSITIVE),
+            raw: batch(raw),
+            planted: batch(planted),
             clip,
-            samples,
-            per_sample,
         }
     }
 
-    /// The figures as a Markdown table, clip beside samples.
+    /// The figures as a Markdown table: clip, raw samples, planted samples.
     pub fn markdown_table(&self) -> String {
-        let (c, s) = (&self.clip, &self.samples);
-        let rows = [
-            (
-                "skating ratio (%) ↓",
-                100.0 * c.skating_ratio,
-                100.0 * s.skating_ratio,
-                1,
-            ),
+        let (c, r, p) = (&self.clip, &self.raw.mean, &self.planted.mean);
+        let rows: [TableRow; 4] = [
+            ("skating ratio (%) ↓", |s| 100.0 * s.skating_ratio, 1),
             (
                 "deepest point below the ground (x H) ↓",
-                c.max_penetration,
-                s.max_penetration,
+                |s| s.max_penetration,
                 4,
             ),
             (
                 "frames through the floor (%) ↓",
-                100.0 * c.penetrating_frames,
-                100.0 * s.penetrating_frames,
+                |s| 100.0 * s.penetrating_frames,
                 1,
             ),
-            ("jitter (H/s²) ↓", c.jitter, s.jitter, 2),
+            ("jitter (H/s²) ↓", |s| s.jitter, 2),
         ];
-        let mut out = String::from("| feet and smoothness | clip | samples |\n|---|---|---|\n");
-        for (name, clip, samples, digits) in rows {
+        let mut out = String::from(
+            "| feet and smoothness | clip | samples, raw | samples, feet planted |\n|---|---|---|---|\n",
+        );
+        for (name, value, digits) in rows {
             out.push_str(&format!(
-                "| {name} | {clip:.digits$} | {samples:.digits$} |\n"
+                "| {name} | {:.digits$} | {:.digits$} | {:.digits$} |\n",
+                value(c),
+                value(r),
+                value(p)
             ));
         }
         out.push_str(&format!(
-            "| jitter, samples / clip | | {:.2} |\n",
-            self.jitter_ratio
+            "| jitter, samples / clip | | {:.2} | {:.2} |\n",
+            self.raw.jitter_ratio, self.planted.jitter_ratio
         ));
         out
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn percentile_matches_numpy_linear() {
-        // numpy.percentile([1, 2, 3, 4, 10], 5) = 1.2
-        assert!((percentile(&[1.0, 2.0, 3.0, 4.0, 10.0], 5.0) - 1.2).abs() < 1e-12);
-        assert_eq!(percentile(&[7.0], 5.0), 7.0);
     }
 }

@@ -42,8 +42,8 @@ use thiserror::Error;
 use sinmdm::motion::{ColumnKind, FeatureLayout};
 
 pub use feet::{
-    FeetReference, FeetReport, FeetScores, GROUND_BAND, GROUND_PERCENTILE, PENETRATION_TOLERANCE,
-    SKATING_SPEED, SPEED_WINDOW, mean_scores,
+    FeetReference, FeetReport, FeetScores, GROUND_BAND, PENETRATION_TOLERANCE, SKATING_SPEED,
+    SPEED_WINDOW, SampleFeet, mean_scores,
 };
 pub use model_eval::{ModelEvalError, ModelEvaluation, evaluate_model};
 pub use patched_nn::patched_nearest_neighbour;

@@ -5,7 +5,7 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use ndarray::{Array2, ArrayView2};
-use sinmdm::motion::{MotionError, decode};
+use sinmdm::motion::{ColumnKind, MotionError, decode, encode_motion};
 use sinmdm::{Denoiser, Generated, ModelMetadata, Request, TaskError};
 use thiserror::Error;
 
@@ -30,9 +30,11 @@ pub enum ModelEvalError {
 pub struct ModelEvaluation {
     /// The samples.
     pub generated: Generated,
-    /// Their scores against the clip.
+    /// Their scores against the clip, as the network made them.
     pub report: Report,
-    /// Their feet and smoothness figures beside the clip's.
+    /// The same scores with the samples' feet planted (the motion a user gets by default).
+    pub planted_report: Report,
+    /// Their feet and smoothness figures, raw and planted, beside the clip's.
     pub feet: FeetReport,
     /// Seconds spent sampling.
     pub sampling_seconds: f64,
@@ -75,13 +77,37 @@ where
         .map(|sample| metric_features(layout, sample))
         .collect();
     let report = evaluate(clip_metric.view(), &samples, threads.max(1))?;
-    let motions = (0..generated.count())
-        .map(|i| generated.motion(i))
+    let raw = (0..generated.count())
+        .map(|i| generated.raw_motion(i))
         .collect::<Result<Vec<_>, _>>()?;
-    let feet = FeetReport::new(layout, &decode(layout, clip)?, &motions);
+    let planted = (0..generated.count())
+        .map(|i| Ok(generated.planted_motion(i)?.0))
+        .collect::<Result<Vec<_>, MotionError>>()?;
+    // Planting changes rotations and the root's height; the contact labels stay the model's.
+    let contact_rows: Vec<usize> = layout
+        .columns()
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.kind == ColumnKind::Contact)
+        .map(|(i, _)| i)
+        .collect();
+    let planted_samples: Vec<Array2<f64>> = planted
+        .iter()
+        .zip(generated.features.outer_iter())
+        .map(|(motion, made)| {
+            let mut features = encode_motion(layout, motion);
+            for &row in &contact_rows {
+                features.row_mut(row).assign(&made.row(row));
+            }
+            metric_features(layout, features.view())
+        })
+        .collect();
+    let planted_report = evaluate(clip_metric.view(), &planted_samples, threads.max(1))?;
+    let feet = FeetReport::new(layout, &decode(layout, clip)?, &raw, &planted);
     Ok(ModelEvaluation {
         generated,
         report,
+        planted_report,
         feet,
         sampling_seconds,
         scoring_seconds: started.elapsed().as_secs_f64(),

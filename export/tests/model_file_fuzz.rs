@@ -298,6 +298,7 @@ fn try_mutant(bytes: &[u8]) -> Result<Option<&'static str>, String> {
         count: 1,
         seed: 1,
         steps: Some(2),
+        feet: sinmdm::Feet::default(),
     };
     match sinmdm::run(&mut model, &request, &mut |_, _| ControlFlow::Continue(())) {
         Ok(generated) => match generated.poses(0) {

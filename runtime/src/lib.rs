@@ -11,7 +11,7 @@
 //!
 //! ```
 //! use std::ops::ControlFlow;
-//! use sinmdm::{Model, ModelOptions, Request, Task};
+//! use sinmdm::{Feet, Model, ModelOptions, Request, Task};
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! # let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../onnx-models/human_walk_cmu.onnx");
@@ -22,6 +22,7 @@
 //!     count: 2,
 //!     seed: 7,
 //!     steps: Some(10),
+//!     feet: Feet::Planted, // contact points held still on the ground; Feet::Raw leaves them
 //! };
 //! let generated = sinmdm::run(&mut model, &request, &mut |_done, _steps| ControlFlow::Continue(()))?;
 //! let poses = generated.poses(0)?; // per frame: root position, local rotations, translations
@@ -55,7 +56,7 @@ pub mod tasks;
 pub use diffusion::{Denoiser, Sampler, SamplerError};
 pub use model::{Model, ModelError, ModelOptions};
 pub use model_file::ModelMetadata;
-pub use motion::{Joint, Pose, Quaternion, Skeleton, UpAxis};
+pub use motion::{Feet, Joint, Pose, Quaternion, Skeleton, UpAxis};
 pub use onnxruntime::{
     ONNXRUNTIME_VERSION, OnnxRuntime, RuntimeLibraryError, init as init_onnxruntime,
     load_onnxruntime,

@@ -21,6 +21,7 @@ fn request(task: Task, count: usize) -> Request {
         count,
         seed: 11,
         steps: Some(12),
+        feet: sinmdm::Feet::default(),
     }
 }
 

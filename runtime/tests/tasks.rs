@@ -37,6 +37,7 @@ fn run(model: &mut Model, task: Task, count: usize, steps: usize) -> Generated {
         count,
         seed: 3,
         steps: Some(steps),
+        feet: sinmdm::Feet::default(),
     };
     tasks::run(model, &request, &mut |_, _| {
         std::ops::ControlFlow::Continue(())
@@ -170,6 +171,7 @@ fn same_seed_same_motion_and_another_seed_another() {
         count: 1,
         seed: 4,
         steps: Some(10),
+        feet: sinmdm::Feet::default(),
     };
     let c = tasks::run(&mut m, &request, &mut |_, _| {
         std::ops::ControlFlow::Continue(())
@@ -240,6 +242,7 @@ fn plan_error(task: Task, count: usize, steps: Option<usize>) -> TaskError {
             count,
             seed: 0,
             steps,
+            feet: sinmdm::Feet::default(),
         },
     )
     .unwrap_err()

@@ -117,9 +117,10 @@ def test_eval_feet_figures_match_the_numpy_reference(tmp_path):
     assert "| skating ratio (%) ↓ |" in done.stdout
     report = json.loads(scores_json.read_text())["feet"]
     frames = json.loads(scores_json.read_text())["frames"]
-    done = run("generate", *common, "--count", 2, "--frames", frames, "--quiet",
-               "-o", tmp_path / "s.bvh")
-    assert done.returncode == 0, done.stderr
+    for feet_mode in ["raw", "planted"]:
+        done = run("generate", *common, "--count", 2, "--frames", frames, "--quiet",
+                   "--feet", feet_mode, "-o", tmp_path / f"{feet_mode}.bvh")
+        assert done.returncode == 0, done.stderr
 
     # Our numpy forward kinematics agrees with bvhio on the joints (End Sites are ours alone).
     theirs, their_names = bvhio_joint_positions(WALK)
@@ -140,13 +141,17 @@ def test_eval_feet_figures_match_the_numpy_reference(tmp_path):
         assert abs(rust["jitter"] - numpy["jitter"]) <= 1e-3 * numpy["jitter"] + 1e-6, (rust, numpy)
 
     close(report["clip"], expected_clip, cj.shape[0] - 1)
-    skated = 0
-    for i, rust in enumerate(report["per_sample"]):
-        sj, ss, names, owners = positions(tmp_path / f"s_{i:03d}.bvh")
-        assert sj.shape[0] == frames
-        contacts = contact_points(sj, ss, names, owners, contact_names)
-        expected = feet.scores(np.concatenate([sj, ss], axis=1), sj, contacts, ground, height, fps)
-        close(rust, expected, frames - 1)
-        skated += expected["skating_ratio"] > 0
-    # The figures are not all trivially zero: a 4-step sample of a tiny model skates.
-    assert skated > 0 and expected_clip["jitter"] > 0
+    skated = {}
+    for feet_mode in ["raw", "planted"]:
+        skated[feet_mode] = 0.0
+        for i, rust in enumerate(report[feet_mode]["per_sample"]):
+            sj, ss, names, owners = positions(tmp_path / f"{feet_mode}_{i:03d}.bvh")
+            assert sj.shape[0] == frames
+            contacts = contact_points(sj, ss, names, owners, contact_names)
+            expected = feet.scores(np.concatenate([sj, ss], axis=1), sj, contacts, ground, height, fps)
+            close(rust, expected, frames - 1)
+            skated[feet_mode] += expected["skating_ratio"]
+    # The figures are not all trivially zero: a 4-step sample of a tiny model skates, and
+    # planting its feet (measured here by numpy on the written files) skates less.
+    assert skated["raw"] > 0 and expected_clip["jitter"] > 0
+    assert skated["planted"] < skated["raw"], skated

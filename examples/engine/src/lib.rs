@@ -42,6 +42,7 @@ pub fn generate_crowd(
         count,
         seed,
         steps: Some(20),
+        feet: sinmdm::Feet::default(),
     };
     let plan = sinmdm::plan(model.metadata(), &request)?;
     let mut sampler = plan.sampler()?;

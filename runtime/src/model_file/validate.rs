@@ -143,6 +143,9 @@ fn layout(p: &mut Problems, m: &ModelMetadata) {
         l.contact_speed_threshold,
         f64::MAX,
     );
+    if let Some(ground) = l.ground {
+        p.finite("layout.ground", &[ground]);
+    }
     if l.rest_translations.len() != n {
         p.add(format!(
             "layout.rest_translations has {} entries for {n} joints",

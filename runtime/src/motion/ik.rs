@@ -18,17 +18,29 @@ pub fn bone_lengths(points: &[Vec3]) -> Vec<f64> {
 /// and the old knee (the generated bend direction). A target out of reach gets the closest
 /// reach: the chain straight towards it (too far) or folded (too near).
 pub fn two_bone(root: Vec3, mid: Vec3, end: Vec3, target: Vec3) -> [Vec3; 2] {
-    let a = math::norm(math::sub(mid, root));
-    let b = math::norm(math::sub(end, mid));
+    let lengths = [
+        math::norm(math::sub(mid, root)),
+        math::norm(math::sub(end, mid)),
+    ];
+    let fallback = math::normalize_or(math::sub(end, root), [0.0, -1.0, 0.0]);
+    two_bone_bent(root, lengths, target, math::sub(mid, root), fallback)
+}
+
+/// The two-bone chain from `root` with bone `lengths` reaching for `target`, its knee bent
+/// towards `bend` (only the part of `bend` across the root-target line counts): new
+/// `[mid, end]`. `fallback` is the reach direction when the target sits on the root.
+pub fn two_bone_bent(
+    root: Vec3,
+    lengths: [f64; 2],
+    target: Vec3,
+    bend: Vec3,
+    fallback: Vec3,
+) -> [Vec3; 2] {
+    let [a, b] = lengths;
     let to_target = math::sub(target, root);
-    let old_reach = math::sub(end, root);
-    // Direction to the target (or, on top of the root, the chain's present direction).
-    let fallback = math::normalize_or(old_reach, [0.0, -1.0, 0.0]);
-    let u = math::normalize_or(to_target, fallback);
+    let u = math::normalize_or(to_target, math::normalize_or(fallback, [0.0, -1.0, 0.0]));
     let d = math::norm(to_target).clamp((a - b).abs(), a + b);
-    // The bend direction: the old knee's offset across the root-target line.
-    let knee = math::sub(mid, root);
-    let across = math::sub(knee, math::scale(u, math::dot(knee, u)));
+    let across = math::sub(bend, math::scale(u, math::dot(bend, u)));
     let v = math::normalize_or(across, any_perpendicular(u));
     let cos = if a * d > 0.0 {
         ((a * a + d * d - b * b) / (2.0 * a * d)).clamp(-1.0, 1.0)

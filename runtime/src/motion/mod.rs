@@ -4,6 +4,7 @@
 pub mod clip;
 pub mod contacts;
 pub mod features;
+pub mod feet;
 pub mod fk;
 pub mod ik;
 pub mod math;
@@ -18,8 +19,9 @@ pub use clip::{ChannelClip, LocalMotion, fps_from_frame_time};
 pub use contacts::ContactConfig;
 pub use features::{
     ClipForModel, Column, ColumnKind, EncodeOptions, EncodedClip, FeatureLayout, FeatureMatrix,
-    MotionError, RootFeatures, decode, encode, encode_for, encode_for_model,
+    MotionError, RootFeatures, decode, encode, encode_for, encode_for_model, encode_motion,
 };
+pub use feet::{Feet, PlantOptions, PlantStats, plant_feet};
 pub use fk::{GlobalPose, global_pose, global_poses, max_position_error, skeleton_height};
 pub use normalize::Normalizer;
 pub use pose::{Pose, Quaternion, poses};

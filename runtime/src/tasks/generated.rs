@@ -3,7 +3,8 @@
 use ndarray::{Array3, Axis};
 
 use crate::model_file::ModelMetadata;
-use crate::motion::{FeatureLayout, LocalMotion, MotionError, Pose, decode, poses};
+use crate::motion::feet::{Feet, Kept, PlantOptions, PlantStats, plant_feet};
+use crate::motion::{ColumnKind, FeatureLayout, LocalMotion, MotionError, Pose, decode, poses};
 
 /// A batch of generated samples in the model's layout.
 #[derive(Debug, Clone)]
@@ -13,6 +14,8 @@ pub struct Generated {
     pub normalized: Array3<f32>,
     /// Features `[B, F, N]` in file units (denormalised).
     pub features: Array3<f32>,
+    feet: Feet,
+    kept: Kept,
 }
 
 impl Generated {
@@ -27,7 +30,28 @@ impl Generated {
             metadata,
             normalized,
             features,
+            feet: Feet::default(),
+            kept: Kept::default(),
         }
+    }
+
+    /// The same batch with `feet` for [`Generated::motion`] and [`Generated::poses`], and the
+    /// joints and root positions a task kept from its reference (left untouched by planting).
+    pub(crate) fn with_feet(mut self, feet: Feet, kept: Kept) -> Generated {
+        self.feet = feet;
+        self.kept = kept;
+        self
+    }
+
+    /// What [`Generated::motion`] and [`Generated::poses`] do to the feet.
+    pub fn feet(&self) -> Feet {
+        self.feet
+    }
+
+    /// Chooses what [`Generated::motion`] and [`Generated::poses`] do to the feet (the
+    /// request's choice until changed).
+    pub fn set_feet(&mut self, feet: Feet) {
+        self.feet = feet;
     }
 
     /// Samples in the batch.
@@ -45,8 +69,32 @@ impl Generated {
         &self.metadata.layout
     }
 
-    /// Sample `index` as local joint transforms.
+    /// Sample `index` as local joint transforms, its feet as [`Generated::feet`] says.
     pub fn motion(&self, index: usize) -> Result<LocalMotion, MotionError> {
+        match self.feet {
+            Feet::Planted => Ok(self.planted_motion(index)?.0),
+            Feet::Raw => self.raw_motion(index),
+        }
+    }
+
+    /// Sample `index` with its feet planted ([`plant_feet`] with default options), and what
+    /// planting did.
+    pub fn planted_motion(&self, index: usize) -> Result<(LocalMotion, PlantStats), MotionError> {
+        let raw = self.raw_motion(index)?;
+        let layout = &self.metadata.layout;
+        let sample = self.features.index_axis(Axis(0), index);
+        let labels: Vec<Vec<f32>> = layout
+            .columns()
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.kind == ColumnKind::Contact)
+            .map(|(row, _)| sample.row(row).to_vec())
+            .collect();
+        plant_feet(layout, &raw, &labels, &self.kept, &PlantOptions::default())
+    }
+
+    /// Sample `index` as the network made it, feet untouched.
+    pub fn raw_motion(&self, index: usize) -> Result<LocalMotion, MotionError> {
         if index >= self.count() {
             return Err(MotionError::NoSuchSample {
                 index,
@@ -59,7 +107,8 @@ impl Generated {
         )
     }
 
-    /// Sample `index` as per-frame root positions and joint quaternions, for engines.
+    /// Sample `index` as per-frame root positions and joint quaternions, for engines, its feet
+    /// as [`Generated::feet`] says.
     pub fn poses(&self, index: usize) -> Result<Vec<Pose>, MotionError> {
         Ok(poses(&self.motion(index)?))
     }

@@ -18,6 +18,7 @@ use thiserror::Error;
 use crate::diffusion::ScheduleError;
 use crate::diffusion::sampler::{SamplerError, StepError};
 use crate::model::ModelError;
+use crate::motion::feet::Feet;
 use crate::motion::{FeatureMatrix, MotionError};
 pub use generated::Generated;
 pub use joints::{joints_by_name, subtree};
@@ -216,4 +217,7 @@ pub struct Request {
     pub seed: u64,
     /// Sampling steps S (respaced); `None` runs all T steps.
     pub steps: Option<usize>,
+    /// What the motion and poses of the result do to the feet: planted (the default) or raw.
+    /// A post-process of decoded motion: the features are the same either way.
+    pub feet: Feet,
 }

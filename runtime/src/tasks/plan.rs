@@ -12,6 +12,7 @@ use crate::diffusion::Schedule;
 use crate::diffusion::sampler::{Denoiser, Guidance, Harmonization, Inpainting, Sampler};
 use crate::model::Model;
 use crate::model_file::ModelMetadata;
+use crate::motion::feet::{Feet, Kept};
 
 /// A request checked against a model: its length, guidance, schedule, sample count and seed,
 /// ready to run. Made only by [`plan`], so what runs is what was checked.
@@ -23,6 +24,7 @@ pub struct Plan {
     frames: usize,
     guidance: Guidance,
     schedule: Schedule,
+    feet: Feet,
 }
 
 impl Plan {
@@ -77,6 +79,28 @@ impl Plan {
         )
     }
 
+    /// Per frame, whether the task keeps the root's position from the reference (every root
+    /// position column fully masked); `None` for tasks without a reference mask.
+    pub fn kept_root(&self) -> Option<Vec<bool>> {
+        let inpaint = self.guidance.inpainting.as_ref()?;
+        let axes = self
+            .metadata
+            .layout
+            .root
+            .as_ref()
+            .map_or(0, |r| r.axes.len());
+        Some(
+            (0..self.frames)
+                .map(|frame| axes > 0 && (0..axes).all(|c| inpaint.mask[[c, frame]] >= 1.0))
+                .collect(),
+        )
+    }
+
+    /// What the batch's motion and poses do to the feet.
+    pub fn feet(&self) -> Feet {
+        self.feet
+    }
+
     /// A sampler for this plan, to step by hand.
     pub fn sampler(&self) -> Result<Sampler<'_>, TaskError> {
         Ok(Sampler::new(
@@ -91,7 +115,12 @@ impl Plan {
 
     /// The batch of a sampler made by [`Plan::sampler`] (finished, or stopped early).
     pub fn finish(&self, sampler: Sampler<'_>) -> Generated {
+        let kept = Kept {
+            joints: self.kept_joints().unwrap_or_default(),
+            root: self.kept_root().unwrap_or_default(),
+        };
         Generated::from_normalized(self.metadata.clone(), sampler.into_sample())
+            .with_feet(self.feet, kept)
     }
 
     /// Runs the plan on a denoiser. `progress` is called after each step with (steps done,
@@ -358,5 +387,6 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
         frames,
         guidance,
         schedule,
+        feet: request.feet,
     })
 }

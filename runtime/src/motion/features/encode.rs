@@ -7,6 +7,7 @@ use super::error::MotionError;
 use super::layout::{FeatureLayout, RootFeatures};
 use crate::motion::clip::{ChannelClip, LocalMotion};
 use crate::motion::contacts::{ContactConfig, choose_contact_joints, label_contacts};
+use crate::motion::feet::ground_level;
 use crate::motion::fk::{global_pose, global_poses, skeleton_height};
 use crate::motion::math::{self, IDENTITY, Vec3};
 use crate::motion::resample::resample;
@@ -248,6 +249,11 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         contact_speed_threshold: options.contacts.speed_threshold,
         skeleton_height: height,
         up,
+        ground: None,
+    };
+    let layout = FeatureLayout {
+        ground: Some(ground_level(&layout.contact_joints, &poses)),
+        ..layout
     };
 
     let filled = fill_features(&layout, &local, &poses);
@@ -369,4 +375,13 @@ pub fn encode_for(
     let local = to_canonical(&resample(&clip.to_local(), layout.fps), layout.up);
     let poses = global_poses(&local);
     Ok(fill_features(layout, &local, &poses).features)
+}
+
+/// Encodes a motion already in a layout's skeleton and frame rate (a decoded or planted
+/// sample, in the file's frame) with the layout's columns; contact labels are measured from
+/// its own feet, as for a clip.
+pub fn encode_motion(layout: &FeatureLayout, motion: &LocalMotion) -> FeatureMatrix {
+    let local = to_canonical(motion, layout.up);
+    let poses = global_poses(&local);
+    fill_features(layout, &local, &poses).features
 }

@@ -80,4 +80,14 @@ pub enum MotionError {
         /// Frame.
         frame: usize,
     },
+    /// Contact labels that do not match the layout's contact joints or the motion's frames.
+    #[error(
+        "planting feet needs one label series per contact joint ({contacts}), each {frames} frames long"
+    )]
+    ContactLabels {
+        /// Contact joints in the layout.
+        contacts: usize,
+        /// Frames in the motion.
+        frames: usize,
+    },
 }

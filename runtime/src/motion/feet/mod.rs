@@ -1,0 +1,31 @@
+//! Planted feet: a pass over decoded motion that holds each contact point still while the
+//! model's own contact labels say it is on the ground, and keeps everything above the ground,
+//! by turning the joints of each leg (bone lengths stay exact). Usable on its own
+//! ([`plant_feet`]) and applied by default to the motion and poses of a
+//! [`Generated`](crate::Generated) batch ([`Feet`]).
+//!
+//! - [`spans`]: contact spans from labels (hysteresis, shortest span) and blend weights;
+//! - [`chain`]: which joints above a contact joint may turn;
+//! - [`ground`]: the ground level of a motion;
+//! - [`plant`]: the pass itself, on the inverse kinematics of [`crate::motion::ik`].
+
+pub mod chain;
+pub mod ground;
+pub mod plant;
+pub mod spans;
+
+pub use chain::{LegChain, leg_chain};
+pub use ground::{GROUND_PERCENTILE, ground_level};
+pub use plant::{Anchor, Kept, PlantOptions, PlantStats, plant_feet};
+pub use spans::{CONTACT_OFF, CONTACT_ON, contact_spans};
+
+/// What happens to the feet of generated motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Feet {
+    /// Contact points held still during their predicted contact spans and nothing below the
+    /// ground ([`plant_feet`] with default [`PlantOptions`]). The default.
+    #[default]
+    Planted,
+    /// The network's motion untouched.
+    Raw,
+}

@@ -1,0 +1,268 @@
+//! Foot planting against expectations that do not come from the pass itself: a synthetic leg
+//! whose foot slides during a labelled contact span ends up with the foot still and every bone
+//! its exact length; frames a task kept are bit for bit the input's; and on a real model, the
+//! frames an in-between keeps are the network's raw motion after planting.
+
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+
+use ndarray::s;
+use sinmdm::bvh::read_bvh;
+use sinmdm::motion::feet::{Kept, PlantOptions, plant_feet};
+use sinmdm::motion::math::{self, Mat3, Vec3, axis_rotation};
+use sinmdm::motion::{
+    Axis, Channel, FeatureLayout, GlobalPose, Joint, LocalMotion, Skeleton, UpAxis, encode_for,
+    global_poses,
+};
+use sinmdm::tasks::{Request, Span, Task};
+use sinmdm::{Feet, Model, ModelOptions};
+
+const FRAMES: usize = 40;
+/// The labelled contact span.
+const SPAN: std::ops::Range<usize> = 10..30;
+
+fn joint(name: &str, parent: Option<usize>, offset: Vec3, end_site: Option<Vec3>) -> Joint {
+    let mut channels = vec![
+        Channel::Rotation(Axis::Z),
+        Channel::Rotation(Axis::X),
+        Channel::Rotation(Axis::Y),
+    ];
+    if parent.is_none() {
+        channels.splice(0..0, [Axis::X, Axis::Y, Axis::Z].map(Channel::Position));
+    }
+    Joint {
+        name: name.into(),
+        parent,
+        offset,
+        channels,
+        end_site,
+    }
+}
+
+/// Hips (travelling forward along +Z at 0.3 units/s) with a spine and one leg: hip, knee
+/// (bent 80 degrees, so the hip-ankle distance stays well inside the leg's reach), ankle with a
+/// toe End Site. The foot therefore slides forward with the hips in every frame.
+fn sliding_leg() -> (FeatureLayout, LocalMotion) {
+    let skeleton = Skeleton {
+        joints: vec![
+            joint("Hips", None, [0.0; 3], None),
+            joint("Hip", Some(0), [0.1, 0.0, 0.0], None),
+            joint("Knee", Some(1), [0.0, -0.45, 0.0], None),
+            joint(
+                "Ankle",
+                Some(2),
+                [0.0, -0.45, 0.0],
+                Some([0.0, -0.05, 0.12]),
+            ),
+            joint("Spine", Some(0), [0.0, 0.5, 0.0], Some([0.0, 0.3, 0.0])),
+        ],
+    };
+    let bend = 80f64.to_radians();
+    let mut rotations: Vec<Mat3> = Vec::new();
+    let mut translations: Vec<Vec3> = Vec::new();
+    for f in 0..FRAMES {
+        let t = f as f64 / 30.0;
+        rotations.extend([
+            math::IDENTITY,
+            axis_rotation(0, -bend / 2.0 + 0.05 * (3.0 * t).sin()),
+            axis_rotation(0, bend),
+            axis_rotation(0, -bend / 2.0),
+            math::IDENTITY,
+        ]);
+        translations.extend([
+            [0.0, 0.75, 0.3 * t],
+            [0.1, 0.0, 0.0],
+            [0.0, -0.45, 0.0],
+            [0.0, -0.45, 0.0],
+            [0.0, 0.5, 0.0],
+        ]);
+    }
+    let motion = LocalMotion {
+        skeleton: skeleton.clone(),
+        fps: 30.0,
+        rotations,
+        translations,
+    };
+    let ground = global_poses(&motion)
+        .iter()
+        .map(|p| p.contact_point(3)[1])
+        .fold(f64::INFINITY, f64::min)
+        - 0.01;
+    let layout = FeatureLayout {
+        rest_translations: skeleton.joints.iter().map(|j| j.offset).collect(),
+        skeleton,
+        fps: 30.0,
+        root: None,
+        rotation_joints: vec![0, 1, 2, 3, 4],
+        position_channels: vec![],
+        contact_joints: vec![3],
+        contact_speed_threshold: 0.2,
+        skeleton_height: 1.3,
+        up: UpAxis::PosY,
+        ground: Some(ground),
+    };
+    (layout, motion)
+}
+
+fn labels() -> Vec<Vec<f32>> {
+    vec![
+        (0..FRAMES)
+            .map(|f| if SPAN.contains(&f) { 1.0 } else { 0.0 })
+            .collect(),
+    ]
+}
+
+/// Labelled spans only: growing them over low frames is measured elsewhere.
+fn options() -> PlantOptions {
+    PlantOptions {
+        grow_within: 0.0,
+        ..PlantOptions::default()
+    }
+}
+
+fn distance(a: Vec3, b: Vec3) -> f64 {
+    math::norm(math::sub(a, b))
+}
+
+fn bone_lengths(pose: &GlobalPose, motion: &LocalMotion) -> Vec<f64> {
+    motion
+        .skeleton
+        .joints
+        .iter()
+        .enumerate()
+        .filter_map(|(j, joint)| Some(distance(pose.joints[j], pose.joints[joint.parent?])))
+        .collect()
+}
+
+#[test]
+fn a_sliding_foot_is_held_still_through_its_span_with_exact_bones() {
+    let (layout, motion) = sliding_leg();
+    let h = layout.skeleton_height;
+    let before = global_poses(&motion);
+    let slide = distance(
+        before[SPAN.end - 1].contact_point(3),
+        before[SPAN.start].contact_point(3),
+    );
+    assert!(slide > 0.15, "the synthetic foot must slide ({slide})");
+    let (planted, stats) =
+        plant_feet(&layout, &motion, &labels(), &Kept::default(), &options()).unwrap();
+    let after = global_poses(&planted);
+    let held = after[SPAN.start].contact_point(3);
+    for f in SPAN {
+        let d = distance(after[f].contact_point(3), held);
+        assert!(d <= 1e-6 * h, "frame {f}: the foot moved {d}");
+    }
+    for (b, a) in before.iter().zip(&after) {
+        for (x, y) in bone_lengths(b, &motion)
+            .iter()
+            .zip(bone_lengths(a, &planted))
+        {
+            assert!((x - y).abs() < 1e-9, "a bone changed length: {x} -> {y}");
+        }
+        // The hips and the spine are the network's: only the leg turned.
+        assert!(distance(b.joints[0], a.joints[0]) < 1e-12);
+        assert!(distance(b.joints[4], a.joints[4]) < 1e-12);
+    }
+    // Far from the span (beyond its blend border) the motion is untouched.
+    let blend = (PlantOptions::default().blend_seconds * 30.0).round() as usize;
+    for f in (0..SPAN.start - blend - 1).chain(SPAN.end + blend + 1..FRAMES) {
+        assert!(distance(after[f].contact_point(3), before[f].contact_point(3)) < 1e-12);
+    }
+    assert_eq!(stats.spans, 1);
+    assert_eq!(stats.planted_frames, SPAN.len());
+    assert_eq!(stats.lifted_frames, 0);
+}
+
+#[test]
+fn nothing_goes_below_the_ground() {
+    let (mut layout, motion) = sliding_leg();
+    // A ground above the toes' lowest point: the pass must lift them to it.
+    let toes = global_poses(&motion)[0].contact_point(3)[1];
+    layout.ground = Some(toes + 0.05);
+    let (planted, stats) =
+        plant_feet(&layout, &motion, &labels(), &Kept::default(), &options()).unwrap();
+    let lowest = global_poses(&planted)
+        .iter()
+        .flat_map(|p| p.points().collect::<Vec<_>>())
+        .map(|p| p[1])
+        .fold(f64::INFINITY, f64::min);
+    assert!(lowest >= toes + 0.05 - 1e-9, "lowest point {lowest}");
+    assert!(stats.max_lift >= 0.0);
+}
+
+#[test]
+fn kept_frames_are_the_input_bit_for_bit() {
+    let (layout, motion) = sliding_leg();
+    let joints = motion.skeleton.len();
+    // The task kept every joint and the root in frames 0..15, inside the span's start.
+    let kept = Kept {
+        joints: (0..FRAMES).map(|f| vec![f < 15; joints]).collect(),
+        root: (0..FRAMES).map(|f| f < 15).collect(),
+    };
+    let (planted, _) = plant_feet(&layout, &motion, &labels(), &kept, &options()).unwrap();
+    for f in 0..15 {
+        for j in 0..joints {
+            let k = f * joints + j;
+            assert!(math::mat_max_abs_diff(&planted.rotations[k], &motion.rotations[k]) <= 1e-9);
+            assert!(distance(planted.translations[k], motion.translations[k]) <= 1e-9);
+        }
+    }
+    // ... and the rest of the span is still planted.
+    let after = global_poses(&planted);
+    let held = after[16].contact_point(3);
+    assert!(distance(after[SPAN.end - 1].contact_point(3), held) < 1e-6);
+}
+
+#[test]
+fn labels_of_the_wrong_shape_are_refused() {
+    let (layout, motion) = sliding_leg();
+    let short = vec![vec![1.0; FRAMES - 1]];
+    assert!(plant_feet(&layout, &motion, &short, &Kept::default(), &options()).is_err());
+    assert!(plant_feet(&layout, &motion, &[], &Kept::default(), &options()).is_err());
+}
+
+#[test]
+fn an_inbetween_keeps_its_frames_after_planting() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut model = Model::open(
+        root.join("tests/data/models/walk_tiny.onnx"),
+        &ModelOptions { threads: Some(1) },
+    )
+    .unwrap();
+    let clip = read_bvh(root.join("tests/data/bvh/human_walk_cmu_131_01.bvh")).unwrap();
+    let reference = encode_for(&clip, &model.metadata().layout)
+        .unwrap()
+        .slice(s![.., ..120])
+        .to_owned();
+    let request = Request {
+        task: Task::Inbetween {
+            reference,
+            keep: vec![Span::new(0, 40), Span::new(80, 120)],
+            ramp: 5,
+        },
+        count: 1,
+        seed: 5,
+        steps: Some(5),
+        feet: Feet::Planted,
+    };
+    let generated =
+        sinmdm::run(&mut model, &request, &mut |_, _| ControlFlow::Continue(())).unwrap();
+    assert_eq!(generated.feet(), Feet::Planted);
+    let raw = generated.raw_motion(0).unwrap();
+    let (planted, stats) = generated.planted_motion(0).unwrap();
+    assert_eq!(generated.motion(0).unwrap(), planted);
+    let joints = raw.skeleton.len();
+    // Kept frames: the hard-kept parts of both spans (the ramp's soft frames are generated).
+    for f in (0..35).chain(85..120) {
+        for j in 0..joints {
+            let k = f * joints + j;
+            assert!(
+                math::mat_max_abs_diff(&planted.rotations[k], &raw.rotations[k]) <= 1e-9,
+                "frame {f} joint {j} turned"
+            );
+            assert!(distance(planted.translations[k], raw.translations[k]) <= 1e-9);
+        }
+    }
+    // The gap was worked on (the walk's feet touch the ground there).
+    assert!(stats.spans > 0, "{stats:?}");
+}
