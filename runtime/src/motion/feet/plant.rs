@@ -150,6 +150,11 @@ pub fn plant_feet(
         ground,
         ..PlantStats::default()
     };
+    // A rig whose positions overflow (a broken model file's offsets) is left as it is.
+    let finite = |p: Vec3| p.iter().all(|v| v.is_finite());
+    if !ground.is_finite() || !poses.iter().all(|pose| pose.points().all(finite)) {
+        return Ok((motion.clone(), stats));
+    }
 
     // One chain per contact joint; a chain that shares joints with an earlier one is skipped.
     let mut chains: Vec<Option<LegChain>> = Vec::new();
