@@ -8,7 +8,7 @@ use std::path::Path;
 use sinmdm::bvh::read_bvh;
 use sinmdm::features_file::read_features;
 use sinmdm::motion::feet::{Anchor, Kept, PlantOptions, plant_feet};
-use sinmdm::motion::{ColumnKind, decode, encode_for_model};
+use sinmdm::motion::{decode, encode_for_model};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_eval::{FeetReference, mean_scores};
 
@@ -20,13 +20,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let clip_motion = decode(layout, clip.features.view())?;
     let reference = FeetReference::new(layout, &clip_motion);
     let (features, _) = read_features(Path::new(&args[3]))?;
-    let contact_rows: Vec<usize> = layout
-        .columns()
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.kind == ColumnKind::Contact)
-        .map(|(i, _)| i)
-        .collect();
+    let contact_rows = layout.contact_rows();
     let samples: Vec<_> = features
         .outer_iter()
         .map(|s| {

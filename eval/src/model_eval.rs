@@ -5,7 +5,7 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use ndarray::{Array2, ArrayView2};
-use sinmdm::motion::{ColumnKind, MotionError, decode, encode_motion};
+use sinmdm::motion::{MotionError, decode, encode_motion};
 use sinmdm::{Denoiser, Generated, ModelMetadata, Request, TaskError};
 use thiserror::Error;
 
@@ -84,13 +84,7 @@ where
         .map(|i| Ok(generated.planted_motion(i)?.0))
         .collect::<Result<Vec<_>, MotionError>>()?;
     // Planting changes rotations and the root's height; the contact labels stay the model's.
-    let contact_rows: Vec<usize> = layout
-        .columns()
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.kind == ColumnKind::Contact)
-        .map(|(i, _)| i)
-        .collect();
+    let contact_rows = layout.contact_rows();
     let planted_samples: Vec<Array2<f64>> = planted
         .iter()
         .zip(generated.features.outer_iter())

@@ -4,7 +4,7 @@ use ndarray::{Array3, Axis};
 
 use crate::model_file::ModelMetadata;
 use crate::motion::feet::{Feet, Kept, PlantOptions, PlantStats, plant_feet};
-use crate::motion::{ColumnKind, FeatureLayout, LocalMotion, MotionError, Pose, decode, poses};
+use crate::motion::{FeatureLayout, LocalMotion, MotionError, Pose, decode, poses};
 
 /// A batch of generated samples in the model's layout.
 #[derive(Debug, Clone)]
@@ -84,11 +84,9 @@ impl Generated {
         let layout = &self.metadata.layout;
         let sample = self.features.index_axis(Axis(0), index);
         let labels: Vec<Vec<f32>> = layout
-            .columns()
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| c.kind == ColumnKind::Contact)
-            .map(|(row, _)| sample.row(row).to_vec())
+            .contact_rows()
+            .into_iter()
+            .map(|row| sample.row(row).to_vec())
             .collect();
         plant_feet(layout, &raw, &labels, &self.kept, &PlantOptions::default())
     }

@@ -143,6 +143,17 @@ impl FeatureLayout {
         out
     }
 
+    /// Rows of the contact labels, one per contact joint in [`FeatureLayout::contact_joints`]
+    /// order.
+    pub fn contact_rows(&self) -> Vec<usize> {
+        self.columns()
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.kind == ColumnKind::Contact)
+            .map(|(i, _)| i)
+            .collect()
+    }
+
     /// Column indices that belong to `joint` (its rotation, varying positions, root channels and
     /// contact label).
     pub fn joint_columns(&self, joint: usize) -> Vec<usize> {

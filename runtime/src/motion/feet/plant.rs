@@ -362,14 +362,6 @@ fn grow_spans(
 /// direction outweighs the smoothed one.
 const BEND_FLOOR: f64 = 0.05;
 
-/// A length scale of a chain (its reach), for tolerances.
-fn options_scale(points: &[Vec3]) -> f64 {
-    crate::motion::ik::bone_lengths(points)
-        .iter()
-        .sum::<f64>()
-        .max(f64::MIN_POSITIVE)
-}
-
 /// One chain's goal in one frame.
 struct Wanted<'a> {
     chain: &'a LegChain,
@@ -541,16 +533,12 @@ fn solve_frame(
     {
         let old: Vec<Vec3> = chain.joints.iter().map(|&j| pose.joints[j]).collect();
         let exact = effector_target(&pose, chain, *target);
-        if math::norm(math::sub(exact, old[old.len() - 1])) <= 1e-12 * options_scale(&old) {
+        let reach: f64 = crate::motion::ik::bone_lengths(&old).iter().sum();
+        if math::norm(math::sub(exact, old[old.len() - 1])) <= 1e-12 * reach.max(f64::MIN_POSITIVE)
+        {
             continue;
         }
-        let goal = soften(
-            old[0],
-            old[old.len() - 1],
-            exact,
-            crate::motion::ik::bone_lengths(&old).iter().sum(),
-            options.soft_reach,
-        );
+        let goal = soften(old[0], old[old.len() - 1], exact, reach, options.soft_reach);
         let new: Vec<Vec3> = if old.len() == 3 {
             let [mid, end] = match bend {
                 Some(bend) => {
@@ -580,7 +568,6 @@ fn solve_frame(
             };
             vec![old[0], mid, end]
         } else {
-            let reach: f64 = crate::motion::ik::bone_lengths(&old).iter().sum();
             fabrik(&old, goal, options.iterations, 1e-6 * reach)
         };
         let globals: Vec<Mat3> = (0..old.len() - 1)
