@@ -298,8 +298,7 @@ fn try_mutant(bytes: &[u8]) -> Result<Option<&'static str>, String> {
         count: 1,
         seed: 1,
         steps: Some(2),
-        // Raw for now: planting panics on offsets near 1e308 (found by this fuzz; open defect).
-        feet: sinmdm::Feet::Raw,
+        feet: sinmdm::Feet::default(),
     };
     match sinmdm::run(&mut model, &request, &mut |_, _| ControlFlow::Continue(())) {
         Ok(generated) => match generated.poses(0) {

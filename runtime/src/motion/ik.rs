@@ -39,7 +39,9 @@ pub fn two_bone_bent(
     let [a, b] = lengths;
     let to_target = math::sub(target, root);
     let u = math::normalize_or(to_target, math::normalize_or(fallback, [0.0, -1.0, 0.0]));
-    let d = math::norm(to_target).clamp((a - b).abs(), a + b);
+    // max/min rather than clamp: with overflowing lengths the bounds may be NaN, and clamp
+    // would panic on them.
+    let d = math::norm(to_target).max((a - b).abs()).min(a + b);
     let across = math::sub(bend, math::scale(u, math::dot(bend, u)));
     let v = math::normalize_or(across, any_perpendicular(u));
     let cos = if a * d > 0.0 {
@@ -206,6 +208,25 @@ mod tests {
         let p = fabrik(&[root, mid, end, [0.0, -0.3, 0.1]], far, 20, 1e-6);
         assert!(p.iter().flatten().all(|v| v.is_finite()));
         assert!(distance(p[3], far) > 1.0);
+    }
+
+    #[test]
+    fn overflowing_lengths_do_not_panic() {
+        // Bones of a broken rig whose lengths overflowed: any answer, but no panic.
+        let lengths = [f64::INFINITY, f64::INFINITY];
+        let _ = two_bone_bent(
+            [0.0; 3],
+            lengths,
+            [1e308, 0.0, -1e308],
+            [1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+        );
+        let _ = two_bone(
+            [0.0; 3],
+            [1e308, 0.0, 0.0],
+            [-1e308, 0.0, 0.0],
+            [0.0, 1e308, 0.0],
+        );
     }
 
     #[test]

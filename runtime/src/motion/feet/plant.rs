@@ -119,6 +119,9 @@ pub struct PlantStats {
     pub mean_miss: f64,
 }
 
+/// Coordinates below this size can be subtracted, squared and summed without overflow.
+const OVERFLOW_SAFE: f64 = 1e150;
+
 /// Holds every contact joint of `motion` (decoded in `layout`, the file's frame) still during
 /// the spans its `labels` (one series per contact joint, as the features carry them) mark, on
 /// or above the ground, easing in and out over [`PlantOptions::blend_seconds`]; and lifts
@@ -150,9 +153,14 @@ pub fn plant_feet(
         ground,
         ..PlantStats::default()
     };
-    // A rig whose positions overflow (a broken model file's offsets) is left as it is.
-    let finite = |p: Vec3| p.iter().all(|v| v.is_finite());
-    if !ground.is_finite() || !poses.iter().all(|pose| pose.points().all(finite)) {
+    // A rig whose positions are so large that differences or squared lengths of them could
+    // overflow (a broken model file's offsets) is left as it is.
+    let tame = |v: f64| v.abs() < OVERFLOW_SAFE;
+    if !tame(ground)
+        || !poses
+            .iter()
+            .all(|pose| pose.points().all(|p| p.iter().all(|&v| tame(v))))
+    {
         return Ok((motion.clone(), stats));
     }
 
