@@ -51,14 +51,16 @@ pub mod model_file;
 pub mod motion;
 pub mod network;
 mod onnxruntime;
+pub mod stream;
 pub mod tasks;
 
 pub use diffusion::{Denoiser, Sampler, SamplerError};
 pub use model::{Model, ModelError, ModelOptions};
 pub use model_file::ModelMetadata;
-pub use motion::{Feet, Joint, Pose, Quaternion, Skeleton, UpAxis};
+pub use motion::{Feet, Joint, Pose, Quaternion, Skeleton, UpAxis, motion_from_poses};
 pub use onnxruntime::{
     ONNXRUNTIME_VERSION, OnnxRuntime, RuntimeLibraryError, init as init_onnxruntime,
     load_onnxruntime,
 };
+pub use stream::{Stream, StreamChunk, StreamCompose, StreamOptions};
 pub use tasks::{Generated, Plan, Request, Span, Task, TaskError, plan, run};

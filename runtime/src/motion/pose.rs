@@ -2,7 +2,9 @@
 //! quaternion, without touching the file system.
 
 use super::clip::LocalMotion;
-use super::math::quat_wxyz_from_mat;
+use super::features::MotionError;
+use super::math::{mat_from_quat_wxyz, quat_wxyz_from_mat};
+use super::skeleton::Skeleton;
 
 /// A unit quaternion with named components (`w` the scalar part), laid out `x, y, z, w` in
 /// memory as engines (Unity, Unreal, glTF) store it.
@@ -60,4 +62,66 @@ pub fn poses(motion: &LocalMotion) -> Vec<Pose> {
             }
         })
         .collect()
+}
+
+/// The inverse of [`poses`]: engine poses of `skeleton` at `fps` as a motion, to give a model as
+/// a reference or content (poses in, the same layout the runtime returns). Quaternions are
+/// normalised; the root joint's translation is [`Pose::root_position`]. Poses whose joint
+/// counts differ from the skeleton's, zero quaternions and non-finite numbers are refused,
+/// naming the frame.
+pub fn motion_from_poses(
+    skeleton: &Skeleton,
+    fps: f64,
+    poses: &[Pose],
+) -> Result<LocalMotion, MotionError> {
+    if poses.is_empty() {
+        return Err(MotionError::NoPoses);
+    }
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(MotionError::BadFrameRate(fps));
+    }
+    let joints = skeleton.len();
+    let mut rotations = Vec::with_capacity(poses.len() * joints);
+    let mut translations = Vec::with_capacity(poses.len() * joints);
+    let wide = |v: [f32; 3]| [f64::from(v[0]), f64::from(v[1]), f64::from(v[2])];
+    for (frame, pose) in poses.iter().enumerate() {
+        let bad = |problem: String| MotionError::BadPose { frame, problem };
+        if pose.rotations.len() != joints || pose.translations.len() != joints {
+            return Err(bad(format!(
+                "{} rotations and {} translations for a skeleton of {joints} joints",
+                pose.rotations.len(),
+                pose.translations.len()
+            )));
+        }
+        if !pose.root_position.iter().all(|v| v.is_finite()) {
+            return Err(bad("the root position is not finite".into()));
+        }
+        for (j, q) in pose.rotations.iter().enumerate() {
+            let q = [q.w, q.x, q.y, q.z].map(f64::from);
+            let length = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if !(length.is_finite() && length > 1e-6) {
+                return Err(bad(format!(
+                    "joint {j} ('{}') has a rotation that is not a unit quaternion ({q:?}, w first)",
+                    skeleton.joints[j].name
+                )));
+            }
+            rotations.push(mat_from_quat_wxyz(q.map(|v| v / length)));
+        }
+        for (j, t) in pose.translations.iter().enumerate() {
+            if !t.iter().all(|v| v.is_finite()) {
+                return Err(bad(format!(
+                    "joint {j} ('{}') has a translation that is not finite",
+                    skeleton.joints[j].name
+                )));
+            }
+            let root = skeleton.joints[j].parent.is_none();
+            translations.push(wide(if root { pose.root_position } else { *t }));
+        }
+    }
+    Ok(LocalMotion {
+        skeleton: skeleton.clone(),
+        fps,
+        rotations,
+        translations,
+    })
 }

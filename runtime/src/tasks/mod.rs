@@ -133,6 +133,9 @@ pub enum TaskError {
     /// A harmonization factor or free share out of range.
     #[error("{0}")]
     Harmonization(String),
+    /// Stream options that cannot work together.
+    #[error("{0}")]
+    Stream(String),
 }
 
 impl From<Infallible> for TaskError {

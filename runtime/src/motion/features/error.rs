@@ -90,4 +90,15 @@ pub enum MotionError {
         /// Frames in the motion.
         frames: usize,
     },
+    /// Engine poses that do not fit the skeleton, or hold non-finite numbers.
+    #[error("pose {frame}: {problem}")]
+    BadPose {
+        /// The frame (index into the poses given).
+        frame: usize,
+        /// What is wrong.
+        problem: String,
+    },
+    /// No poses were given where some are needed.
+    #[error("no poses were given")]
+    NoPoses,
 }

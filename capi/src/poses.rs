@@ -1,0 +1,178 @@
+//! Poses across the boundary: flat float arrays in (references, supplied stream poses, BVH
+//! output) and out (results and stream chunks).
+
+use std::ffi::c_char;
+
+use sinmdm::motion::LocalMotion;
+use sinmdm::{Pose, Quaternion, motion_from_poses};
+
+use crate::model::SinmdmModel;
+use crate::status::{Failure, SinmdmStatus, guard};
+use crate::text::{handle, out_slice, slice_arg, str_arg};
+
+/// Poses given to the library, `frames` of them for the model's `joints` joints, as flat
+/// arrays in the model file's frame and units.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct SinmdmPoses {
+    /// Frames.
+    pub frames: usize,
+    /// The root joint's position per frame: `3 x frames` floats.
+    pub root_positions: *const f32,
+    /// Every joint's local rotation per frame, `x, y, z, w`: `4 x joints x frames` floats.
+    pub rotations: *const f32,
+    /// Every joint's local translation per frame: `3 x joints x frames` floats, or NULL for
+    /// the rest offsets (what a skeleton without stretching has).
+    pub translations: *const f32,
+}
+
+/// Caller-owned arrays the library fills with poses; capacities are in floats. Needed: root
+/// positions `3 x frames`, rotations `4 x joints x frames`, translations `3 x joints x frames`
+/// (translations may be NULL when not wanted).
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct SinmdmPoseBuffers {
+    /// Root position per frame.
+    pub root_positions: *mut f32,
+    /// Capacity of `root_positions`.
+    pub root_positions_capacity: usize,
+    /// Local rotation (`x, y, z, w`) per frame and joint.
+    pub rotations: *mut f32,
+    /// Capacity of `rotations`.
+    pub rotations_capacity: usize,
+    /// Local translation per frame and joint, or NULL.
+    pub translations: *mut f32,
+    /// Capacity of `translations`.
+    pub translations_capacity: usize,
+}
+
+/// Reads caller poses into a motion of the model's skeleton.
+///
+/// # Safety
+/// The arrays of `poses` are readable for the sizes its documentation gives.
+pub(crate) unsafe fn motion_in(
+    model: &SinmdmModel,
+    poses: *const SinmdmPoses,
+    argument: &str,
+) -> Result<(LocalMotion, Vec<Pose>), Failure> {
+    let poses = unsafe { handle(poses.cast_mut(), argument) }?;
+    let layout = &model.model.metadata().layout;
+    let joints = layout.skeleton.len();
+    let frames = poses.frames;
+    if frames == 0 || frames > sinmdm::tasks::MAX_FRAMES {
+        return Err(Failure::invalid(format!(
+            "{argument}.frames must be between 1 and {}, got {frames}",
+            sinmdm::tasks::MAX_FRAMES
+        )));
+    }
+    let roots = unsafe { slice_arg(poses.root_positions, 3 * frames, "root_positions") }?;
+    let rotations = unsafe { slice_arg(poses.rotations, 4 * joints * frames, "rotations") }?;
+    let translations = if poses.translations.is_null() {
+        None
+    } else {
+        Some(unsafe { slice_arg(poses.translations, 3 * joints * frames, "translations") }?)
+    };
+    let list: Vec<Pose> = (0..frames)
+        .map(|f| Pose {
+            root_position: [roots[3 * f], roots[3 * f + 1], roots[3 * f + 2]],
+            rotations: (0..joints)
+                .map(|j| {
+                    let q = &rotations[4 * (f * joints + j)..][..4];
+                    Quaternion {
+                        x: q[0],
+                        y: q[1],
+                        z: q[2],
+                        w: q[3],
+                    }
+                })
+                .collect(),
+            translations: (0..joints)
+                .map(|j| match translations {
+                    Some(t) => {
+                        let t = &t[3 * (f * joints + j)..][..3];
+                        [t[0], t[1], t[2]]
+                    }
+                    None => layout.rest_translations[j].map(|v| v as f32),
+                })
+                .collect(),
+        })
+        .collect();
+    let motion = motion_from_poses(&layout.skeleton, layout.fps, &list)?;
+    Ok((motion, list))
+}
+
+/// Writes poses into caller buffers.
+///
+/// # Safety
+/// The arrays of `buffers` are writable for their capacities.
+pub(crate) unsafe fn poses_out(
+    poses: &[Pose],
+    joints: usize,
+    buffers: *const SinmdmPoseBuffers,
+) -> Result<(), Failure> {
+    let b = unsafe { handle(buffers.cast_mut(), "buffers") }?;
+    let frames = poses.len();
+    let roots = unsafe {
+        out_slice(
+            b.root_positions,
+            b.root_positions_capacity,
+            3 * frames,
+            "root_positions",
+        )
+    }?;
+    let rotations = unsafe {
+        out_slice(
+            b.rotations,
+            b.rotations_capacity,
+            4 * joints * frames,
+            "rotations",
+        )
+    }?;
+    let translations = if b.translations.is_null() {
+        None
+    } else {
+        Some(unsafe {
+            out_slice(
+                b.translations,
+                b.translations_capacity,
+                3 * joints * frames,
+                "translations",
+            )
+        }?)
+    };
+    for (f, pose) in poses.iter().enumerate() {
+        roots[3 * f..3 * f + 3].copy_from_slice(&pose.root_position);
+        for (j, q) in pose.rotations.iter().enumerate() {
+            rotations[4 * (f * joints + j)..][..4].copy_from_slice(&[q.x, q.y, q.z, q.w]);
+        }
+    }
+    if let Some(out) = translations {
+        for (f, pose) in poses.iter().enumerate() {
+            for (j, t) in pose.translations.iter().enumerate() {
+                out[3 * (f * joints + j)..][..3].copy_from_slice(t);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Writes `poses` of the model's skeleton to the BVH file `path` (at the model's frame rate,
+/// with the skeleton, channels and up axis of its training clip), atomically: the file
+/// appears whole or not at all.
+///
+/// # Safety
+/// `model` is a live handle; `poses` as its documentation says; `path` NUL-terminated.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_write_bvh(
+    model: *const SinmdmModel,
+    poses: *const SinmdmPoses,
+    path: *const c_char,
+) -> SinmdmStatus {
+    guard(|| {
+        let model = unsafe { handle(model.cast_mut(), "model") }?;
+        let path = unsafe { str_arg(path, "path") }?;
+        let (motion, _) = unsafe { motion_in(model, poses, "poses") }?;
+        sinmdm::bvh::write_bvh(path, &motion.to_channels())
+            .map_err(|e| Failure::new(SinmdmStatus::SinmdmIo, e.to_string()))
+    })
+}

@@ -1,0 +1,165 @@
+//! Endless streamed motion over the C ABI.
+
+use sinmdm::{Stream, StreamCompose, StreamOptions};
+
+use crate::model::SinmdmModel;
+use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, motion_in, poses_out};
+use crate::run::feet_arg;
+use crate::status::{Failure, SinmdmStatus, guard};
+use crate::text::{give, handle, slice_arg};
+
+/// A stream (opaque): motion handed out a chunk at a time, forever, in flat memory.
+pub struct SinmdmStream {
+    stream: Stream,
+}
+
+/// How a stream makes its motion; zeros give the defaults.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct SinmdmStreamOptions {
+    /// Seed of the portable noise.
+    pub seed: u64,
+    /// Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STEPS`.
+    pub steps: u32,
+    /// Frames each block makes final; 0 for two seconds.
+    pub block_frames: u32,
+    /// `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
+    pub feet: u32,
+    /// Joints taken from poses supplied with `sinmdm_stream_supply` (NULL with count 0: none).
+    pub compose_joints: *const usize,
+    /// Entries of `compose_joints`.
+    pub compose_joint_count: usize,
+    /// Not 0: the root's travel and height also come from the supplied poses.
+    pub compose_root: i32,
+}
+
+/// Makes a stream of `model`'s motion with `options` and writes its handle to `out`.
+///
+/// # Safety
+/// `model` is a live handle; `options` readable (its joint array as it says); `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_stream_new(
+    model: *const SinmdmModel,
+    options: *const SinmdmStreamOptions,
+    out: *mut *mut SinmdmStream,
+) -> SinmdmStatus {
+    guard(|| {
+        let model = unsafe { handle(model.cast_mut(), "model") }?;
+        let o = *unsafe { handle(options.cast_mut(), "options") }?;
+        if out.is_null() {
+            return Err(Failure::null("out"));
+        }
+        let joints =
+            unsafe { slice_arg(o.compose_joints, o.compose_joint_count, "compose_joints") }?;
+        let compose = (!joints.is_empty() || o.compose_root != 0).then(|| StreamCompose {
+            joints: joints.to_vec(),
+            root: o.compose_root != 0,
+        });
+        let options = StreamOptions {
+            seed: o.seed,
+            steps: Some(if o.steps == 0 {
+                sinmdm::stream::STREAM_DEFAULT_STEPS
+            } else {
+                o.steps as usize
+            }),
+            block_frames: (o.block_frames > 0).then_some(o.block_frames as usize),
+            feet: feet_arg(o.feet)?,
+            compose,
+            ..StreamOptions::default()
+        };
+        let stream = Stream::new(model.model.metadata(), options)?;
+        unsafe { give(out, SinmdmStream { stream }) };
+        Ok(())
+    })
+}
+
+/// Supplies poses for the frames after the last supplied ones (the first call supplies frame
+/// 0 on), for a stream with composed joints. Poses supplied at least
+/// `2 x block_frames + 10` frames ahead of what has been handed out make the stream's motion
+/// independent of chunk sizes.
+///
+/// # Safety
+/// `stream` and `model` are live handles (the stream's model); `poses` as its documentation says.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_stream_supply(
+    stream: *mut SinmdmStream,
+    model: *const SinmdmModel,
+    poses: *const SinmdmPoses,
+) -> SinmdmStatus {
+    guard(|| {
+        let stream = unsafe { handle(stream, "stream") }?;
+        let model = unsafe { handle(model.cast_mut(), "model") }?;
+        let (_, list) = unsafe { motion_in(model, poses, "poses") }?;
+        stream.stream.supply(&list)?;
+        Ok(())
+    })
+}
+
+/// Makes the next `frames` frames on `model` (the model the stream was made with) and writes
+/// their poses into `buffers`. The motion is the same whatever chunk sizes are asked for.
+///
+/// # Safety
+/// `stream` and `model` are live handles; `buffers` as its documentation says.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_stream_next(
+    stream: *mut SinmdmStream,
+    model: *mut SinmdmModel,
+    frames: usize,
+    buffers: *const SinmdmPoseBuffers,
+) -> SinmdmStatus {
+    guard(|| {
+        let stream = unsafe { handle(stream, "stream") }?;
+        let model = unsafe { handle(model, "model") }?;
+        let buffers_ref = unsafe { handle(buffers.cast_mut(), "buffers") }?;
+        let joints = model.model.skeleton().len();
+        // Check the buffers before making anything, so a short one loses no motion.
+        let need = [
+            (
+                buffers_ref.root_positions_capacity,
+                3 * frames,
+                "root_positions",
+            ),
+            (
+                buffers_ref.rotations_capacity,
+                4 * joints * frames,
+                "rotations",
+            ),
+        ];
+        for (capacity, needed, name) in need {
+            if capacity < needed {
+                return Err(Failure::new(
+                    SinmdmStatus::SinmdmBufferTooSmall,
+                    format!("{name} holds {capacity} values, {needed} are needed"),
+                ));
+            }
+        }
+        if !buffers_ref.translations.is_null()
+            && buffers_ref.translations_capacity < 3 * joints * frames
+        {
+            return Err(Failure::new(
+                SinmdmStatus::SinmdmBufferTooSmall,
+                format!(
+                    "translations holds {} values, {} are needed",
+                    buffers_ref.translations_capacity,
+                    3 * joints * frames
+                ),
+            ));
+        }
+        if model.model.metadata() != stream.stream.metadata() {
+            return Err(Failure::invalid("the stream was made with another model"));
+        }
+        let chunk = stream.stream.next(&mut model.model, frames)?;
+        unsafe { poses_out(&chunk.poses(), joints, buffers) }
+    })
+}
+
+/// Frees a stream (NULL is fine).
+///
+/// # Safety
+/// `stream` is NULL or a handle from this library, not used again.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_stream_free(stream: *mut SinmdmStream) {
+    if !stream.is_null() {
+        drop(unsafe { Box::from_raw(stream) });
+    }
+}

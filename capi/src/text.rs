@@ -1,0 +1,108 @@
+//! Strings and pointers across the boundary: C strings in, strings out into caller buffers.
+
+use std::ffi::{CStr, c_char};
+
+use crate::status::{Failure, SinmdmStatus};
+
+/// A NUL-terminated UTF-8 argument.
+///
+/// # Safety
+/// `text` is NULL or points to a NUL-terminated string.
+pub(crate) unsafe fn str_arg<'a>(text: *const c_char, argument: &str) -> Result<&'a str, Failure> {
+    if text.is_null() {
+        return Err(Failure::null(argument));
+    }
+    unsafe { CStr::from_ptr(text) }
+        .to_str()
+        .map_err(|_| Failure::invalid(format!("{argument} is not UTF-8")))
+}
+
+/// Copies `text` and a NUL into `buffer` of `capacity` bytes; `needed` (if not NULL) gets the
+/// size with the NUL. A NULL `buffer` only asks for the size.
+///
+/// # Safety
+/// `buffer` is NULL or writable for `capacity` bytes; `needed` is NULL or writable.
+pub(crate) unsafe fn copy_str(
+    text: &str,
+    buffer: *mut c_char,
+    capacity: usize,
+    needed: *mut usize,
+) -> Result<(), Failure> {
+    let size = text.len() + 1;
+    if !needed.is_null() {
+        unsafe { *needed = size };
+    }
+    if buffer.is_null() {
+        return Ok(());
+    }
+    if capacity < size {
+        return Err(Failure::new(
+            SinmdmStatus::SinmdmBufferTooSmall,
+            format!("the text needs {size} bytes with its NUL, the buffer holds {capacity}"),
+        ));
+    }
+    unsafe {
+        std::ptr::copy_nonoverlapping(text.as_ptr().cast::<c_char>(), buffer, text.len());
+        *buffer.add(text.len()) = 0;
+    }
+    Ok(())
+}
+
+/// A caller's array of `count` values as a slice (empty for a NULL pointer with count 0).
+///
+/// # Safety
+/// `data` is NULL or readable for `count` values.
+pub(crate) unsafe fn slice_arg<'a, T>(
+    data: *const T,
+    count: usize,
+    argument: &str,
+) -> Result<&'a [T], Failure> {
+    if count == 0 {
+        return Ok(&[]);
+    }
+    if data.is_null() {
+        return Err(Failure::null(argument));
+    }
+    Ok(unsafe { std::slice::from_raw_parts(data, count) })
+}
+
+/// A caller's output array of `capacity` values, checked to hold `needed`.
+///
+/// # Safety
+/// `data` is NULL or writable for `capacity` values.
+pub(crate) unsafe fn out_slice<'a, T>(
+    data: *mut T,
+    capacity: usize,
+    needed: usize,
+    argument: &str,
+) -> Result<&'a mut [T], Failure> {
+    if data.is_null() {
+        return Err(Failure::null(argument));
+    }
+    if capacity < needed {
+        return Err(Failure::new(
+            SinmdmStatus::SinmdmBufferTooSmall,
+            format!("{argument} holds {capacity} values, {needed} are needed"),
+        ));
+    }
+    Ok(unsafe { std::slice::from_raw_parts_mut(data, needed) })
+}
+
+/// The handle behind a pointer.
+///
+/// # Safety
+/// `handle` is NULL or a live handle of type `T` made by this library.
+pub(crate) unsafe fn handle<'a, T>(handle: *mut T, argument: &str) -> Result<&'a mut T, Failure> {
+    if handle.is_null() {
+        return Err(Failure::null(argument));
+    }
+    Ok(unsafe { &mut *handle })
+}
+
+/// Writes a new handle to `out`.
+///
+/// # Safety
+/// `out` is writable (checked for NULL by the caller).
+pub(crate) unsafe fn give<T>(out: *mut *mut T, value: T) {
+    unsafe { *out = Box::into_raw(Box::new(value)) };
+}

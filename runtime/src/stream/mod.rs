@@ -1,0 +1,395 @@
+//! Endless motion, a chunk at a time: a [`Stream`] over a model hands out the next `n` frames on
+//! demand, forever, with memory that does not grow.
+//!
+//! Motion is made in fixed blocks ([`blocks`]): each block is an in-betweening run whose window
+//! starts with the last final frames of the block before (the model's receptive field by
+//! default, kept exactly) and the frames that block held back (kept with a soft border, so the
+//! seam is settled by the new block), followed by new frames. Every block is seeded from the
+//! stream's seed and its index, so the motion depends on the model, the seed and the
+//! [`StreamOptions`] only, never on the chunk sizes a caller asks for (with
+//! [`StreamOptions::compose`], also on how far ahead poses were supplied when a block was made:
+//! supply at least [`Stream::lookahead`] frames past what has been handed out to make that
+//! moot). The root's travel continues from where the last chunk ended, and planted feet stay
+//! planted across seams (spans are held where they landed, and frames handed out are never
+//! changed).
+
+pub mod blocks;
+mod guide;
+
+use std::collections::VecDeque;
+
+use ndarray::{Array2, Axis, s};
+
+use crate::diffusion::Schedule;
+use crate::diffusion::sampler::{Denoiser, Guidance, Inpainting, Sampler};
+use crate::model_file::ModelMetadata;
+use crate::motion::feet::{Anchor, Feet, Kept, PlantOptions, plant_feet};
+use crate::motion::math::{self, Mat3, Vec3};
+use crate::motion::{FeatureMatrix, LocalMotion, MotionError, Pose, decode, poses};
+use crate::tasks::mask::soft_mask;
+use crate::tasks::{INBETWEEN_RAMP, MAX_FRAMES, TaskError};
+use blocks::{BlockSizes, block_seed};
+use guide::Guide;
+
+/// Respaced sampling steps of a stream unless told otherwise (the command line's default).
+pub const STREAM_DEFAULT_STEPS: usize = 100;
+/// Frames a block makes final unless told otherwise, in seconds of the model's frame rate.
+pub const STREAM_DEFAULT_BLOCK_SECONDS: f64 = 2.0;
+
+/// Joints (and the root's travel) that a stream takes from poses the game supplies.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct StreamCompose {
+    /// Joints whose rotations come from the supplied poses (indices into the skeleton).
+    pub joints: Vec<usize>,
+    /// Whether the root's travel (per-frame displacement) and height come from them.
+    pub root: bool,
+}
+
+/// How a stream makes its motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StreamOptions {
+    /// Seed of the portable noise.
+    pub seed: u64,
+    /// Sampling steps per block (respaced); `None` runs all T steps.
+    pub steps: Option<usize>,
+    /// Frames each block makes final; `None` for [`STREAM_DEFAULT_BLOCK_SECONDS`]. Longer blocks
+    /// cost less per frame (the context is paid once per block) but take longer to make.
+    pub block_frames: Option<usize>,
+    /// Final frames of the previous block each block sees; `None` for the model's receptive field.
+    pub context_frames: Option<usize>,
+    /// Frames held back and settled by the next block (the seam's soft border).
+    pub ramp: usize,
+    /// What is done to the feet of the motion handed out.
+    pub feet: Feet,
+    /// Joints taken from supplied poses ([`Stream::supply`]), if any.
+    pub compose: Option<StreamCompose>,
+}
+
+impl Default for StreamOptions {
+    fn default() -> Self {
+        StreamOptions {
+            seed: 0,
+            steps: Some(STREAM_DEFAULT_STEPS),
+            block_frames: None,
+            context_frames: None,
+            ramp: INBETWEEN_RAMP,
+            feet: Feet::default(),
+            compose: None,
+        }
+    }
+}
+
+/// Frames handed out by [`Stream::next`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct StreamChunk {
+    /// The frames as local joint transforms (the file's frame and units).
+    pub motion: LocalMotion,
+    /// The network's features of the frames `[F, n]` (file units; the same whatever the feet).
+    pub features: FeatureMatrix,
+}
+
+impl StreamChunk {
+    /// The frames as engine poses.
+    pub fn poses(&self) -> Vec<Pose> {
+        poses(&self.motion)
+    }
+
+    /// Frames in the chunk.
+    pub fn frames(&self) -> usize {
+        self.features.ncols()
+    }
+}
+
+/// One final frame waiting to be handed out.
+#[derive(Debug, Clone)]
+struct Frame {
+    features: Vec<f32>,
+    rotations: Vec<Mat3>,
+    translations: Vec<Vec3>,
+}
+
+/// Endless motion from one model; see the [module documentation](self).
+#[derive(Debug, Clone)]
+pub struct Stream {
+    metadata: ModelMetadata,
+    feet: Feet,
+    seed: u64,
+    sizes: BlockSizes,
+    schedule: Schedule,
+    compose_rows: Vec<usize>,
+    /// Blocks made so far.
+    blocks: usize,
+    /// Frames handed out so far.
+    handed_out: usize,
+    /// The last `C + R` normalised frames of the last block's window.
+    carried: Option<Array2<f32>>,
+    /// The last `C` final frames as handed out (feet as chosen).
+    tail: Option<LocalMotion>,
+    /// The root joint's translation in the last final frame, before planting.
+    last_root: Option<Vec3>,
+    /// Final frames not yet handed out.
+    ready: VecDeque<Frame>,
+    guide: Guide,
+}
+
+impl Stream {
+    /// A stream over a model with `metadata` (the [`crate::Model`] it will run on), checked.
+    pub fn new(metadata: &ModelMetadata, options: StreamOptions) -> Result<Stream, TaskError> {
+        let bad = |m: String| Err(TaskError::Stream(m));
+        let layout = &metadata.layout;
+        let context = options
+            .context_frames
+            .unwrap_or(metadata.network.receptive_field.max(1));
+        let block = options.block_frames.unwrap_or_else(|| {
+            (STREAM_DEFAULT_BLOCK_SECONDS * layout.fps).round().max(1.0) as usize
+        });
+        let ramp = options.ramp.max(1);
+        if context == 0 {
+            return bad("a stream needs at least one frame of context".into());
+        }
+        if block < context {
+            return bad(format!(
+                "blocks of {block} frames are shorter than their {context} frames of context; make them at least as long"
+            ));
+        }
+        if ramp > block {
+            return bad(format!(
+                "a soft border of {ramp} frames does not fit in blocks of {block} frames"
+            ));
+        }
+        let window = context.saturating_add(ramp).saturating_add(block);
+        if window > MAX_FRAMES {
+            return bad(format!(
+                "a window of {window} frames is beyond the limit of {MAX_FRAMES}"
+            ));
+        }
+        let schedule = match options.steps {
+            Some(s) => Schedule::respaced(metadata.diffusion.steps, s)?,
+            None => Schedule::cosine(metadata.diffusion.steps)?,
+        };
+        let mut compose_rows = Vec::new();
+        if let Some(compose) = &options.compose {
+            if let Some(&index) = compose.joints.iter().find(|&&j| j >= layout.skeleton.len()) {
+                return Err(TaskError::JointIndex {
+                    index,
+                    joints: layout.skeleton.len(),
+                });
+            }
+            compose_rows.extend(compose.joints.iter().flat_map(|&j| layout.joint_columns(j)));
+            if compose.root
+                && let Some(r) = &layout.root
+            {
+                compose_rows.extend(0..r.axes.len());
+            }
+            compose_rows.sort_unstable();
+            compose_rows.dedup();
+            if compose_rows.is_empty() {
+                return Err(TaskError::NothingToDo(
+                    "composition needs joints or the root to take from the supplied poses".into(),
+                ));
+            }
+        }
+        Ok(Stream {
+            metadata: metadata.clone(),
+            feet: options.feet,
+            seed: options.seed,
+            sizes: BlockSizes {
+                context,
+                ramp,
+                block,
+            },
+            schedule,
+            compose_rows,
+            blocks: 0,
+            handed_out: 0,
+            carried: None,
+            tail: None,
+            last_root: None,
+            ready: VecDeque::new(),
+            guide: Guide::default(),
+        })
+    }
+
+    /// The metadata of the model the stream was made for.
+    pub fn metadata(&self) -> &ModelMetadata {
+        &self.metadata
+    }
+
+    /// The block sizes in use.
+    pub fn sizes(&self) -> BlockSizes {
+        self.sizes
+    }
+
+    /// Frames handed out so far.
+    pub fn frames_handed_out(&self) -> usize {
+        self.handed_out
+    }
+
+    /// How many frames past those handed out a block may reach: poses supplied that far ahead
+    /// make a composed stream independent of chunk sizes.
+    pub fn lookahead(&self) -> usize {
+        2 * self.sizes.block + self.sizes.ramp
+    }
+
+    /// Poses for the frames after the last supplied one (the first call supplies frame 0), for
+    /// [`StreamOptions::compose`]. Frames without a supplied pose are generated freely.
+    pub fn supply(&mut self, poses: &[Pose]) -> Result<(), MotionError> {
+        self.guide.supply(&self.metadata, poses)
+    }
+
+    /// The next `frames` frames, making as many blocks as that needs on `denoiser` (the model
+    /// whose metadata made the stream).
+    pub fn next<D: Denoiser>(
+        &mut self,
+        denoiser: &mut D,
+        frames: usize,
+    ) -> Result<StreamChunk, TaskError>
+    where
+        TaskError: From<D::Error>,
+    {
+        if frames > MAX_FRAMES {
+            return Err(TaskError::Length {
+                frames,
+                reason: format!("one chunk holds at most {MAX_FRAMES} frames"),
+            });
+        }
+        while self.ready.len() < frames {
+            self.make_block(denoiser)?;
+        }
+        let layout = &self.metadata.layout;
+        let joints = layout.skeleton.len();
+        let mut features = Array2::<f32>::zeros((self.metadata.network.features, frames));
+        let mut rotations = Vec::with_capacity(frames * joints);
+        let mut translations = Vec::with_capacity(frames * joints);
+        for (i, frame) in self.ready.drain(..frames).enumerate() {
+            features
+                .column_mut(i)
+                .iter_mut()
+                .zip(&frame.features)
+                .for_each(|(o, v)| *o = *v);
+            rotations.extend(frame.rotations);
+            translations.extend(frame.translations);
+        }
+        self.handed_out += frames;
+        Ok(StreamChunk {
+            motion: LocalMotion {
+                skeleton: layout.skeleton.clone(),
+                fps: layout.fps,
+                rotations,
+                translations,
+            },
+            features,
+        })
+    }
+
+    /// Makes the next block and queues its final frames.
+    fn make_block<D: Denoiser>(&mut self, denoiser: &mut D) -> Result<(), TaskError>
+    where
+        TaskError: From<D::Error>,
+    {
+        let sizes = self.sizes;
+        let window = sizes.window(self.blocks);
+        let f = self.metadata.network.features;
+        let n = window.frames;
+        let mut reference = Array2::<f32>::zeros((f, n));
+        let mut mask = Array2::<f32>::zeros((f, n));
+        if let Some(carried) = &self.carried {
+            reference
+                .slice_mut(s![.., ..window.carried])
+                .assign(carried);
+            for (i, w) in sizes.carry_weights(&window).into_iter().enumerate() {
+                mask.column_mut(i).fill(w);
+            }
+        }
+        if !self.compose_rows.is_empty() {
+            let (guide, covered) = self.guide.features(&self.metadata, window.start, n)?;
+            let weights = soft_mask(&covered, sizes.ramp);
+            for &row in &self.compose_rows {
+                for i in window.context..n {
+                    if weights[i] > mask[[row, i]] {
+                        mask[[row, i]] = weights[i];
+                        reference[[row, i]] = guide[[row, i]];
+                    }
+                }
+            }
+            self.guide.forget_before(
+                (window.start + window.frames).saturating_sub(sizes.context + sizes.ramp + 1),
+            );
+        }
+        let guidance = if mask.iter().any(|&m| m > 0.0) {
+            Guidance {
+                inpainting: Some(Inpainting { reference, mask }),
+                harmonization: None,
+            }
+        } else {
+            Guidance::default()
+        };
+        let seed = block_seed(self.seed, self.blocks as u64);
+        let mut sampler = Sampler::new(&self.schedule, &guidance, 1, f, n, seed)?;
+        while !sampler.is_finished() {
+            sampler.step(denoiser)?;
+        }
+        let normalized = sampler.into_sample().index_axis_move(Axis(0), 0);
+        let keep = sizes.context + sizes.ramp;
+        self.carried = Some(normalized.slice(s![.., n - keep..]).to_owned());
+        let raw = self.metadata.normalizer.denormalize(normalized.view());
+
+        // Decode the context and the final frames; carry the root on from the last chunk.
+        let done = window.finalised(&sizes);
+        let layout = &self.metadata.layout;
+        let joints = layout.skeleton.len();
+        let mut motion = decode(layout, raw.slice(s![.., ..done.end]))?;
+        if let Some(root) = &layout.root {
+            let r = root.joint;
+            if let (Some(last), true) = (self.last_root, done.start > 0) {
+                let offset = math::sub(last, motion.translations[(done.start - 1) * joints + r]);
+                for frame in 0..done.end {
+                    let t = &mut motion.translations[frame * joints + r];
+                    *t = math::add(*t, offset);
+                }
+            }
+            self.last_root = Some(motion.translations[(done.end - 1) * joints + r]);
+        }
+        if self.feet == Feet::Planted {
+            if let Some(tail) = &self.tail {
+                // What was handed out stays as it was.
+                let kept = done.start * joints;
+                motion.rotations[..kept].copy_from_slice(&tail.rotations);
+                motion.translations[..kept].copy_from_slice(&tail.translations);
+            }
+            let labels: Vec<Vec<f32>> = layout
+                .contact_rows()
+                .into_iter()
+                .map(|row| raw.row(row).slice(s![..done.end]).to_vec())
+                .collect();
+            let kept = Kept {
+                joints: (0..done.end)
+                    .map(|frame| vec![frame < done.start; joints])
+                    .collect(),
+                root: (0..done.end).map(|frame| frame < done.start).collect(),
+            };
+            let options = PlantOptions {
+                anchor: Anchor::Landing,
+                ..PlantOptions::default()
+            };
+            motion = plant_feet(layout, &motion, &labels, &kept, &options)?.0;
+        }
+        for frame in done.clone() {
+            let range = frame * joints..(frame + 1) * joints;
+            self.ready.push_back(Frame {
+                features: raw.column(frame).to_vec(),
+                rotations: motion.rotations[range.clone()].to_vec(),
+                translations: motion.translations[range].to_vec(),
+            });
+        }
+        let tail_from = (done.end - sizes.context) * joints;
+        self.tail = Some(LocalMotion {
+            skeleton: layout.skeleton.clone(),
+            fps: layout.fps,
+            rotations: motion.rotations[tail_from..].to_vec(),
+            translations: motion.translations[tail_from..].to_vec(),
+        });
+        self.blocks += 1;
+        Ok(())
+    }
+}
