@@ -4,41 +4,12 @@
 //! program also runs under valgrind memcheck, which must find no invalid access and nothing
 //! definitely lost.
 
-use std::collections::BTreeMap;
-use std::ops::ControlFlow;
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 use std::process::Command;
 
-use sinmdm::motion::encode_motion;
-use sinmdm::{
-    Feet, Model, ModelOptions, Pose, Request, Span, Stream, StreamOptions, Task, motion_from_poses,
-};
-
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn model_path() -> PathBuf {
-    repo().join("onnx-models/human_walk_cmu.onnx")
-}
-
-/// The folder of the test binary's profile (`target/release`), where `libsinmdm_c.so` is.
-fn library_dir() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().unwrap().parent().unwrap().to_path_buf();
-    assert!(
-        dir.join("libsinmdm_c.so").is_file(),
-        "no libsinmdm_c.so in {}",
-        dir.display()
-    );
-    dir
-}
-
-fn work_dir(name: &str) -> PathBuf {
-    let dir = library_dir().join("c-abi-tests").join(name);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::*;
 
 /// Builds a C program with the system compiler, warnings as errors.
 fn compile(source: &Path, out: &Path) {
@@ -57,93 +28,6 @@ fn compile(source: &Path, out: &Path) {
         .status()
         .expect("no C compiler: run scripts/setup.sh (it installs the test tools)");
     assert!(status.success(), "cc failed on {}", source.display());
-}
-
-fn onnxruntime_path() -> PathBuf {
-    sinmdm::init_onnxruntime().unwrap().path.clone()
-}
-
-fn hex(values: impl IntoIterator<Item = f32>) -> String {
-    values
-        .into_iter()
-        .map(|v| format!(" {:08x}", v.to_bits()))
-        .collect()
-}
-
-fn pose_lines(label: &str, poses: &[Pose], out: &mut BTreeMap<String, String>) {
-    out.insert(
-        format!("{label}.root"),
-        hex(poses.iter().flat_map(|p| p.root_position)),
-    );
-    out.insert(
-        format!("{label}.rotations"),
-        hex(poses
-            .iter()
-            .flat_map(|p| p.rotations.iter().flat_map(|q| [q.x, q.y, q.z, q.w]))),
-    );
-    out.insert(
-        format!("{label}.translations"),
-        hex(poses
-            .iter()
-            .flat_map(|p| p.translations.iter().flatten().copied())),
-    );
-}
-
-/// What the check program must print, from the Rust API.
-fn expected() -> BTreeMap<String, String> {
-    let mut model = Model::open(model_path(), &ModelOptions { threads: Some(1) }).unwrap();
-    let mut out = BTreeMap::new();
-    let go = &mut |_: usize, _: usize| ControlFlow::Continue(());
-    let crowd = sinmdm::run(
-        &mut model,
-        &Request {
-            task: Task::Generate { frames: 40 },
-            count: 2,
-            seed: 7,
-            steps: Some(4),
-            feet: Feet::Planted,
-        },
-        go,
-    )
-    .unwrap();
-    pose_lines("generate1", &crowd.poses(1).unwrap(), &mut out);
-    let layout = model.metadata().layout.clone();
-    let reference = encode_motion(
-        &layout,
-        &motion_from_poses(&layout.skeleton, layout.fps, &crowd.poses(0).unwrap()).unwrap(),
-    );
-    let between = sinmdm::run(
-        &mut model,
-        &Request {
-            task: Task::Inbetween {
-                reference,
-                keep: vec![Span::new(0, 10), Span::new(30, 40)],
-                ramp: 5,
-            },
-            count: 1,
-            seed: 3,
-            steps: Some(4),
-            feet: Feet::Planted,
-        },
-        go,
-    )
-    .unwrap();
-    pose_lines("inbetween", &between.poses(0).unwrap(), &mut out);
-    let mut stream = Stream::new(
-        model.metadata(),
-        StreamOptions {
-            seed: 11,
-            steps: Some(3),
-            block_frames: Some(30),
-            ..StreamOptions::default()
-        },
-    )
-    .unwrap();
-    let a = stream.next(&mut model, 20).unwrap();
-    let b = stream.next(&mut model, 25).unwrap();
-    pose_lines("stream20", &a.poses(), &mut out);
-    pose_lines("stream25", &b.poses(), &mut out);
-    out
 }
 
 fn run_check(valgrind: bool) -> String {
@@ -194,19 +78,6 @@ fn run_check(valgrind: bool) -> String {
     let clip = sinmdm::bvh::read_bvh(&bvh).unwrap();
     assert_eq!(clip.frame_count(), 40);
     stdout
-}
-
-fn parse(stdout: &str) -> BTreeMap<String, String> {
-    stdout
-        .lines()
-        .filter_map(|l| {
-            let (label, rest) = l.split_once(' ')?;
-            rest.chars()
-                .all(|c| c.is_ascii_hexdigit() || c == ' ')
-                .then(|| (label.to_string(), format!(" {rest}")))
-        })
-        .filter(|(label, _)| label.contains('.'))
-        .collect()
 }
 
 #[test]

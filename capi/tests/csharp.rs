@@ -1,0 +1,43 @@
+//! The C# binding under Mono: `bindings/csharp/Sinmdm.cs` and the console example
+//! `examples/csharp/Example.cs` are compiled with `mcs` (warnings as errors) and run with
+//! `mono`; every value must be bit for bit the Rust API's for the same arguments.
+
+mod common;
+
+use std::process::Command;
+
+use common::*;
+
+#[test]
+fn the_csharp_binding_gets_the_rust_values_under_mono() {
+    let dir = work_dir("csharp");
+    let exe = dir.join("example.exe");
+    let status = Command::new("mcs")
+        .arg("-warnaserror+")
+        .arg(format!("-out:{}", exe.display()))
+        .arg(repo().join("bindings/csharp/Sinmdm.cs"))
+        .arg(repo().join("examples/csharp/Example.cs"))
+        .status()
+        .expect("no C# compiler (mcs): run scripts/setup.sh, which installs mono-mcs");
+    assert!(status.success(), "mcs failed");
+    let bvh = dir.join("out.bvh");
+    let output = Command::new("mono")
+        .arg(&exe)
+        .arg(model_path())
+        .arg(&bvh)
+        .env("LD_LIBRARY_PATH", library_dir())
+        .env("ORT_DYLIB_PATH", onnxruntime_path())
+        .output()
+        .expect("no Mono runtime: run scripts/setup.sh, which installs mono-runtime");
+    let stdout = String::from_utf8_lossy(&output.stdout).to_string();
+    assert!(
+        output.status.success(),
+        "the C# example failed ({}): {}",
+        output.status,
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(stdout.contains("info joints=31 root=Hips"), "{stdout}");
+    assert!(stdout.contains("unknown joint: status 4"), "{stdout}");
+    assert_same_values(&stdout);
+    assert_eq!(sinmdm::bvh::read_bvh(&bvh).unwrap().frame_count(), 40);
+}

@@ -1,0 +1,64 @@
+// A console program over the C# binding: a crowd, an in-between and a stream, each value
+// printed as the bits of its float (the tests compare them with the Rust API's), and a BVH.
+//
+//   mcs -out:example.exe bindings/csharp/Sinmdm.cs examples/csharp/Example.cs
+//   LD_LIBRARY_PATH=target/release mono example.exe onnx-models/human_walk_cmu.onnx out.bvh
+using System;
+using System.Text;
+using Sinmdm;
+
+static class Example
+{
+    static void Print(string label, float[] values)
+    {
+        var line = new StringBuilder(label);
+        foreach (float v in values)
+            line.Append(' ').Append(BitConverter.ToUInt32(BitConverter.GetBytes(v), 0).ToString("x8"));
+        Console.WriteLine(line);
+    }
+
+    static void Print(string label, Poses poses)
+    {
+        Print(label + ".root", poses.RootPositions);
+        Print(label + ".rotations", poses.Rotations);
+        Print(label + ".translations", poses.Translations);
+    }
+
+    static int Main(string[] args)
+    {
+        if (args.Length != 2)
+        {
+            Console.Error.WriteLine("usage: example.exe MODEL.onnx OUT.bvh");
+            return 2;
+        }
+        using (var model = Model.Open(args[0], 1))
+        {
+            Console.WriteLine("info joints=" + model.Joints + " root=" + model.JointName(0));
+            Poses first;
+            using (var crowd = model.Generate(40, seed: 7, count: 2, steps: 4))
+            {
+                first = crowd.Poses(0);
+                Print("generate1", crowd.Poses(1));
+            }
+            using (var between = model.Inbetween(first, new[] { 0, 10, 30, 40 }, 5, seed: 3, steps: 4))
+                Print("inbetween", between.Poses(0));
+            using (var stream = new Stream(model, seed: 11, steps: 3, blockFrames: 30))
+            {
+                Print("stream20", stream.Next(20));
+                Print("stream25", stream.Next(25));
+            }
+            try
+            {
+                model.FindJoint("NoSuchJoint");
+                Console.WriteLine("no error for an unknown joint");
+                return 1;
+            }
+            catch (SinmdmException e)
+            {
+                Console.WriteLine("unknown joint: status " + e.Status);
+            }
+            model.WriteBvh(first, args[1]);
+        }
+        return 0;
+    }
+}
