@@ -7,6 +7,7 @@ mod inspect;
 mod render;
 mod reorient;
 mod sampling;
+mod stream;
 mod tasks;
 
 use clap::{Parser, Subcommand};
@@ -48,6 +49,9 @@ pub enum Command {
     /// Rewrite a clip with another up axis (Z-up to Y-up, say) and/or turned about its up axis.
     #[command(after_help = reorient::EXAMPLES)]
     Reorient(reorient::ReorientArgs),
+    /// Endless motion written chunk by chunk, as an engine pulls it from a stream.
+    #[command(after_help = stream::EXAMPLES)]
+    Stream(stream::StreamArgs),
     /// Score a model: generate samples and measure coverage and diversity against its clip.
     #[command(after_help = eval::EXAMPLES)]
     Eval(eval::EvalArgs),
@@ -68,6 +72,7 @@ fn main() -> std::process::ExitCode {
         Command::Expand(args) => tasks::expand(&args),
         Command::Compose(args) => tasks::compose(&args),
         Command::Harmonize(args) => tasks::harmonize(&args),
+        Command::Stream(args) => stream::run(&args),
         Command::Eval(args) => eval::run(&args),
         Command::Info(args) => info::info(&args),
         Command::Render(args) => render::run(&args),

@@ -151,3 +151,40 @@ fn bad_stream_options_are_refused() {
         .contains("composition needs")
     );
 }
+
+#[test]
+fn a_bvh_written_chunk_by_chunk_is_the_bvh_of_the_whole_motion() {
+    use sinmdm::bvh::{BvhStreamWriter, to_bvh_string};
+    let mut model = model();
+    let dir = std::env::temp_dir().join(format!("sinmdm-stream-bvh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("chunked.bvh");
+    let mut stream = Stream::new(model.metadata(), options(Feet::Planted)).unwrap();
+    let mut writer =
+        BvhStreamWriter::create(&path, model.skeleton(), model.fps(), 130).unwrap();
+    let mut whole: Option<sinmdm::motion::LocalMotion> = None;
+    for n in [17, 50, 1, 62] {
+        let chunk = stream.next(&mut model, n).unwrap();
+        writer.append(&chunk.motion).unwrap();
+        match whole.as_mut() {
+            None => whole = Some(chunk.motion),
+            Some(w) => {
+                w.rotations.extend(chunk.motion.rotations);
+                w.translations.extend(chunk.motion.translations);
+            }
+        }
+        // Nothing under the file's name until it is complete.
+        assert!(!path.exists());
+    }
+    writer.finish().unwrap();
+    let written = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(written, to_bvh_string(&whole.unwrap().to_channels()));
+    // A writer dropped before its last frame leaves nothing behind.
+    let partial = dir.join("partial.bvh");
+    let mut writer = BvhStreamWriter::create(&partial, model.skeleton(), model.fps(), 10).unwrap();
+    writer.append(&stream.next(&mut model, 5).unwrap().motion).unwrap();
+    assert!(writer.append(&stream.next(&mut model, 6).unwrap().motion).is_err());
+    drop(writer);
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -5,6 +5,7 @@
     python -m sinmdm_reference expand    --model M.onnx --reference REF.json --prefix 2s --suffix 60 -o OUT.json
     python -m sinmdm_reference compose   --model M.onnx --reference REF.json --part LeftUpLeg --root -o OUT.json
     python -m sinmdm_reference harmonize --model M.onnx --content REF.json [--factor 2] [--free-share 0.02] -o OUT.json
+    python -m sinmdm_reference stream    --model M.onnx --frames N [--block B] [--seed S] -o OUT.json
 
 References are features files (`sinmdm encode CLIP.bvh -m M.onnx -o REF.json`); the output is
 the unnormalised features of every sample, the same file `sinmdm ... --features-json` writes.
@@ -19,6 +20,7 @@ from . import tasks
 from .features import read_features, write_features
 from .model import Model, ModelError
 from .sampler import sample
+from .stream import stream_features
 
 
 def _steps(text):
@@ -62,6 +64,9 @@ def main(argv=None):
     ha.add_argument("--content", required=True)
     ha.add_argument("--factor", type=int, default=tasks.HARMONIZE_FACTOR)
     ha.add_argument("--free-share", type=float, default=tasks.HARMONIZE_FREE_SHARE)
+    st = common(sub.add_parser("stream"))
+    st.add_argument("--frames", type=int, required=True)
+    st.add_argument("--block", type=int, default=None)
     args = parser.parse_args(argv)
 
     try:
@@ -73,6 +78,12 @@ def main(argv=None):
             feats, _ = read_features(path)
             return feats[0]
 
+        if args.command == "stream":
+            schedule = tasks.schedule_for(model, _steps(args.steps))
+            feats = stream_features(model, schedule, args.seed, args.frames, block=args.block)
+            write_features(args.output, model.layout, feats[None])
+            print(f"wrote {args.output}", file=sys.stderr)
+            return 0
         if args.command == "generate":
             if args.frames is not None:
                 frames = args.frames

@@ -1,5 +1,6 @@
 """The Rust runtime (`sinmdm`) and the Python reference (`scripts/sinmdm_reference`, numpy +
-onnxruntime) give the same features for the same model, seed and arguments, task by task; and the
+onnxruntime) give the same features for the same model, seed and arguments, task by task (and
+for a stream); and the
 command line refuses bad input with a clear message and no output file."""
 
 import json
@@ -67,6 +68,8 @@ CASES = {
     "compose": (["compose", "--part", "LeftHip", "--joints", "Head,Neck", "--root", "--frames", "20:200",
                  "--steps", 25], {"--reference": "walk"}),
     "harmonize": (["harmonize", "--factor", 2, "--free-share", 0.1, "--steps", 40], {"--content": "hop"}),
+    # Five blocks of 30 frames, each seeded from the stream's seed and continuing the last.
+    "stream": (["stream", "--frames", 140, "--block", 30, "--steps", 12], {}),
 }
 
 

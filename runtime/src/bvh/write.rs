@@ -65,24 +65,35 @@ fn hierarchy(out: &mut String, skeleton: &Skeleton, joint: usize, depth: usize) 
     let _ = writeln!(out, "{indent}}}");
 }
 
-/// The clip as BVH text (LF line ends).
-pub fn to_bvh_string(clip: &ChannelClip) -> String {
-    let mut out = String::with_capacity(64 + clip.values.len() * 11);
-    out.push_str("HIERARCHY\n");
-    if !clip.skeleton.is_empty() {
-        hierarchy(&mut out, &clip.skeleton, 0, 0);
+/// The HIERARCHY and the MOTION block's header (frame count and frame time) of a file.
+pub(crate) fn header_text(skeleton: &Skeleton, fps: f64, frames: usize) -> String {
+    let mut out = String::from("HIERARCHY\n");
+    if !skeleton.is_empty() {
+        hierarchy(&mut out, skeleton, 0, 0);
     }
     out.push_str("MOTION\n");
-    let _ = writeln!(out, "Frames: {}", clip.frame_count());
-    let _ = writeln!(out, "Frame Time: {:.8}", 1.0 / clip.fps);
-    for f in 0..clip.frame_count() {
-        for (i, &v) in clip.frame(f).iter().enumerate() {
-            if i > 0 {
-                out.push(' ');
-            }
-            num(&mut out, v);
+    let _ = writeln!(out, "Frames: {frames}");
+    let _ = writeln!(out, "Frame Time: {:.8}", 1.0 / fps);
+    out
+}
+
+/// Appends one MOTION line.
+pub(crate) fn push_row(out: &mut String, values: &[f64]) {
+    for (i, &v) in values.iter().enumerate() {
+        if i > 0 {
+            out.push(' ');
         }
-        out.push('\n');
+        num(out, v);
+    }
+    out.push('\n');
+}
+
+/// The clip as BVH text (LF line ends).
+pub fn to_bvh_string(clip: &ChannelClip) -> String {
+    let mut out = header_text(&clip.skeleton, clip.fps, clip.frame_count());
+    out.reserve(clip.values.len() * 11);
+    for f in 0..clip.frame_count() {
+        push_row(&mut out, clip.frame(f));
     }
     out
 }
