@@ -237,7 +237,7 @@ typedef struct SinmdmStreamOptions {
    */
   uint32_t steps;
   /*
-   Frames each block makes final; 0 for two seconds.
+   Frames each block makes final; 0 for the length of the model's training clip.
    */
   uint32_t block_frames;
   /*

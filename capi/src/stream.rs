@@ -21,7 +21,7 @@ pub struct SinmdmStreamOptions {
     pub seed: u64,
     /// Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STEPS`.
     pub steps: u32,
-    /// Frames each block makes final; 0 for two seconds.
+    /// Frames each block makes final; 0 for the length of the model's training clip.
     pub block_frames: u32,
     /// `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
     pub feet: u32,

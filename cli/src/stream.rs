@@ -9,7 +9,6 @@ use ndarray::{Array2, s};
 
 use sinmdm::bvh::BvhStreamWriter;
 use sinmdm::features_file::write_features;
-use sinmdm::stream::STREAM_DEFAULT_BLOCK_SECONDS;
 use sinmdm::tasks::INBETWEEN_RAMP;
 use sinmdm::{Model, ModelOptions, Stream, StreamOptions};
 
@@ -40,7 +39,8 @@ pub struct StreamArgs {
     /// same whatever the chunk size.
     #[arg(long, default_value = "1s")]
     chunk: String,
-    /// Frames each block makes final, in frames or seconds (the motion depends on it).
+    /// Frames each block makes final, in frames or seconds (the motion depends on it; default:
+    /// the training clip's length).
     #[arg(long)]
     block: Option<String>,
     /// Seed of the noise.
@@ -114,7 +114,7 @@ pub fn run(args: &StreamArgs) -> Result<()> {
         args.quiet,
         total,
         format!(
-            "{total} frames in chunks of {chunk} (blocks of {}, {STREAM_DEFAULT_BLOCK_SECONDS} s unless --block)",
+            "{total} frames in chunks of {chunk}, blocks of {}",
             stream.sizes().block
         ),
     );
@@ -140,7 +140,11 @@ pub fn run(args: &StreamArgs) -> Result<()> {
         total as f64 / fps / seconds.max(1e-9)
     );
     if let (Some(path), Some(all)) = (&args.features_json, &features) {
-        write_features(path, &model.metadata().layout, all.view().insert_axis(ndarray::Axis(0)))?;
+        write_features(
+            path,
+            &model.metadata().layout,
+            all.view().insert_axis(ndarray::Axis(0)),
+        )?;
         eprintln!("wrote {}", path.display());
     }
     Ok(())

@@ -160,8 +160,7 @@ fn a_bvh_written_chunk_by_chunk_is_the_bvh_of_the_whole_motion() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("chunked.bvh");
     let mut stream = Stream::new(model.metadata(), options(Feet::Planted)).unwrap();
-    let mut writer =
-        BvhStreamWriter::create(&path, model.skeleton(), model.fps(), 130).unwrap();
+    let mut writer = BvhStreamWriter::create(&path, model.skeleton(), model.fps(), 130).unwrap();
     let mut whole: Option<sinmdm::motion::LocalMotion> = None;
     for n in [17, 50, 1, 62] {
         let chunk = stream.next(&mut model, n).unwrap();
@@ -182,8 +181,14 @@ fn a_bvh_written_chunk_by_chunk_is_the_bvh_of_the_whole_motion() {
     // A writer dropped before its last frame leaves nothing behind.
     let partial = dir.join("partial.bvh");
     let mut writer = BvhStreamWriter::create(&partial, model.skeleton(), model.fps(), 10).unwrap();
-    writer.append(&stream.next(&mut model, 5).unwrap().motion).unwrap();
-    assert!(writer.append(&stream.next(&mut model, 6).unwrap().motion).is_err());
+    writer
+        .append(&stream.next(&mut model, 5).unwrap().motion)
+        .unwrap();
+    assert!(
+        writer
+            .append(&stream.next(&mut model, 6).unwrap().motion)
+            .is_err()
+    );
     drop(writer);
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
     std::fs::remove_dir_all(&dir).unwrap();

@@ -10,7 +10,6 @@ from .sampler import sample
 from .tasks import INBETWEEN_RAMP, soft_mask
 
 BLOCK_SEED_STREAM = 2_000_000
-DEFAULT_BLOCK_SECONDS = 2.0
 
 
 def block_seed(seed, index):
@@ -26,9 +25,8 @@ def window(context, ramp, block, index):
 
 def stream_features(model, schedule, seed, total, block=None, context=None, ramp=INBETWEEN_RAMP):
     """Raw features [F, total] of the first `total` frames of a stream."""
-    fps = model.layout["fps"]
     context = context or max(model.metadata["network"]["receptive_field"], 1)
-    block = block or max(int(np.floor(DEFAULT_BLOCK_SECONDS * fps + 0.5)), 1)
+    block = block or max(model.metadata["training"]["clip_frames"], context)
     ramp = max(ramp, 1)
     f = model.features
     out = np.zeros((f, total), dtype=np.float32)

@@ -70,6 +70,8 @@ CASES = {
     "harmonize": (["harmonize", "--factor", 2, "--free-share", 0.1, "--steps", 40], {"--content": "hop"}),
     # Five blocks of 30 frames, each seeded from the stream's seed and continuing the last.
     "stream": (["stream", "--frames", 140, "--block", 30, "--steps", 12], {}),
+    # The default blocks: the training clip's length.
+    "stream-default-blocks": (["stream", "--frames", 400, "--steps", 4], {}),
 }
 
 

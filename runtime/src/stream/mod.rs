@@ -33,8 +33,6 @@ use guide::Guide;
 
 /// Respaced sampling steps of a stream unless told otherwise (the command line's default).
 pub const STREAM_DEFAULT_STEPS: usize = 100;
-/// Frames a block makes final unless told otherwise, in seconds of the model's frame rate.
-pub const STREAM_DEFAULT_BLOCK_SECONDS: f64 = 2.0;
 
 /// Joints (and the root's travel) that a stream takes from poses the game supplies.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -52,8 +50,11 @@ pub struct StreamOptions {
     pub seed: u64,
     /// Sampling steps per block (respaced); `None` runs all T steps.
     pub steps: Option<usize>,
-    /// Frames each block makes final; `None` for [`STREAM_DEFAULT_BLOCK_SECONDS`]. Longer blocks
-    /// cost less per frame (the context is paid once per block) but take longer to make.
+    /// Frames each block makes final; `None` for the length of the model's training clip, the
+    /// length its GroupNorm statistics were learned at (shorter blocks came out measurably more
+    /// unlike one-shot samples: on the walk, global diversity 1.67 with 2 s blocks, 1.37 with
+    /// 4 s and 1.18 with 8 s, against 1.24 in one shot). Longer blocks also cost less per frame
+    /// (the context is paid once per block) but take longer to make.
     pub block_frames: Option<usize>,
     /// Final frames of the previous block each block sees; `None` for the model's receptive field.
     pub context_frames: Option<usize>,
@@ -140,9 +141,9 @@ impl Stream {
         let context = options
             .context_frames
             .unwrap_or(metadata.network.receptive_field.max(1));
-        let block = options.block_frames.unwrap_or_else(|| {
-            (STREAM_DEFAULT_BLOCK_SECONDS * layout.fps).round().max(1.0) as usize
-        });
+        let block = options
+            .block_frames
+            .unwrap_or(metadata.training.clip_frames.max(context));
         let ramp = options.ramp.max(1);
         if context == 0 {
             return bad("a stream needs at least one frame of context".into());
