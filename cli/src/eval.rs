@@ -13,13 +13,16 @@ use crate::sampling::{
 };
 use sinmdm::features_file::write_features;
 use sinmdm::files::write_atomically;
-use sinmdm::{Feet, Request, Task};
+use sinmdm::{Feet, Generated, Request, Stream, StreamOptions, Task};
 use sinmdm::{Model, ModelOptions};
-use sinmdm_eval::{COVERAGE_WINDOW, FeetReport, ModelEvaluation, Report, evaluate_model};
+use sinmdm_eval::{
+    COVERAGE_WINDOW, FeetReport, ModelEvaluation, Report, evaluate_generated, evaluate_model,
+};
 
 pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm eval -m onnx-models/human_walk_cmu.onnx --clip tests/data/bvh/human_walk_cmu_131_01.bvh
   sinmdm eval -m walk.onnx --clip walk.bvh --samples 20 --steps all --json out/walk_eval.json
+  sinmdm eval -m walk.onnx --clip walk.bvh --samples 3 --frames 1800 --stream   # 60 s streams
 
 Samples are twice the clip's length by default, as in the published benchmark. The table is
 Markdown, ready for a model card.";
@@ -56,6 +59,10 @@ pub struct EvalArgs {
     /// Also write the samples' raw features as JSON here (to check the scores elsewhere).
     #[arg(long, value_name = "OUT.json")]
     features_json: Option<PathBuf>,
+    /// Make every sample as a stream (`sinmdm stream`, blocks of the training clip's length)
+    /// instead of in one shot; sample i uses seed + i.
+    #[arg(long)]
+    stream: bool,
     /// Do not show the progress bar.
     #[arg(long)]
     quiet: bool,
@@ -135,18 +142,45 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         format!("{} x {} frames", args.samples, frames),
     );
     let metadata = model.metadata().clone();
-    let evaluation = evaluate_model(
-        &mut model,
-        &metadata,
-        &request,
-        clip.view(),
-        threads,
-        &mut |done, steps| {
-            bar.set_length(steps as u64);
-            bar.set_position(done as u64);
-            ControlFlow::Continue(())
-        },
-    )
+    let evaluation = if args.stream {
+        let started = std::time::Instant::now();
+        bar.set_length(args.samples as u64);
+        let mut normalized =
+            ndarray::Array3::<f32>::zeros((args.samples, metadata.network.features, frames));
+        for i in 0..args.samples {
+            let options = StreamOptions {
+                seed: args.seed + i as u64,
+                steps,
+                feet: Feet::Raw,
+                ..StreamOptions::default()
+            };
+            let chunk = Stream::new(&metadata, options)?.next(&mut model, frames)?;
+            normalized
+                .index_axis_mut(Axis(0), i)
+                .assign(&metadata.normalizer.normalize(chunk.features.view()));
+            bar.set_position(i as u64 + 1);
+        }
+        let generated = Generated::from_normalized(metadata.clone(), normalized);
+        evaluate_generated(
+            generated,
+            clip.view(),
+            threads,
+            started.elapsed().as_secs_f64(),
+        )
+    } else {
+        evaluate_model(
+            &mut model,
+            &metadata,
+            &request,
+            clip.view(),
+            threads,
+            &mut |done, steps| {
+                bar.set_length(steps as u64);
+                bar.set_position(done as u64);
+                ControlFlow::Continue(())
+            },
+        )
+    }
     .with_context(|| format!("cannot score against {}", args.clip.display()))?;
     bar.finish_and_clear();
     let ModelEvaluation {
@@ -169,8 +203,14 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         layout.fps
     );
     println!(
-        "{} samples x {} frames, {} steps, seed {}: sampled in {:.1} s, scored in {:.1} s",
-        args.samples, frames, steps_text, args.seed, sampling_seconds, scoring_seconds
+        "{} samples x {} frames{}, {} steps, seed {}: sampled in {:.1} s, scored in {:.1} s",
+        args.samples,
+        frames,
+        if args.stream { " (streamed)" } else { "" },
+        steps_text,
+        args.seed,
+        sampling_seconds,
+        scoring_seconds
     );
     println!();
     println!("samples as the network made them (--feet raw):");

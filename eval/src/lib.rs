@@ -45,7 +45,7 @@ pub use feet::{
     FeetReference, FeetReport, FeetScores, GROUND_BAND, PENETRATION_TOLERANCE, SKATING_SPEED,
     SPEED_WINDOW, SampleFeet, mean_scores,
 };
-pub use model_eval::{ModelEvalError, ModelEvaluation, evaluate_model};
+pub use model_eval::{ModelEvalError, ModelEvaluation, evaluate_generated, evaluate_model};
 pub use patched_nn::patched_nearest_neighbour;
 pub use window_match::DiagonalSums;
 

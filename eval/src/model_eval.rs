@@ -67,7 +67,26 @@ where
     }
     let started = Instant::now();
     let generated = plan.run(denoiser, progress)?;
-    let sampling_seconds = started.elapsed().as_secs_f64();
+    evaluate_generated(generated, clip, threads, started.elapsed().as_secs_f64())
+}
+
+/// Scores samples made elsewhere (a stream's, say) against `clip`, raw features `[F, N]` in the
+/// samples' layout: as [`evaluate_model`] after its sampling. Planted figures plant each sample
+/// whole, with nothing kept.
+pub fn evaluate_generated(
+    generated: Generated,
+    clip: ArrayView2<'_, f32>,
+    threads: usize,
+    sampling_seconds: f64,
+) -> Result<ModelEvaluation, ModelEvalError> {
+    if generated.frames() < COVERAGE_WINDOW {
+        return Err(EvalError::TooShort {
+            what: "sample length".into(),
+            frames: generated.frames(),
+            needed: COVERAGE_WINDOW,
+        }
+        .into());
+    }
     let started = Instant::now();
     let layout = generated.layout();
     let clip_metric = metric_features(layout, clip);

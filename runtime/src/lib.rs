@@ -57,7 +57,9 @@ pub mod tasks;
 pub use diffusion::{Denoiser, Sampler, SamplerError};
 pub use model::{Model, ModelError, ModelOptions};
 pub use model_file::ModelMetadata;
-pub use motion::{Feet, Joint, Pose, Quaternion, Skeleton, UpAxis, motion_from_poses};
+pub use motion::{
+    Feet, Joint, Pose, Quaternion, Skeleton, UpAxis, features_from_poses, motion_from_poses,
+};
 pub use onnxruntime::{
     ONNXRUNTIME_VERSION, OnnxRuntime, RuntimeLibraryError, init as init_onnxruntime,
     load_onnxruntime,

@@ -122,3 +122,50 @@ fn engine_poses_rebuild_the_decoded_skeleton() {
         }
     }
 }
+
+#[test]
+fn poses_in_give_back_the_features_they_came_from() {
+    use sinmdm::motion::{MotionError, features_from_poses};
+    let clip = read_bvh(common::workspace().join("tests/data/bvh/fox_survey_khronos.bvh")).unwrap();
+    let encoded = encode(&clip, &EncodeOptions::default()).unwrap();
+    let layout = &encoded.layout;
+    let out = poses(&decode(layout, encoded.features.view()).unwrap());
+    let back = features_from_poses(layout, &out).unwrap();
+    // Every row but the contact labels (measured again from the feet) and the first frame's
+    // displacement (nothing before it) comes back within f32 rounding.
+    let contacts = layout.contact_rows();
+    for row in (0..layout.width()).filter(|r| !contacts.contains(r)) {
+        for frame in 1..back.ncols() {
+            let (a, b) = (back[[row, frame]], encoded.features[[row, frame]]);
+            assert!(
+                (a - b).abs() < 1e-3 * (1.0 + b.abs()),
+                "row {row} frame {frame}: {a} vs {b}"
+            );
+        }
+    }
+    // Bad poses name the frame and the joint.
+    let mut bad = out.clone();
+    bad[3].rotations[2] = sinmdm::Quaternion {
+        x: 0.0,
+        y: 0.0,
+        z: 0.0,
+        w: 0.0,
+    };
+    let e = features_from_poses(layout, &bad).unwrap_err();
+    assert!(matches!(e, MotionError::BadPose { frame: 3, .. }), "{e}");
+    assert!(
+        e.to_string().contains(&layout.skeleton.joints[2].name),
+        "{e}"
+    );
+    bad[3].rotations.pop();
+    assert!(
+        features_from_poses(layout, &bad)
+            .unwrap_err()
+            .to_string()
+            .contains("rotations")
+    );
+    assert_eq!(
+        features_from_poses(layout, &[]).unwrap_err(),
+        MotionError::NoPoses
+    );
+}

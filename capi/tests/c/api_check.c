@@ -154,6 +154,12 @@ int main(int argc, char **argv) {
   CHECK_OK(sinmdm_write_bvh(model, &reference, argv[3]));
 
   /* Bad arguments: a status code and a message each, never a crash. */
+  int32_t one_parent_early[1];
+  EXPECT(SINMDM_RUNTIME_LIBRARY, sinmdm_load_onnxruntime("/no/such/libonnxruntime.so"));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_model_rest_offsets(model, NULL, 0));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_model_parents(NULL, one_parent_early, 1));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_stream_supply(NULL, model, &reference));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_stream_supply(stream, model, NULL));
   SinmdmModel *none = NULL;
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_model_open(NULL, 1, &none));
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_model_open(argv[1], 1, NULL));

@@ -24,6 +24,6 @@ pub use features::{
 pub use feet::{Feet, PlantOptions, PlantStats, plant_feet};
 pub use fk::{GlobalPose, global_pose, global_poses, max_position_error, skeleton_height};
 pub use normalize::Normalizer;
-pub use pose::{Pose, Quaternion, motion_from_poses, poses};
+pub use pose::{Pose, Quaternion, features_from_poses, motion_from_poses, poses};
 pub use skeleton::{Axis, Channel, Joint, Skeleton};
 pub use up::{Confidence, UpAxis, UpDetection, detect_up};

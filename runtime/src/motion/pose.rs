@@ -2,7 +2,7 @@
 //! quaternion, without touching the file system.
 
 use super::clip::LocalMotion;
-use super::features::MotionError;
+use super::features::{FeatureLayout, FeatureMatrix, MotionError, encode_motion};
 use super::math::{mat_from_quat_wxyz, quat_wxyz_from_mat};
 use super::skeleton::Skeleton;
 
@@ -124,4 +124,15 @@ pub fn motion_from_poses(
         rotations,
         translations,
     })
+}
+
+/// Engine poses of a model's skeleton as raw features in its `layout`: a reference or content for
+/// in-betweening, expansion, composition or harmonization, given as poses instead of a file.
+/// The poses are at the layout's frame rate, in its file's frame and units.
+pub fn features_from_poses(
+    layout: &FeatureLayout,
+    poses: &[Pose],
+) -> Result<FeatureMatrix, MotionError> {
+    let motion = motion_from_poses(&layout.skeleton, layout.fps, poses)?;
+    Ok(encode_motion(layout, &motion))
 }
