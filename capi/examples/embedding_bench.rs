@@ -156,6 +156,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             seed,
             steps: Some(100),
             feet: Feet::Raw,
+            method: Default::default(),
         };
         let generated = sinmdm::run(&mut model, &request, &mut |_, _| ControlFlow::Continue(()))?;
         one_shot.push(metric_features(
@@ -202,6 +203,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         seed: 1,
         steps: Some(20),
         feet: Feet::Planted,
+        method: Default::default(),
     };
     let (mut rust, mut c) = (Vec::new(), Vec::new());
     for _ in 0..15 {

@@ -82,6 +82,7 @@ unsafe fn run_task(
             seed: sampling.seed,
             steps: (sampling.steps > 0).then_some(sampling.steps as usize),
             feet: feet_arg(sampling.feet)?,
+            method: Default::default(),
         };
         let generated = sinmdm::run(&mut model.model, &request, &mut |_, _| {
             ControlFlow::Continue(())

@@ -59,6 +59,8 @@ pub struct EvalArgs {
     /// Also write the samples' raw features as JSON here (to check the scores elsewhere).
     #[arg(long, value_name = "OUT.json")]
     features_json: Option<PathBuf>,
+    #[command(flatten)]
+    method: crate::sampling::MethodArgs,
     /// Make every sample as a stream (`sinmdm stream`, blocks of the training clip's length)
     /// instead of in one shot; sample i uses seed + i.
     #[arg(long)]
@@ -79,6 +81,7 @@ struct EvalFile<'a> {
     samples: usize,
     frames: usize,
     steps: String,
+    sampler: String,
     seed: u64,
     sampling_seconds: f64,
     report: &'a Report,
@@ -94,6 +97,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         bail!("--threads must be at least 1");
     }
     let steps = parse_steps(&args.steps)?;
+    let method = args.method.method()?;
     let outputs: Vec<PathBuf> = args
         .json
         .iter()
@@ -131,6 +135,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         seed: args.seed,
         steps,
         feet: Feet::Planted,
+        method,
     };
     let threads = args.threads.unwrap_or_else(|| {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
@@ -152,6 +157,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
                 seed: args.seed + i as u64,
                 steps,
                 feet: Feet::Raw,
+                method,
                 ..StreamOptions::default()
             };
             let chunk = Stream::new(&metadata, options)?.next(&mut model, frames)?;
@@ -203,11 +209,12 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         layout.fps
     );
     println!(
-        "{} samples x {} frames{}, {} steps, seed {}: sampled in {:.1} s, scored in {:.1} s",
+        "{} samples x {} frames{}, {} {} steps, seed {}: sampled in {:.1} s, scored in {:.1} s",
         args.samples,
         frames,
         if args.stream { " (streamed)" } else { "" },
         steps_text,
+        method.name(),
         args.seed,
         sampling_seconds,
         scoring_seconds
@@ -235,6 +242,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             samples: args.samples,
             frames,
             steps: steps_text,
+            sampler: method.name(),
             seed: args.seed,
             sampling_seconds,
             report: &report,

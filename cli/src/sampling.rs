@@ -14,7 +14,7 @@ use sinmdm::files::write_atomically;
 use sinmdm::motion::encode_for_model;
 use sinmdm::motion::up::UpAxis;
 use sinmdm::tasks::MAX_COUNT;
-use sinmdm::{Feet, Generated, Plan, Request, Span, Task};
+use sinmdm::{Feet, Generated, Method, Plan, Request, Span, Task};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_render::{Camera, Figure};
 
@@ -60,6 +60,50 @@ pub struct SamplingArgs {
     /// `raw` writes the network's motion untouched.
     #[arg(long, value_enum, default_value_t = FeetArg::Planted)]
     pub feet: FeetArg,
+    #[command(flatten)]
+    pub method: MethodArgs,
+}
+
+/// `--sampler` and `--eta`: the update rule of each denoising step.
+#[derive(Debug, Clone, Args)]
+pub struct MethodArgs {
+    /// The update rule of each step: `ancestral` (the paper's DDPM sampler), `ddim`
+    /// (deterministic with --eta 0) or `dpm2m` (DPM-Solver++(2M), deterministic, second order:
+    /// good motion in fewer steps).
+    #[arg(long, value_enum, default_value_t = SamplerArg::Ancestral)]
+    pub sampler: SamplerArg,
+    /// DDIM's share of the ancestral noise, 0 to 1.
+    #[arg(long, default_value_t = 0.0)]
+    pub eta: f64,
+}
+
+/// `--sampler`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SamplerArg {
+    /// Ancestral DDPM.
+    Ancestral,
+    /// DDIM (with --eta).
+    Ddim,
+    /// DPM-Solver++(2M).
+    Dpm2m,
+}
+
+impl MethodArgs {
+    /// The method asked for.
+    pub fn method(&self) -> Result<Method> {
+        if self.sampler != SamplerArg::Ddim && self.eta != 0.0 {
+            bail!("--eta applies to --sampler ddim only");
+        }
+        let method = match self.sampler {
+            SamplerArg::Ancestral => Method::Ancestral,
+            SamplerArg::Ddim => Method::Ddim { eta: self.eta },
+            SamplerArg::Dpm2m => Method::DpmSolver2M,
+        };
+        if let Some(problem) = method.problem() {
+            bail!("--eta: {problem}");
+        }
+        Ok(method)
+    }
 }
 
 /// `--feet`.
@@ -248,6 +292,7 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         seed: args.seed,
         steps: args.steps()?,
         feet: args.feet.into(),
+        method: args.method.method()?,
     };
     let plan = sinmdm::plan(model.metadata(), &request)?;
     let mut outputs: Vec<PathBuf> = (0..plan.count())

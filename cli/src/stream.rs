@@ -49,6 +49,8 @@ pub struct StreamArgs {
     /// Denoising steps per block: a number of respaced steps, or `all`.
     #[arg(long, default_value = DEFAULT_STEPS, value_name = "S|all")]
     steps: String,
+    #[command(flatten)]
+    method: crate::sampling::MethodArgs,
     /// Feet: planted (held during contact, nothing below the ground) or raw.
     #[arg(long, value_enum, default_value_t = FeetArg::Planted)]
     feet: FeetArg,
@@ -100,6 +102,7 @@ pub fn run(args: &StreamArgs) -> Result<()> {
         ramp: INBETWEEN_RAMP,
         feet: args.feet.into(),
         compose: None,
+        method: args.method.method()?,
     };
     let mut stream = Stream::new(model.metadata(), options)?;
     let mut outputs = vec![args.output.clone()];

@@ -299,6 +299,7 @@ fn try_mutant(bytes: &[u8]) -> Result<Option<&'static str>, String> {
         seed: 1,
         steps: Some(2),
         feet: sinmdm::Feet::default(),
+        method: Default::default(),
     };
     match sinmdm::run(&mut model, &request, &mut |_, _| ControlFlow::Continue(())) {
         Ok(generated) => match generated.poses(0) {

@@ -23,6 +23,7 @@
 //!     seed: 7,
 //!     steps: Some(10),
 //!     feet: Feet::Planted, // contact points held still on the ground; Feet::Raw leaves them
+//!     method: Default::default(), // ancestral; Method::DpmSolver2M needs fewer steps
 //! };
 //! let generated = sinmdm::run(&mut model, &request, &mut |_done, _steps| ControlFlow::Continue(()))?;
 //! let poses = generated.poses(0)?; // per frame: root position, local rotations, translations
@@ -54,7 +55,7 @@ mod onnxruntime;
 pub mod stream;
 pub mod tasks;
 
-pub use diffusion::{Denoiser, Sampler, SamplerError};
+pub use diffusion::{Denoiser, Method, Sampler, SamplerError};
 pub use model::{Model, ModelError, ModelOptions};
 pub use model_file::ModelMetadata;
 pub use motion::{

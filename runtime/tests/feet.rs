@@ -244,6 +244,7 @@ fn an_inbetween_keeps_its_frames_after_planting() {
         seed: 5,
         steps: Some(5),
         feet: Feet::Planted,
+        method: Default::default(),
     };
     let generated =
         sinmdm::run(&mut model, &request, &mut |_, _| ControlFlow::Continue(())).unwrap();

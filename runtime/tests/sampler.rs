@@ -22,6 +22,7 @@ fn request(task: Task, count: usize) -> Request {
         seed: 11,
         steps: Some(12),
         feet: sinmdm::Feet::default(),
+        method: Default::default(),
     }
 }
 

@@ -8,7 +8,7 @@ use sinmdm::bvh::read_bvh;
 use sinmdm::diffusion::sampler::low_pass;
 use sinmdm::motion::encode_for;
 use sinmdm::tasks::{self, Generated, Request, Span, Task, TaskError};
-use sinmdm::{Model, ModelError, ModelOptions};
+use sinmdm::{Method, Model, ModelError, ModelOptions};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -32,12 +32,23 @@ fn walk(model: &Model, frames: usize) -> Array2<f32> {
 }
 
 fn run(model: &mut Model, task: Task, count: usize, steps: usize) -> Generated {
+    run_with(model, task, count, steps, Method::Ancestral)
+}
+
+fn run_with(
+    model: &mut Model,
+    task: Task,
+    count: usize,
+    steps: usize,
+    method: Method,
+) -> Generated {
     let request = Request {
         task,
         count,
         seed: 3,
         steps: Some(steps),
         feet: sinmdm::Feet::default(),
+        method,
     };
     tasks::run(model, &request, &mut |_, _| {
         std::ops::ControlFlow::Continue(())
@@ -47,11 +58,23 @@ fn run(model: &mut Model, task: Task, count: usize, steps: usize) -> Generated {
 
 #[test]
 fn inbetween_keeps_the_reference_exactly_where_the_mask_is_one() {
+    let methods = [
+        Method::Ancestral,
+        Method::Ddim { eta: 0.0 },
+        Method::Ddim { eta: 0.7 },
+        Method::DpmSolver2M,
+    ];
+    for method in methods {
+        inbetween_keeps_the_reference(method);
+    }
+}
+
+fn inbetween_keeps_the_reference(method: Method) {
     let mut m = model();
     let reference = walk(&m, 150);
     let y = m.metadata().normalizer.normalize(reference.view());
     let keep = vec![Span::new(0, 50), Span::new(100, 150)];
-    let out = run(
+    let out = run_with(
         &mut m,
         Task::Inbetween {
             reference,
@@ -59,7 +82,8 @@ fn inbetween_keeps_the_reference_exactly_where_the_mask_is_one() {
             ramp: 10,
         },
         2,
-        20,
+        12,
+        method,
     );
     assert_eq!(out.normalized.dim(), (2, y.nrows(), 150));
     for sample in out.normalized.outer_iter() {
@@ -68,14 +92,17 @@ fn inbetween_keeps_the_reference_exactly_where_the_mask_is_one() {
             assert_eq!(
                 sample.column(frame),
                 y.column(frame),
-                "frame {frame} differs from the reference"
+                "{method:?}: frame {frame} differs from the reference"
             );
         }
         // The gap itself is generated, not copied.
         let gap_diff: f32 = (55..95)
             .map(|f| (&sample.column(f) - &y.column(f)).mapv(f32::abs).sum())
             .sum();
-        assert!(gap_diff > 1.0, "the gap equals the reference ({gap_diff})");
+        assert!(
+            gap_diff > 1.0,
+            "{method:?}: the gap equals the reference ({gap_diff})"
+        );
     }
 }
 
@@ -172,6 +199,7 @@ fn same_seed_same_motion_and_another_seed_another() {
         seed: 4,
         steps: Some(10),
         feet: sinmdm::Feet::default(),
+        method: Default::default(),
     };
     let c = tasks::run(&mut m, &request, &mut |_, _| {
         std::ops::ControlFlow::Continue(())
@@ -187,8 +215,8 @@ fn low_pass_distance(sample: &Array3<f32>, content: &Array2<f32>, factor: usize)
     (&a - &b).mapv(|v| v * v).mean().unwrap().sqrt()
 }
 
-fn harmonize(m: &mut Model, content: &Array2<f32>, free_share: f64) -> Generated {
-    run(
+fn harmonize(m: &mut Model, content: &Array2<f32>, free_share: f64, method: Method) -> Generated {
+    run_with(
         m,
         Task::Harmonize {
             content: content.clone(),
@@ -197,6 +225,7 @@ fn harmonize(m: &mut Model, content: &Array2<f32>, free_share: f64) -> Generated
         },
         1,
         50,
+        method,
     )
 }
 
@@ -218,15 +247,22 @@ fn harmonization_follows_the_content_low_frequencies() {
     let unguided = low_pass_distance(&free.normalized, &y, 2);
     // With the default free share the model has the last word (its prediction at t = 0), so
     // the output follows the content's slow motion, not exactly.
-    let guided = low_pass_distance(&harmonize(&mut m, &content, 0.02).normalized, &y, 2);
-    assert!(
-        guided * 1.5 < unguided,
-        "harmonized low-pass distance {guided} vs unguided {unguided}"
-    );
+    for method in [Method::Ancestral, Method::DpmSolver2M] {
+        let guided =
+            low_pass_distance(&harmonize(&mut m, &content, 0.02, method).normalized, &y, 2);
+        assert!(
+            guided * 1.5 < unguided,
+            "{method:?}: harmonized low-pass distance {guided} vs unguided {unguided}"
+        );
+    }
     // With no free steps the last replacement is with the clean content, so the output's
     // low-pass is the content's up to what one more low-pass changes (up(down) is not a
     // projection: applying it twice differs a little from applying it once).
-    let strict = low_pass_distance(&harmonize(&mut m, &content, 0.0).normalized, &y, 2);
+    let strict = low_pass_distance(
+        &harmonize(&mut m, &content, 0.0, Method::Ancestral).normalized,
+        &y,
+        2,
+    );
     assert!(
         strict * 10.0 < unguided,
         "low-pass distance {strict} with no free steps, unguided {unguided}"
@@ -243,6 +279,7 @@ fn plan_error(task: Task, count: usize, steps: Option<usize>) -> TaskError {
             seed: 0,
             steps,
             feet: sinmdm::Feet::default(),
+            method: Default::default(),
         },
     )
     .unwrap_err()

@@ -39,6 +39,8 @@ def main(argv=None):
         p.add_argument("--seed", type=int, default=0)
         p.add_argument("--steps", default="100", help="respaced steps S, or 'all'")
         p.add_argument("--threads", type=int, default=None)
+        p.add_argument("--sampler", choices=["ancestral", "ddim", "dpm2m"], default="ancestral")
+        p.add_argument("--eta", type=float, default=0.0)
         return p
 
     g = common(sub.add_parser("generate"))
@@ -69,6 +71,7 @@ def main(argv=None):
     st.add_argument("--block", type=int, default=None)
     args = parser.parse_args(argv)
 
+    method = (args.sampler, args.eta) if args.sampler == "ddim" else (args.sampler,)
     try:
         model = Model(args.model, args.threads)
         fps = model.layout["fps"]
@@ -80,7 +83,7 @@ def main(argv=None):
 
         if args.command == "stream":
             schedule = tasks.schedule_for(model, _steps(args.steps))
-            feats = stream_features(model, schedule, args.seed, args.frames, block=args.block)
+            feats = stream_features(model, schedule, args.seed, args.frames, block=args.block, method=method)
             write_features(args.output, model.layout, feats[None])
             print(f"wrote {args.output}", file=sys.stderr)
             return 0
@@ -116,7 +119,7 @@ def main(argv=None):
         if not 1 <= frames <= tasks.MAX_FRAMES:
             raise tasks.TaskError(f"a sample of {frames} frames is not possible")
         schedule = tasks.schedule_for(model, _steps(args.steps))
-        x = sample(model, schedule, args.count, frames, args.seed, inpainting, harmonization)
+        x = sample(model, schedule, args.count, frames, args.seed, inpainting, harmonization, method=method)
         write_features(args.output, model.layout, model.denormalize(x))
     except (ModelError, tasks.TaskError, ValueError, OSError) as e:
         print(f"error: {e}", file=sys.stderr)

@@ -23,7 +23,8 @@ def window(context, ramp, block, index):
     return index * block - context, context + ramp + block, context + ramp, context
 
 
-def stream_features(model, schedule, seed, total, block=None, context=None, ramp=INBETWEEN_RAMP):
+def stream_features(model, schedule, seed, total, block=None, context=None, ramp=INBETWEEN_RAMP,
+                    method=("ancestral",)):
     """Raw features [F, total] of the first `total` frames of a stream."""
     context = context or max(model.metadata["network"]["receptive_field"], 1)
     block = block or max(model.metadata["training"]["clip_frames"], context)
@@ -41,7 +42,7 @@ def stream_features(model, schedule, seed, total, block=None, context=None, ramp
             weights = soft_mask(np.arange(n) < carry, ramp)
             mask = np.repeat(weights[None, :], f, axis=0).astype(np.float32)
             inpainting = (reference, mask)
-        x = sample(model, schedule, 1, n, block_seed(seed, index), inpainting)[0]
+        x = sample(model, schedule, 1, n, block_seed(seed, index), inpainting, method=method)[0]
         carried = x[:, n - (context + ramp):].copy()
         raw = model.denormalize(x)
         take = min(block, total - made)

@@ -70,6 +70,15 @@ CASES = {
     "harmonize": (["harmonize", "--factor", 2, "--free-share", 0.1, "--steps", 40], {"--content": "hop"}),
     # Five blocks of 30 frames, each seeded from the stream's seed and continuing the last.
     "stream": (["stream", "--frames", 140, "--block", 30, "--steps", 12], {}),
+    # Few-step samplers, with masks (x0 blending) and harmonization (x_t low-pass).
+    "generate-dpm2m": (["generate", "--frames", 90, "--count", 2, "--steps", 12, "--sampler", "dpm2m"], {}),
+    "generate-ddim-eta": (["generate", "--frames", 60, "--steps", 10, "--sampler", "ddim", "--eta", 0.5], {}),
+    "inbetween-ddim": (["inbetween", "--keep", "0:60", "--keep", "5s:", "--steps", 10, "--sampler", "ddim"],
+                       {"--reference": "walk"}),
+    "compose-dpm2m": (["compose", "--part", "LeftHip", "--root", "--steps", 10, "--sampler", "dpm2m"],
+                      {"--reference": "walk"}),
+    "harmonize-dpm2m": (["harmonize", "--steps", 12, "--sampler", "dpm2m"], {"--content": "hop"}),
+    "stream-dpm2m": (["stream", "--frames", 100, "--block", 30, "--steps", 8, "--sampler", "dpm2m"], {}),
     # The default blocks: the training clip's length.
     "stream-default-blocks": (["stream", "--frames", 400, "--steps", 4], {}),
 }

@@ -80,6 +80,7 @@ pub fn expected() -> BTreeMap<String, String> {
             seed: 7,
             steps: Some(4),
             feet: Feet::Planted,
+            method: Default::default(),
         },
         go,
     )
@@ -102,6 +103,7 @@ pub fn expected() -> BTreeMap<String, String> {
             seed: 3,
             steps: Some(4),
             feet: Feet::Planted,
+            method: Default::default(),
         },
         go,
     )

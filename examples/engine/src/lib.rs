@@ -43,6 +43,7 @@ pub fn generate_crowd(
         seed,
         steps: Some(20),
         feet: sinmdm::Feet::default(),
+        method: Default::default(),
     };
     let plan = sinmdm::plan(model.metadata(), &request)?;
     let mut sampler = plan.sampler()?;

@@ -2,11 +2,13 @@
 //! guidance of the tasks and the sampler.
 
 mod guidance;
+pub mod method;
 pub mod noise;
 mod noise_worker;
 pub mod sampler;
 pub mod schedule;
 
+pub use method::Method;
 pub use sampler::{
     Denoiser, Guidance, Harmonization, Inpainting, Sampler, SamplerError, StepError, sample,
 };

@@ -6,7 +6,10 @@
 //! 1. `x = noise(seed, stream 0)`, shape `[B, F, N]`, row-major.
 //! 2. `x0 = denoiser(x, t_k)` with the ORIGINAL timestep `t_k`; with a mask,
 //!    `x0 = x0 * (1 - M) + y * M`.
-//! 3. `x = c0 x0 + ct x`, plus `sigma_k * noise(seed, stream step + 1)` when `k > 0`.
+//! 3. `x = c0 x0 + ct x`, plus `sigma_k * noise(seed, stream step + 1)` when `k > 0` and the
+//!    step draws noise; the coefficients are the run's [`Method`]'s (ancestral by default), and
+//!    a multistep method adds `c_prev x0_prev` (the previous step's guided `x0`) instead of noise:
+//!    `x = (c0 x0 + ct x) + c_prev x0_prev`.
 //! 4. Harmonization, unless the step is among the free final share:
 //!    `x = x - up(down(x)) + up(down(a y + s noise(seed, stream 1_000_000 + step + 1)))`, with
 //!    `(a, s)` the q-sample coefficients of index `k - 1`, and `(1, 0)` after the last step (so
@@ -19,6 +22,7 @@ use ndarray::{Array3, ArrayView3, Zip};
 use thiserror::Error;
 
 pub use super::guidance::{Guidance, Harmonization, Inpainting, downsample, low_pass, upsample};
+use super::method::Method;
 use super::noise::{HARMONIZE_STREAM_BASE, INITIAL_NOISE_STREAM};
 use super::noise_worker::{NoiseWorker, fill_noise};
 use super::schedule::Schedule;
@@ -62,6 +66,9 @@ pub enum SamplerError {
     /// A harmonization low-pass factor of 0.
     #[error("the harmonization down-sampling factor must be at least 1")]
     ZeroFactor,
+    /// A sampling method with a setting out of range.
+    #[error("{0}")]
+    Method(String),
     /// A denoiser whose feature rows are not the run's.
     #[error("the denoiser has {denoiser} feature rows, the run {run}")]
     Features {
@@ -84,6 +91,9 @@ pub struct Sampler<'a> {
     done: usize,
     free: usize,
     noise: NoiseWorker,
+    method: Method,
+    /// The previous step's guided clean prediction (kept for multistep methods only).
+    x0_prev: Option<Array3<f32>>,
 }
 
 impl std::fmt::Debug for Sampler<'_> {
@@ -127,7 +137,19 @@ impl<'a> Sampler<'a> {
             // A step's noise does not depend on the network's output: it is drawn on the
             // worker while the network runs (for a crowd it costs a twentieth of a step).
             noise: NoiseWorker::start(seed, shape),
+            method: Method::Ancestral,
+            x0_prev: None,
         })
+    }
+
+    /// The same run with another update rule (ancestral until changed); only before the first
+    /// step.
+    pub fn with_method(mut self, method: Method) -> Result<Sampler<'a>, SamplerError> {
+        if let Some(problem) = method.problem() {
+            return Err(SamplerError::Method(problem));
+        }
+        self.method = method;
+        Ok(self)
     }
 
     /// Steps taken.
@@ -173,14 +195,20 @@ impl<'a> Sampler<'a> {
         let k = steps - 1 - step;
         let t = vec![self.schedule.timesteps[k] as i64; batch];
         let harmonizing = self.guidance.harmonization.is_some() && step < steps - self.free;
-        if k > 0 {
+        let c = self.method.coefficients(self.schedule, k);
+        let noisy_step = k > 0 && c.sigma > 0.0;
+        if noisy_step {
             self.noise.request(step as u64 + 1);
-            if harmonizing {
-                self.noise.request(HARMONIZE_STREAM_BASE + step as u64 + 1);
-            }
+        }
+        if k > 0 && harmonizing {
+            self.noise.request(HARMONIZE_STREAM_BASE + step as u64 + 1);
         }
         let x0 = denoiser.denoise(self.x.view(), &t);
-        let eps = if k > 0 { self.noise.receive() } else { None };
+        let eps = if noisy_step {
+            self.noise.receive()
+        } else {
+            None
+        };
         let harmonize_eps = if k > 0 && harmonizing {
             self.noise.receive()
         } else {
@@ -203,20 +231,29 @@ impl<'a> Sampler<'a> {
                     .for_each(|p, &m, &y| *p = *p * (1.0 - m) + y * m);
             }
         }
-        let (c0, ct) = self.schedule.posterior_mean_coefficients(k);
-        let (c0, ct) = (c0 as f32, ct as f32);
-        match eps {
-            Some(eps) => {
-                let sigma = self.schedule.posterior_std(k) as f32;
+        let (c0, ct) = (c.x0 as f32, c.xt as f32);
+        match (eps, &self.x0_prev) {
+            (Some(eps), _) => {
+                let sigma = c.sigma as f32;
                 Zip::from(&mut self.x)
                     .and(&x0)
                     .and(&eps)
                     .for_each(|x, &p, &e| *x = (c0 * p + ct * *x) + sigma * e);
                 self.noise.recycle(eps);
             }
-            None => Zip::from(&mut self.x)
+            (None, Some(prev)) if c.x0_prev != 0.0 => {
+                let cp = c.x0_prev as f32;
+                Zip::from(&mut self.x)
+                    .and(&x0)
+                    .and(prev)
+                    .for_each(|x, &p, &q| *x = (c0 * p + ct * *x) + cp * q);
+            }
+            (None, _) => Zip::from(&mut self.x)
                 .and(&x0)
                 .for_each(|x, &p| *x = c0 * p + ct * *x),
+        }
+        if self.method == Method::DpmSolver2M {
+            self.x0_prev = Some(x0);
         }
         if let Some(h) = &self.guidance.harmonization
             && harmonizing

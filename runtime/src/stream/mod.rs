@@ -20,8 +20,8 @@ use std::collections::VecDeque;
 
 use ndarray::{Array2, Axis, s};
 
-use crate::diffusion::Schedule;
 use crate::diffusion::sampler::{Denoiser, Guidance, Inpainting, Sampler};
+use crate::diffusion::{Method, Schedule};
 use crate::model_file::ModelMetadata;
 use crate::motion::feet::{Anchor, Feet, Kept, PlantOptions, plant_feet};
 use crate::motion::math::{self, Mat3, Vec3};
@@ -64,6 +64,8 @@ pub struct StreamOptions {
     pub feet: Feet,
     /// Joints taken from supplied poses ([`Stream::supply`]), if any.
     pub compose: Option<StreamCompose>,
+    /// The update rule of each sampling step.
+    pub method: Method,
 }
 
 impl Default for StreamOptions {
@@ -76,6 +78,7 @@ impl Default for StreamOptions {
             ramp: INBETWEEN_RAMP,
             feet: Feet::default(),
             compose: None,
+            method: Method::default(),
         }
     }
 }
@@ -115,6 +118,7 @@ pub struct Stream {
     metadata: ModelMetadata,
     feet: Feet,
     seed: u64,
+    method: Method,
     sizes: BlockSizes,
     schedule: Schedule,
     compose_rows: Vec<usize>,
@@ -164,6 +168,9 @@ impl Stream {
                 "a window of {window} frames is beyond the limit of {MAX_FRAMES}"
             ));
         }
+        if let Some(problem) = options.method.problem() {
+            return bad(problem);
+        }
         let schedule = match options.steps {
             Some(s) => Schedule::respaced(metadata.diffusion.steps, s)?,
             None => Schedule::cosine(metadata.diffusion.steps)?,
@@ -194,6 +201,7 @@ impl Stream {
             metadata: metadata.clone(),
             feet: options.feet,
             seed: options.seed,
+            method: options.method,
             sizes: BlockSizes {
                 context,
                 ramp,
@@ -326,7 +334,8 @@ impl Stream {
             Guidance::default()
         };
         let seed = block_seed(self.seed, self.blocks as u64);
-        let mut sampler = Sampler::new(&self.schedule, &guidance, 1, f, n, seed)?;
+        let mut sampler =
+            Sampler::new(&self.schedule, &guidance, 1, f, n, seed)?.with_method(self.method)?;
         while !sampler.is_finished() {
             sampler.step(denoiser)?;
         }

@@ -15,8 +15,8 @@ use std::convert::Infallible;
 
 use thiserror::Error;
 
-use crate::diffusion::ScheduleError;
 use crate::diffusion::sampler::{SamplerError, StepError};
+use crate::diffusion::{Method, ScheduleError};
 use crate::model::ModelError;
 use crate::motion::feet::Feet;
 use crate::motion::{FeatureMatrix, MotionError};
@@ -223,4 +223,6 @@ pub struct Request {
     /// What the motion and poses of the result do to the feet: planted (the default) or raw.
     /// A post-process of decoded motion: the features are the same either way.
     pub feet: Feet,
+    /// The update rule of each step: ancestral (the default), DDIM or DPM-Solver++(2M).
+    pub method: Method,
 }

@@ -8,8 +8,8 @@ use ndarray::Array2;
 use super::Generated;
 use super::mask::{Span, covered, soft_mask};
 use super::{MAX_COUNT, MAX_FRAMES, MAX_VALUES, Request, Task, TaskError};
-use crate::diffusion::Schedule;
 use crate::diffusion::sampler::{Denoiser, Guidance, Harmonization, Inpainting, Sampler};
+use crate::diffusion::{Method, SamplerError, Schedule};
 use crate::model::Model;
 use crate::model_file::ModelMetadata;
 use crate::motion::feet::{Feet, Kept};
@@ -25,6 +25,7 @@ pub struct Plan {
     guidance: Guidance,
     schedule: Schedule,
     feet: Feet,
+    method: Method,
 }
 
 impl Plan {
@@ -101,6 +102,11 @@ impl Plan {
         self.feet
     }
 
+    /// The update rule of each step.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
     /// A sampler for this plan, to step by hand.
     pub fn sampler(&self) -> Result<Sampler<'_>, TaskError> {
         Ok(Sampler::new(
@@ -110,7 +116,8 @@ impl Plan {
             self.metadata.network.features,
             self.frames,
             self.seed,
-        )?)
+        )?
+        .with_method(self.method)?)
     }
 
     /// The batch of a sampler made by [`Plan::sampler`] (finished, or stopped early).
@@ -225,6 +232,9 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
     let f = metadata.network.features;
     if request.count == 0 || request.count > MAX_COUNT {
         return Err(TaskError::Count(request.count));
+    }
+    if let Some(problem) = request.method.problem() {
+        return Err(TaskError::Sampler(SamplerError::Method(problem)));
     }
     let schedule = match request.steps {
         Some(s) => Schedule::respaced(metadata.diffusion.steps, s)?,
@@ -388,5 +398,6 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
         guidance,
         schedule,
         feet: request.feet,
+        method: request.method,
     })
 }
