@@ -22,6 +22,9 @@ namespace Sinmdm
     /// <summary>What is done to the feet of the poses handed out.</summary>
     public enum Feet : uint { Planted = 0, Raw = 1 }
 
+    /// <summary>The update rule of each denoising step (DDIM takes an eta).</summary>
+    public enum Method : uint { Ancestral = 0, Ddim = 1, DpmSolver2M = 2 }
+
     /// <summary>A model's facts (sinmdm_model_info).</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct ModelInfo
@@ -51,7 +54,7 @@ namespace Sinmdm
         const string Lib = "sinmdm_c";
 
         [StructLayout(LayoutKind.Sequential)]
-        internal struct Sampling { public ulong Seed; public uint Count, Steps, Feet; }
+        internal struct Sampling { public ulong Seed; public uint Count, Steps, Feet, Method; public double Eta; }
 
         [StructLayout(LayoutKind.Sequential)]
         internal struct PoseBuffers
@@ -72,6 +75,7 @@ namespace Sinmdm
         {
             public ulong Seed; public uint Steps, BlockFrames, Feet;
             public IntPtr ComposeJoints; public UIntPtr ComposeJointCount; public int ComposeRoot;
+            public uint Method; public double Eta;
         }
 
         [DllImport(Lib)] internal static extern IntPtr sinmdm_last_error();
@@ -180,9 +184,11 @@ namespace Sinmdm
         }
 
         /// <summary>New motion: `count` samples of `frames` frames.</summary>
-        public Result Generate(int frames, ulong seed, int count = 1, uint steps = 100, Feet feet = Feet.Planted)
+        public Result Generate(int frames, ulong seed, int count = 1, uint steps = 100, Feet feet = Feet.Planted,
+                               Method method = Method.Ancestral, double eta = 0.0)
         {
-            var sampling = new Native.Sampling { Seed = seed, Count = (uint)count, Steps = steps, Feet = (uint)feet };
+            var sampling = new Native.Sampling { Seed = seed, Count = (uint)count, Steps = steps, Feet = (uint)feet,
+                                                 Method = (uint)method, Eta = eta };
             Native.Check(Native.sinmdm_generate(Handle, ref sampling, (UIntPtr)frames, out IntPtr result));
             return new Result(result, Joints);
         }
@@ -252,10 +258,12 @@ namespace Sinmdm
         IntPtr handle;
         readonly Model model;
 
-        public Stream(Model model, ulong seed, uint steps = 100, uint blockFrames = 0, Feet feet = Feet.Planted)
+        public Stream(Model model, ulong seed, uint steps = 100, uint blockFrames = 0, Feet feet = Feet.Planted,
+                      Method method = Method.Ancestral)
         {
             this.model = model;
-            var options = new Native.StreamOptions { Seed = seed, Steps = steps, BlockFrames = blockFrames, Feet = (uint)feet };
+            var options = new Native.StreamOptions { Seed = seed, Steps = steps, BlockFrames = blockFrames, Feet = (uint)feet,
+                                                     Method = (uint)method };
             Native.Check(Native.sinmdm_stream_new(model.Handle, ref options, out handle));
         }
 

@@ -196,6 +196,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         count: 1,
         steps: 20,
         feet: SINMDM_FEET_PLANTED,
+        method: 0,
+        eta: 0.0,
     };
     let request = Request {
         task: Task::Generate { frames },

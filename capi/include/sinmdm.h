@@ -27,6 +27,21 @@
 #define SINMDM_FEET_RAW 1
 
 /*
+ Sampling method: ancestral DDPM (the paper's sampler; the default).
+ */
+#define SINMDM_METHOD_ANCESTRAL 0
+
+/*
+ Sampling method: DDIM, with `eta` the share of the ancestral noise (0: deterministic).
+ */
+#define SINMDM_METHOD_DDIM 1
+
+/*
+ Sampling method: DPM-Solver++(2M), deterministic, good motion in fewer steps.
+ */
+#define SINMDM_METHOD_DPM2M 2
+
+/*
  What a call did. Every function returns one; on anything but `SINMDM_OK`,
  `sinmdm_last_error` says why, in words that name the argument, field or file.
  */
@@ -176,6 +191,14 @@ typedef struct SinmdmSampling {
    `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
    */
   uint32_t feet;
+  /*
+   `SINMDM_METHOD_ANCESTRAL` (0, the default), `SINMDM_METHOD_DDIM` or `SINMDM_METHOD_DPM2M`.
+   */
+  uint32_t method;
+  /*
+   DDIM's share of the ancestral noise, 0 to 1 (ignored by the other methods).
+   */
+  double eta;
 } SinmdmSampling;
 
 /*
@@ -256,6 +279,14 @@ typedef struct SinmdmStreamOptions {
    Not 0: the root's travel and height also come from the supplied poses.
    */
   int32_t compose_root;
+  /*
+   `SINMDM_METHOD_ANCESTRAL` (0, the default), `SINMDM_METHOD_DDIM` or `SINMDM_METHOD_DPM2M`.
+   */
+  uint32_t method;
+  /*
+   DDIM's share of the ancestral noise, 0 to 1.
+   */
+  double eta;
 } SinmdmStreamOptions;
 
 #ifdef __cplusplus

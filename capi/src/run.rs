@@ -18,6 +18,31 @@ pub const SINMDM_FEET_PLANTED: u32 = 0;
 /// Feet: the network's motion untouched.
 pub const SINMDM_FEET_RAW: u32 = 1;
 
+/// Sampling method: ancestral DDPM (the paper's sampler; the default).
+pub const SINMDM_METHOD_ANCESTRAL: u32 = 0;
+/// Sampling method: DDIM, with `eta` the share of the ancestral noise (0: deterministic).
+pub const SINMDM_METHOD_DDIM: u32 = 1;
+/// Sampling method: DPM-Solver++(2M), deterministic, good motion in fewer steps.
+pub const SINMDM_METHOD_DPM2M: u32 = 2;
+
+/// A `method` and `eta` as the library's setting.
+pub(crate) fn method_arg(method: u32, eta: f64) -> Result<sinmdm::Method, Failure> {
+    let chosen = match method {
+        SINMDM_METHOD_ANCESTRAL => sinmdm::Method::Ancestral,
+        SINMDM_METHOD_DDIM => sinmdm::Method::Ddim { eta },
+        SINMDM_METHOD_DPM2M => sinmdm::Method::DpmSolver2M,
+        other => {
+            return Err(Failure::invalid(format!(
+                "method must be SINMDM_METHOD_ANCESTRAL (0), SINMDM_METHOD_DDIM (1) or SINMDM_METHOD_DPM2M (2), got {other}"
+            )));
+        }
+    };
+    if let Some(problem) = chosen.problem() {
+        return Err(Failure::invalid(problem));
+    }
+    Ok(chosen)
+}
+
 /// A `feet` field's value as the library's setting.
 pub(crate) fn feet_arg(feet: u32) -> Result<Feet, Failure> {
     match feet {
@@ -42,6 +67,10 @@ pub struct SinmdmSampling {
     pub steps: u32,
     /// `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
     pub feet: u32,
+    /// `SINMDM_METHOD_ANCESTRAL` (0, the default), `SINMDM_METHOD_DDIM` or `SINMDM_METHOD_DPM2M`.
+    pub method: u32,
+    /// DDIM's share of the ancestral noise, 0 to 1 (ignored by the other methods).
+    pub eta: f64,
 }
 
 /// A span of frames `start..end` (end excluded).
@@ -82,7 +111,7 @@ unsafe fn run_task(
             seed: sampling.seed,
             steps: (sampling.steps > 0).then_some(sampling.steps as usize),
             feet: feet_arg(sampling.feet)?,
-            method: Default::default(),
+            method: method_arg(sampling.method, sampling.eta)?,
         };
         let generated = sinmdm::run(&mut model.model, &request, &mut |_, _| {
             ControlFlow::Continue(())

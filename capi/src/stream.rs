@@ -4,7 +4,7 @@ use sinmdm::{Stream, StreamCompose, StreamOptions};
 
 use crate::model::SinmdmModel;
 use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, motion_in, poses_out};
-use crate::run::feet_arg;
+use crate::run::{feet_arg, method_arg};
 use crate::status::{Failure, SinmdmStatus, guard};
 use crate::text::{give, handle, slice_arg};
 
@@ -31,6 +31,10 @@ pub struct SinmdmStreamOptions {
     pub compose_joint_count: usize,
     /// Not 0: the root's travel and height also come from the supplied poses.
     pub compose_root: i32,
+    /// `SINMDM_METHOD_ANCESTRAL` (0, the default), `SINMDM_METHOD_DDIM` or `SINMDM_METHOD_DPM2M`.
+    pub method: u32,
+    /// DDIM's share of the ancestral noise, 0 to 1.
+    pub eta: f64,
 }
 
 /// Makes a stream of `model`'s motion with `options` and writes its handle to `out`.
@@ -65,6 +69,7 @@ pub unsafe extern "C" fn sinmdm_stream_new(
             block_frames: (o.block_frames > 0).then_some(o.block_frames as usize),
             feet: feet_arg(o.feet)?,
             compose,
+            method: method_arg(o.method, o.eta)?,
             ..StreamOptions::default()
         };
         let stream = Stream::new(model.model.metadata(), options)?;

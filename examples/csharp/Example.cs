@@ -40,6 +40,8 @@ static class Example
                 first = crowd.Poses(0);
                 Print("generate1", crowd.Poses(1));
             }
+            using (var quick = model.Generate(40, seed: 5, steps: 8, feet: Feet.Raw, method: Method.DpmSolver2M))
+                Print("dpm2m", quick.Poses(0));
             using (var between = model.Inbetween(first, new[] { 0, 10, 30, 40 }, 5, seed: 3, steps: 4))
                 Print("inbetween", between.Poses(0));
             using (var stream = new Stream(model, seed: 11, steps: 3, blockFrames: 30))

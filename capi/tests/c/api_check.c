@@ -116,7 +116,7 @@ int main(int argc, char **argv) {
   free(parents);
 
   /* A crowd of two, 40 frames, planted feet. */
-  SinmdmSampling sampling = {7, 2, 4, SINMDM_FEET_PLANTED};
+  SinmdmSampling sampling = {7, 2, 4, SINMDM_FEET_PLANTED, SINMDM_METHOD_ANCESTRAL, 0.0};
   SinmdmResult *result = NULL;
   CHECK_OK(sinmdm_generate(model, &sampling, 40, &result));
   size_t count = 0, frames = 0;
@@ -129,10 +129,21 @@ int main(int argc, char **argv) {
   CHECK_OK(sinmdm_result_poses(result, 1, &b1));
   print_poses("generate1", &sample1);
 
+  /* A few-step deterministic sample. */
+  SinmdmSampling few = {5, 1, 8, SINMDM_FEET_RAW, SINMDM_METHOD_DPM2M, 0.0};
+  SinmdmResult *quick = NULL;
+  CHECK_OK(sinmdm_generate(model, &few, 40, &quick));
+  Poses quick_poses = poses_alloc(40, joints);
+  SinmdmPoseBuffers bq = buffers_of(&quick_poses);
+  CHECK_OK(sinmdm_result_poses(quick, 0, &bq));
+  print_poses("dpm2m", &quick_poses);
+  poses_free(&quick_poses);
+  sinmdm_result_free(quick);
+
   /* An in-between of sample 0: keep 0..10 and 30..40. */
   SinmdmPoses reference = input_of(&sample0);
   SinmdmSpan keep[2] = {{0, 10}, {30, 40}};
-  SinmdmSampling once = {3, 1, 4, SINMDM_FEET_PLANTED};
+  SinmdmSampling once = {3, 1, 4, SINMDM_FEET_PLANTED, SINMDM_METHOD_ANCESTRAL, 0.0};
   SinmdmResult *between = NULL;
   CHECK_OK(sinmdm_inbetween(model, &once, &reference, keep, 2, 5, &between));
   Poses filled = poses_alloc(40, joints);
@@ -141,7 +152,7 @@ int main(int argc, char **argv) {
   print_poses("inbetween", &filled);
 
   /* A stream in chunks of 20 and 25 frames. */
-  SinmdmStreamOptions stream_options = {11, 3, 30, SINMDM_FEET_PLANTED, NULL, 0, 0};
+  SinmdmStreamOptions stream_options = {11, 3, 30, SINMDM_FEET_PLANTED, NULL, 0, 0, SINMDM_METHOD_ANCESTRAL, 0.0};
   SinmdmStream *stream = NULL;
   CHECK_OK(sinmdm_stream_new(model, &stream_options, &stream));
   Poses chunk_a = poses_alloc(20, joints), chunk_b = poses_alloc(25, joints);
@@ -185,11 +196,15 @@ int main(int argc, char **argv) {
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_generate(model, NULL, 10, &unused));
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_generate(model, &sampling, 10, NULL));
   EXPECT(SINMDM_TASK_FAILED, sinmdm_generate(model, &sampling, 0, &unused));
-  SinmdmSampling no_samples = {1, 0, 2, SINMDM_FEET_RAW};
+  SinmdmSampling no_samples = {1, 0, 2, SINMDM_FEET_RAW, SINMDM_METHOD_ANCESTRAL, 0.0};
   EXPECT(SINMDM_TASK_FAILED, sinmdm_generate(model, &no_samples, 10, &unused));
-  SinmdmSampling bad_feet = {1, 1, 2, 7};
+  SinmdmSampling bad_feet = {1, 1, 2, 7, SINMDM_METHOD_ANCESTRAL, 0.0};
   EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_generate(model, &bad_feet, 10, &unused));
-  SinmdmSampling too_many_steps = {1, 1, 100000, SINMDM_FEET_RAW};
+  SinmdmSampling bad_method = {1, 1, 2, SINMDM_FEET_RAW, 9, 0.0};
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_generate(model, &bad_method, 10, &unused));
+  SinmdmSampling bad_eta = {1, 1, 2, SINMDM_FEET_RAW, SINMDM_METHOD_DDIM, 3.0};
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_generate(model, &bad_eta, 10, &unused));
+  SinmdmSampling too_many_steps = {1, 1, 100000, SINMDM_FEET_RAW, SINMDM_METHOD_ANCESTRAL, 0.0};
   EXPECT(SINMDM_TASK_FAILED, sinmdm_generate(model, &too_many_steps, 10, &unused));
   SinmdmSpan past_end[1] = {{30, 50}};
   EXPECT(SINMDM_TASK_FAILED, sinmdm_inbetween(model, &once, &reference, past_end, 1, 5, &unused));
@@ -214,7 +229,7 @@ int main(int argc, char **argv) {
   short_buffers.rotations_capacity = 3;
   EXPECT(SINMDM_BUFFER_TOO_SMALL, sinmdm_result_poses(result, 0, &short_buffers));
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_result_poses(result, 0, NULL));
-  SinmdmStreamOptions tiny_blocks = {1, 2, 5, SINMDM_FEET_RAW, NULL, 0, 0};
+  SinmdmStreamOptions tiny_blocks = {1, 2, 5, SINMDM_FEET_RAW, NULL, 0, 0, SINMDM_METHOD_ANCESTRAL, 0.0};
   SinmdmStream *no_stream = NULL;
   EXPECT(SINMDM_TASK_FAILED, sinmdm_stream_new(model, &tiny_blocks, &no_stream));
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_stream_new(NULL, &stream_options, &no_stream));

@@ -19,16 +19,36 @@ pub fn model_path() -> PathBuf {
     repo().join("onnx-models/human_walk_cmu.onnx")
 }
 
-/// The folder of the test binary's profile (`target/release`), where `libsinmdm_c.so` is.
+/// The folder of the test binary's profile (`target/release`), where `libsinmdm_c.so` is,
+/// with the shared library built now: `cargo test` builds the crate's rlib for the tests, not
+/// its cdylib, which could otherwise be stale.
 pub fn library_dir() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().unwrap().parent().unwrap().to_path_buf();
-    assert!(
-        dir.join("libsinmdm_c.so").is_file(),
-        "no libsinmdm_c.so in {}",
-        dir.display()
-    );
-    dir
+    static BUILT: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    BUILT
+        .get_or_init(|| {
+            let exe = std::env::current_exe().unwrap();
+            let dir = exe.parent().unwrap().parent().unwrap().to_path_buf();
+            let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+            let mut build = std::process::Command::new(cargo);
+            build
+                .args(["build", "--quiet", "-p", "sinmdm-c", "--lib"])
+                .current_dir(repo());
+            if dir.ends_with("release") {
+                build.arg("--release");
+            }
+            if let Some(target) = dir.parent() {
+                build.env("CARGO_TARGET_DIR", target);
+            }
+            let status = build.status().expect("could not run cargo to build libsinmdm_c");
+            assert!(status.success(), "building libsinmdm_c failed");
+            assert!(
+                dir.join("libsinmdm_c.so").is_file(),
+                "no libsinmdm_c.so in {}",
+                dir.display()
+            );
+            dir
+        })
+        .clone()
 }
 
 pub fn work_dir(name: &str) -> PathBuf {
@@ -86,6 +106,20 @@ pub fn expected() -> BTreeMap<String, String> {
     )
     .unwrap();
     pose_lines("generate1", &crowd.poses(1).unwrap(), &mut out);
+    let quick = sinmdm::run(
+        &mut model,
+        &Request {
+            task: Task::Generate { frames: 40 },
+            count: 1,
+            seed: 5,
+            steps: Some(8),
+            feet: Feet::Raw,
+            method: sinmdm::Method::DpmSolver2M,
+        },
+        go,
+    )
+    .unwrap();
+    pose_lines("dpm2m", &quick.poses(0).unwrap(), &mut out);
     let layout = model.metadata().layout.clone();
     let reference = encode_motion(
         &layout,
