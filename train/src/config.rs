@@ -64,6 +64,10 @@ pub struct TrainingConfig {
     pub seed: u64,
     /// Steps between checkpoints (the last step is always saved).
     pub checkpoint_every: u64,
+    /// Frames each batch item sees: a random window of the stretched clip (each item its own),
+    /// so a step costs the same whatever the clip's length; absent or `null` uses the whole clip.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub window_frames: Option<usize>,
 }
 
 /// How the clip becomes features (SPEC §2).
@@ -183,6 +187,14 @@ impl TrainConfig {
             return Err(format!(
                 "training.resample_min ({}) must not exceed training.resample_max ({})",
                 t.resample_min, t.resample_max
+            ));
+        }
+        if let Some(w) = t.window_frames
+            && w < m.receptive_field()
+        {
+            return Err(format!(
+                "training.window_frames must be at least the receptive field ({} frames), got {w}",
+                m.receptive_field()
             ));
         }
         if let Some(fps) = self.data.fps

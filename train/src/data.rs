@@ -67,13 +67,16 @@ pub struct Batch {
     pub timesteps: Vec<usize>,
 }
 
-/// Makes the batch of step `step`: stretch factor, timesteps and noise all come from the
-/// counter-based generator keyed by `(seed, step)`, so any step can be rebuilt after a resume.
+/// Makes the batch of step `step`: stretch factor, timesteps, windows and noise all come from
+/// the counter-based generator keyed by `(seed, step)`, so any step can be rebuilt after a
+/// resume. With `window`, each item is its own random window of that many frames of the
+/// stretched clip (the whole clip when it is shorter).
 pub fn make_batch(
     clip: ArrayView2<'_, f32>,
     schedule: &Schedule,
     batch: usize,
     stretch: (f64, f64),
+    window: Option<usize>,
     seed: u64,
     step: u64,
 ) -> Batch {
@@ -90,20 +93,24 @@ pub fn make_batch(
             ((u * steps as f64) as usize).min(steps - 1)
         })
         .collect();
-    let item = stretched
-        .as_standard_layout()
-        .iter()
-        .copied()
-        .collect::<Vec<f32>>();
-    let mut clean = Vec::with_capacity(batch * item.len());
-    for _ in 0..batch {
-        clean.extend_from_slice(&item);
+    let frames_out = window.map_or(width, |w| w.min(width));
+    let mut clean = Vec::with_capacity(batch * rows * frames_out);
+    for b in 0..batch {
+        let start = if frames_out < width {
+            let u = noise::uniform(noise::word(seed, control, 1 + (batch + b) as u64));
+            ((u * (width - frames_out + 1) as f64) as usize).min(width - frames_out)
+        } else {
+            0
+        };
+        let item = stretched.slice(ndarray::s![.., start..start + frames_out]);
+        clean.extend(item.as_standard_layout().iter().copied());
     }
+    let item_len = rows * frames_out;
     let mut noised = vec![0f32; clean.len()];
     noise::fill_normals(seed, step, &mut noised);
     for (b, &t) in timesteps.iter().enumerate() {
         let (a, s) = schedule.q_sample_coefficients(t);
-        let range = b * item.len()..(b + 1) * item.len();
+        let range = b * item_len..(b + 1) * item_len;
         for (n, &x) in noised[range.clone()].iter_mut().zip(&clean[range]) {
             *n = (a * f64::from(x) + s * f64::from(*n)) as f32;
         }
@@ -111,7 +118,7 @@ pub fn make_batch(
     Batch {
         batch,
         features: rows,
-        frames: width,
+        frames: frames_out,
         clean,
         noised,
         timesteps,
@@ -149,11 +156,11 @@ mod tests {
     fn batch_is_reproducible_and_noised_by_the_schedule() {
         let clip = Array2::from_shape_fn((5, 40), |(r, c)| (r as f32 * 0.3 + c as f32 * 0.1).sin());
         let schedule = Schedule::cosine(1000).unwrap();
-        let a = make_batch(clip.view(), &schedule, 3, (0.75, 1.25), 7, 11);
-        let b = make_batch(clip.view(), &schedule, 3, (0.75, 1.25), 7, 11);
+        let a = make_batch(clip.view(), &schedule, 3, (0.75, 1.25), None, 7, 11);
+        let b = make_batch(clip.view(), &schedule, 3, (0.75, 1.25), None, 7, 11);
         assert_eq!(a.noised, b.noised);
         assert!((30..=50).contains(&a.frames));
-        let c = make_batch(clip.view(), &schedule, 3, (0.75, 1.25), 7, 12);
+        let c = make_batch(clip.view(), &schedule, 3, (0.75, 1.25), None, 7, 12);
         assert_ne!(a.noised, c.noised);
         // x_t = sqrt(abar) x0 + sqrt(1 - abar) eps with eps the portable normals of stream `step`.
         let eps = noise::normals(7, 11, a.clean.len());
@@ -161,5 +168,38 @@ mod tests {
         let i = a.features * a.frames + 4;
         let expected = sa * f64::from(a.clean[i]) + sn * f64::from(eps[i]);
         assert!((f64::from(a.noised[i]) - expected).abs() < 1e-5);
+    }
+
+    #[test]
+    fn windows_are_random_slices_of_the_stretched_clip() {
+        let clip =
+            Array2::from_shape_fn((4, 300), |(r, c)| (r as f32 * 0.7 + c as f32 * 0.05).sin());
+        let schedule = Schedule::cosine(1000).unwrap();
+        let whole = make_batch(clip.view(), &schedule, 4, (0.75, 1.25), None, 3, 5);
+        let windowed = make_batch(clip.view(), &schedule, 4, (0.75, 1.25), Some(64), 3, 5);
+        assert_eq!(windowed.frames, 64);
+        assert_eq!(windowed.timesteps, whole.timesteps);
+        let (rows, width) = (whole.features, whole.frames);
+        let stretched = &whole.clean[..rows * width];
+        let mut starts = Vec::new();
+        for b in 0..4 {
+            let item = &windowed.clean[b * rows * 64..(b + 1) * rows * 64];
+            let start = (0..=width - 64)
+                .find(|&s| {
+                    (0..rows).all(|r| {
+                        item[r * 64..(r + 1) * 64] == stretched[r * width + s..r * width + s + 64]
+                    })
+                })
+                .expect("each item is a window of the stretched clip");
+            starts.push(start);
+        }
+        starts.dedup();
+        assert!(
+            starts.len() > 1,
+            "every item got the same window: {starts:?}"
+        );
+        // A window longer than the clip is the whole clip.
+        let long = make_batch(clip.view(), &schedule, 2, (1.0, 1.0), Some(1000), 3, 5);
+        assert_eq!(long.frames, 300);
     }
 }

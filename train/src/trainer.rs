@@ -272,6 +272,7 @@ impl Trainer {
             &self.schedule,
             config.training.batch_size,
             (config.training.resample_min, config.training.resample_max),
+            config.training.window_frames,
             config.training.seed,
             step,
         );

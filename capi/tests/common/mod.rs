@@ -39,7 +39,9 @@ pub fn library_dir() -> PathBuf {
             if let Some(target) = dir.parent() {
                 build.env("CARGO_TARGET_DIR", target);
             }
-            let status = build.status().expect("could not run cargo to build libsinmdm_c");
+            let status = build
+                .status()
+                .expect("could not run cargo to build libsinmdm_c");
             assert!(status.success(), "building libsinmdm_c failed");
             assert!(
                 dir.join("libsinmdm_c.so").is_file(),

@@ -1,0 +1,64 @@
+//! Seconds per training step against the clip's length, with the whole clip in every batch item
+//! and with random windows (`training.window_frames`): the batch is made from a clip of 250,
+//! 1 000 and 2 000 frames (F 191, the CMU skeleton) and one optimisation step taken (C 128,
+//! batch 8, the CPU configuration). Medians of the timed steps, side by side in one run.
+//! Run: `cargo bench -p sinmdm-train --bench clip_length` (`SINMDM_BENCH_STEPS`, default 3).
+
+use std::time::Instant;
+
+use burn::tensor::{Device, Tensor, TensorData};
+use ndarray::Array2;
+use sinmdm::diffusion::Schedule;
+use sinmdm_train::config::TrainConfig;
+use sinmdm_train::data::make_batch;
+use sinmdm_train::model::QnaUnet;
+use sinmdm_train::trainer::{new_optimizer, optimisation_step};
+
+fn main() {
+    sinmdm_train::memory::keep_freed_memory();
+    let config: TrainConfig =
+        TrainConfig::parse(include_str!("../../configs/cpu.yaml")).expect("cpu config");
+    let timed: usize = std::env::var("SINMDM_BENCH_STEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3);
+    let f = 191;
+    let batch = config.training.batch_size;
+    let schedule = Schedule::cosine(config.diffusion.steps).expect("schedule");
+    println!(
+        "training step against clip length: C {}, batch {batch}, F {f}, stretch 0.75-1.25",
+        config.model.channels
+    );
+    println!("{:>7} {:>14} {:>14}", "frames", "whole clip s", "window 128 s");
+    for frames in [250usize, 1000, 2000] {
+        let clip = Array2::from_shape_fn((f, frames), |(r, c)| {
+            ((r as f32) * 0.37 + (c as f32) * 0.05).sin()
+        });
+        let mut row = Vec::new();
+        for window in [None, Some(128)] {
+            let device = Device::flex().autodiff();
+            device.seed(0);
+            let mut model = QnaUnet::new(f, &config.model, &device);
+            let mut optimizer = new_optimizer(&config);
+            let mut seconds = Vec::new();
+            for step in 0..timed + 1 {
+                let start = Instant::now();
+                let b = make_batch(clip.view(), &schedule, batch, (0.75, 1.25), window, 0, step as u64);
+                let shape = [b.batch, b.features, b.frames];
+                let xt = Tensor::<3>::from_data(TensorData::new(b.noised, shape), &device);
+                let x0 = Tensor::<3>::from_data(TensorData::new(b.clean, shape), &device);
+                let t: Vec<f32> = b.timesteps.iter().map(|&t| t as f32).collect();
+                let t = Tensor::<1>::from_data(TensorData::new(t, [batch]), &device);
+                let (next, loss) = optimisation_step(model, &mut optimizer, xt, t, x0, 1e-4);
+                model = next;
+                assert!(loss.is_finite());
+                if step >= 1 {
+                    seconds.push(start.elapsed().as_secs_f64());
+                }
+            }
+            seconds.sort_by(f64::total_cmp);
+            row.push(seconds[seconds.len() / 2]);
+        }
+        println!("{frames:>7} {:>14.3} {:>14.3}", row[0], row[1]);
+    }
+}
