@@ -88,6 +88,10 @@ namespace Sinmdm
         [DllImport(Lib)] internal static extern int sinmdm_model_find_joint(IntPtr model, byte[] name, out UIntPtr index);
         [DllImport(Lib)] internal static extern int sinmdm_generate(IntPtr model, ref Sampling sampling, UIntPtr frames, out IntPtr result);
         [DllImport(Lib)] internal static extern int sinmdm_inbetween(IntPtr model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out IntPtr result);
+        [DllImport(Lib)] internal static extern int sinmdm_expand(IntPtr model, ref Sampling sampling, ref PosesIn reference, UIntPtr prefix, UIntPtr suffix, UIntPtr ramp, out IntPtr result);
+        [DllImport(Lib)] internal static extern int sinmdm_compose(IntPtr model, ref Sampling sampling, ref PosesIn reference, UIntPtr[] joints, UIntPtr jointCount, int root, Span[] spans, UIntPtr spanCount, UIntPtr ramp, out IntPtr result);
+        [DllImport(Lib)] internal static extern int sinmdm_harmonize(IntPtr model, ref Sampling sampling, ref PosesIn content, UIntPtr factor, double freeShare, out IntPtr result);
+        [DllImport(Lib)] internal static extern int sinmdm_stream_supply(IntPtr stream, IntPtr model, ref PosesIn poses);
         [DllImport(Lib)] internal static extern int sinmdm_result_count(IntPtr result, out UIntPtr count);
         [DllImport(Lib)] internal static extern int sinmdm_result_frames(IntPtr result, out UIntPtr frames);
         [DllImport(Lib)] internal static extern int sinmdm_result_poses(IntPtr result, UIntPtr sample, ref PoseBuffers buffers);
@@ -210,6 +214,48 @@ namespace Sinmdm
             return new Result(result, Joints);
         }
 
+        /// <summary>Expansion: new frames before and after the reference.</summary>
+        public Result Expand(Poses reference, int prefix, int suffix, int ramp, ulong seed, uint steps = 100, Feet feet = Feet.Planted)
+        {
+            var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
+            IntPtr result = IntPtr.Zero;
+            Native.WithInput(reference, input =>
+            {
+                Native.Check(Native.sinmdm_expand(Handle, ref sampling, ref input, (UIntPtr)prefix, (UIntPtr)suffix, (UIntPtr)ramp, out result));
+                return 0;
+            });
+            return new Result(result, Joints);
+        }
+
+        /// <summary>Composition: the joints (and the root's travel when root) from the reference on
+        /// every frame, the rest of the body generated.</summary>
+        public Result Compose(Poses reference, int[] joints, bool root, int ramp, ulong seed, uint steps = 100, Feet feet = Feet.Planted)
+        {
+            var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
+            var indices = Array.ConvertAll(joints, j => (UIntPtr)j);
+            IntPtr result = IntPtr.Zero;
+            Native.WithInput(reference, input =>
+            {
+                Native.Check(Native.sinmdm_compose(Handle, ref sampling, ref input, indices, (UIntPtr)indices.Length, root ? 1 : 0,
+                                                   null, UIntPtr.Zero, (UIntPtr)ramp, out result));
+                return 0;
+            });
+            return new Result(result, Joints);
+        }
+
+        /// <summary>Harmonization (style transfer): the content's low frequencies in the model's style.</summary>
+        public Result Harmonize(Poses content, int factor, double freeShare, ulong seed, uint steps = 100, Feet feet = Feet.Planted)
+        {
+            var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
+            IntPtr result = IntPtr.Zero;
+            Native.WithInput(content, input =>
+            {
+                Native.Check(Native.sinmdm_harmonize(Handle, ref sampling, ref input, (UIntPtr)factor, freeShare, out result));
+                return 0;
+            });
+            return new Result(result, Joints);
+        }
+
         /// <summary>Writes poses of this model's skeleton as a BVH file.</summary>
         public void WriteBvh(Poses poses, string path) =>
             Native.WithInput(poses, input => { Native.Check(Native.sinmdm_write_bvh(Handle, ref input, Native.Utf8(path))); return 0; });
@@ -266,6 +312,10 @@ namespace Sinmdm
                                                      Method = (uint)method };
             Native.Check(Native.sinmdm_stream_new(model.Handle, ref options, out handle));
         }
+
+        /// <summary>Poses for the frames after the last supplied ones, for a composed stream.</summary>
+        public void Supply(Poses poses) =>
+            Native.WithInput(poses, input => { Native.Check(Native.sinmdm_stream_supply(handle, model.Handle, ref input)); return 0; });
 
         public Poses Next(int frames)
         {

@@ -44,6 +44,10 @@ static class Example
                 Print("dpm2m", quick.Poses(0));
             using (var between = model.Inbetween(first, new[] { 0, 10, 30, 40 }, 5, seed: 3, steps: 4))
                 Print("inbetween", between.Poses(0));
+            using (var expanded = model.Expand(first, 5, 7, 3, seed: 2, steps: 3))
+            using (var composed = model.Compose(first, new[] { 1, 2 }, true, 5, seed: 2, steps: 3))
+            using (var styled = model.Harmonize(first, 2, 0.02, seed: 2, steps: 3))
+                Console.WriteLine("tasks expand=" + expanded.Frames + " compose=" + composed.Frames + " harmonize=" + styled.Frames);
             using (var stream = new Stream(model, seed: 11, steps: 3, blockFrames: 30))
             {
                 Print("stream20", stream.Next(20));
