@@ -38,7 +38,10 @@ fn the_csharp_binding_gets_the_rust_values_under_mono() {
     );
     assert!(stdout.contains("info joints=31 root=Hips"), "{stdout}");
     assert!(stdout.contains("unknown joint: status 4"), "{stdout}");
-    assert!(stdout.contains("tasks expand=52 compose=40 harmonize=40"), "{stdout}");
+    assert!(
+        stdout.contains("tasks expand=52 compose=40 harmonize=40"),
+        "{stdout}"
+    );
     assert_same_values(&stdout);
     assert_eq!(sinmdm::bvh::read_bvh(&bvh).unwrap().frame_count(), 40);
 }

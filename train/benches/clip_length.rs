@@ -29,7 +29,10 @@ fn main() {
         "training step against clip length: C {}, batch {batch}, F {f}, stretch 0.75-1.25",
         config.model.channels
     );
-    println!("{:>7} {:>14} {:>14}", "frames", "whole clip s", "window 128 s");
+    println!(
+        "{:>7} {:>14} {:>14}",
+        "frames", "whole clip s", "window 128 s"
+    );
     for frames in [250usize, 1000, 2000] {
         let clip = Array2::from_shape_fn((f, frames), |(r, c)| {
             ((r as f32) * 0.37 + (c as f32) * 0.05).sin()
@@ -43,7 +46,15 @@ fn main() {
             let mut seconds = Vec::new();
             for step in 0..timed + 1 {
                 let start = Instant::now();
-                let b = make_batch(clip.view(), &schedule, batch, (0.75, 1.25), window, 0, step as u64);
+                let b = make_batch(
+                    clip.view(),
+                    &schedule,
+                    batch,
+                    (0.75, 1.25),
+                    window,
+                    0,
+                    step as u64,
+                );
                 let shape = [b.batch, b.features, b.frames];
                 let xt = Tensor::<3>::from_data(TensorData::new(b.noised, shape), &device);
                 let x0 = Tensor::<3>::from_data(TensorData::new(b.clean, shape), &device);
