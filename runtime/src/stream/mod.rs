@@ -321,10 +321,12 @@ impl Stream {
                     }
                 }
             }
-            self.guide.forget_before(
-                (window.start + window.frames).saturating_sub(sizes.context + sizes.ramp + 1),
-            );
         }
+        // Supplied poses the next blocks cannot reach are dropped (also when nothing is composed,
+        // so supplying poses never makes memory grow).
+        self.guide.forget_before(
+            (window.start + window.frames).saturating_sub(sizes.context + sizes.ramp + 1),
+        );
         let guidance = if mask.iter().any(|&m| m > 0.0) {
             Guidance {
                 inpainting: Some(Inpainting { reference, mask }),
