@@ -12,6 +12,14 @@ pub struct SinmdmModel {
     pub(crate) model: Model,
 }
 
+/// The model behind a handle.
+///
+/// # Safety
+/// `model` is NULL or a live handle from `sinmdm_model_open*`.
+pub(crate) unsafe fn model_arg<'a>(model: *const SinmdmModel) -> Result<&'a Model, Failure> {
+    Ok(&unsafe { handle(model.cast_mut(), "model") }?.model)
+}
+
 /// The facts of a model an engine needs to hold its poses.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default)]
@@ -135,7 +143,7 @@ pub unsafe extern "C" fn sinmdm_model_info(
     info: *mut SinmdmModelInfo,
 ) -> SinmdmStatus {
     guard(|| {
-        let model = &unsafe { handle(model.cast_mut(), "model") }?.model;
+        let model = unsafe { model_arg(model) }?;
         let info = unsafe { handle(info, "info") }?;
         let metadata = model.metadata();
         let up: UpAxis = metadata.layout.up;
@@ -169,7 +177,7 @@ pub unsafe extern "C" fn sinmdm_model_joint_name(
     needed: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
-        let model = &unsafe { handle(model.cast_mut(), "model") }?.model;
+        let model = unsafe { model_arg(model) }?;
         let skeleton = model.skeleton();
         let name = &skeleton
             .joints
@@ -197,7 +205,7 @@ pub unsafe extern "C" fn sinmdm_model_find_joint(
     index: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
-        let model = &unsafe { handle(model.cast_mut(), "model") }?.model;
+        let model = unsafe { model_arg(model) }?;
         let name = unsafe { str_arg(name, "name") }?;
         let index = unsafe { handle(index, "index") }?;
         let skeleton = model.skeleton();
@@ -227,7 +235,7 @@ pub unsafe extern "C" fn sinmdm_model_parents(
     capacity: usize,
 ) -> SinmdmStatus {
     guard(|| {
-        let model = &unsafe { handle(model.cast_mut(), "model") }?.model;
+        let model = unsafe { model_arg(model) }?;
         let joints = &model.skeleton().joints;
         let out = unsafe { out_slice(parents, capacity, joints.len(), "parents") }?;
         for (slot, joint) in out.iter_mut().zip(joints) {
@@ -249,7 +257,7 @@ pub unsafe extern "C" fn sinmdm_model_rest_offsets(
     capacity: usize,
 ) -> SinmdmStatus {
     guard(|| {
-        let model = &unsafe { handle(model.cast_mut(), "model") }?.model;
+        let model = unsafe { model_arg(model) }?;
         let rest = &model.metadata().layout.rest_translations;
         let out = unsafe { out_slice(offsets, capacity, rest.len() * 3, "offsets") }?;
         for (slot, value) in out.iter_mut().zip(rest.iter().flatten()) {
@@ -271,7 +279,7 @@ pub unsafe extern "C" fn sinmdm_model_contact_joints(
     capacity: usize,
 ) -> SinmdmStatus {
     guard(|| {
-        let model = &unsafe { handle(model.cast_mut(), "model") }?.model;
+        let model = unsafe { model_arg(model) }?;
         let contacts = &model.metadata().layout.contact_joints;
         if contacts.is_empty() {
             return Ok(());

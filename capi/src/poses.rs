@@ -3,10 +3,9 @@
 
 use std::ffi::c_char;
 
-use sinmdm::motion::LocalMotion;
-use sinmdm::{Pose, Quaternion, motion_from_poses};
+use sinmdm::{Model, Pose, Quaternion, motion_from_poses};
 
-use crate::model::SinmdmModel;
+use crate::model::{SinmdmModel, model_arg};
 use crate::status::{Failure, SinmdmStatus, guard};
 use crate::text::{handle, out_slice, slice_arg, str_arg};
 
@@ -46,17 +45,18 @@ pub struct SinmdmPoseBuffers {
     pub translations_capacity: usize,
 }
 
-/// Reads caller poses into a motion of the model's skeleton.
+/// Reads caller poses of the model's skeleton (checked against it where they are used:
+/// `motion_from_poses`, `features_from_poses`, `Stream::supply`).
 ///
 /// # Safety
 /// The arrays of `poses` are readable for the sizes its documentation gives.
-pub(crate) unsafe fn motion_in(
-    model: &SinmdmModel,
+pub(crate) unsafe fn poses_in(
+    model: &Model,
     poses: *const SinmdmPoses,
     argument: &str,
-) -> Result<(LocalMotion, Vec<Pose>), Failure> {
+) -> Result<Vec<Pose>, Failure> {
     let poses = unsafe { handle(poses.cast_mut(), argument) }?;
-    let layout = &model.model.metadata().layout;
+    let layout = &model.metadata().layout;
     let joints = layout.skeleton.len();
     let frames = poses.frames;
     if frames == 0 || frames > sinmdm::tasks::MAX_FRAMES {
@@ -72,7 +72,7 @@ pub(crate) unsafe fn motion_in(
     } else {
         Some(unsafe { slice_arg(poses.translations, 3 * joints * frames, "translations") }?)
     };
-    let list: Vec<Pose> = (0..frames)
+    Ok((0..frames)
         .map(|f| Pose {
             root_position: [roots[3 * f], roots[3 * f + 1], roots[3 * f + 2]],
             rotations: (0..joints)
@@ -96,22 +96,23 @@ pub(crate) unsafe fn motion_in(
                 })
                 .collect(),
         })
-        .collect();
-    let motion = motion_from_poses(&layout.skeleton, layout.fps, &list)?;
-    Ok((motion, list))
+        .collect())
 }
 
-/// Writes poses into caller buffers.
+/// The caller's buffers for `frames` poses of `joints` joints, checked (NULL, capacity):
+/// root positions, rotations, and translations when wanted.
+type PoseSlices<'a> = (&'a mut [f32], &'a mut [f32], Option<&'a mut [f32]>);
+
+/// Checks the caller's buffers for `frames` poses of `joints` joints and gives them as slices.
 ///
 /// # Safety
 /// The arrays of `buffers` are writable for their capacities.
-pub(crate) unsafe fn poses_out(
-    poses: &[Pose],
-    joints: usize,
+pub(crate) unsafe fn pose_slices<'a>(
     buffers: *const SinmdmPoseBuffers,
-) -> Result<(), Failure> {
+    frames: usize,
+    joints: usize,
+) -> Result<PoseSlices<'a>, Failure> {
     let b = unsafe { handle(buffers.cast_mut(), "buffers") }?;
-    let frames = poses.len();
     let roots = unsafe {
         out_slice(
             b.root_positions,
@@ -140,6 +141,19 @@ pub(crate) unsafe fn poses_out(
             )
         }?)
     };
+    Ok((roots, rotations, translations))
+}
+
+/// Writes poses into caller buffers.
+///
+/// # Safety
+/// The arrays of `buffers` are writable for their capacities.
+pub(crate) unsafe fn poses_out(
+    poses: &[Pose],
+    joints: usize,
+    buffers: *const SinmdmPoseBuffers,
+) -> Result<(), Failure> {
+    let (roots, rotations, translations) = unsafe { pose_slices(buffers, poses.len(), joints) }?;
     for (f, pose) in poses.iter().enumerate() {
         roots[3 * f..3 * f + 3].copy_from_slice(&pose.root_position);
         for (j, q) in pose.rotations.iter().enumerate() {
@@ -169,9 +183,12 @@ pub unsafe extern "C" fn sinmdm_write_bvh(
     path: *const c_char,
 ) -> SinmdmStatus {
     guard(|| {
-        let model = unsafe { handle(model.cast_mut(), "model") }?;
+        let model = unsafe { model_arg(model) }?;
         let path = unsafe { str_arg(path, "path") }?;
-        let (motion, _) = unsafe { motion_in(model, poses, "poses") }?;
+        let layout = &model.metadata().layout;
+        let motion = motion_from_poses(&layout.skeleton, layout.fps, &unsafe {
+            poses_in(model, poses, "poses")
+        }?)?;
         sinmdm::bvh::write_bvh(path, &motion.to_channels())
             .map_err(|e| Failure::new(SinmdmStatus::SinmdmIo, e.to_string()))
     })

@@ -2,11 +2,10 @@
 
 use std::ops::ControlFlow;
 
-use sinmdm::motion::encode_motion;
-use sinmdm::{Feet, Generated, Request, Span, Task};
+use sinmdm::{Feet, Generated, Request, Span, Task, features_from_poses};
 
 use crate::model::SinmdmModel;
-use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, motion_in, poses_out};
+use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, poses_in, poses_out};
 use crate::status::{Failure, SinmdmStatus, guard};
 use crate::text::{give, handle, slice_arg};
 
@@ -124,14 +123,14 @@ unsafe fn run_task(
 /// Reference poses as raw features in the model's layout.
 ///
 /// # Safety
-/// As [`motion_in`].
+/// As [`poses_in`].
 unsafe fn reference_features(
     model: &SinmdmModel,
     poses: *const SinmdmPoses,
     argument: &str,
 ) -> Result<sinmdm::motion::FeatureMatrix, Failure> {
-    let (motion, _) = unsafe { motion_in(model, poses, argument) }?;
-    Ok(encode_motion(&model.model.metadata().layout, &motion))
+    let poses = unsafe { poses_in(&model.model, poses, argument) }?;
+    Ok(features_from_poses(&model.model.metadata().layout, &poses)?)
 }
 
 /// Spans from a caller array.

@@ -2,8 +2,8 @@
 
 use sinmdm::{Stream, StreamCompose, StreamOptions};
 
-use crate::model::SinmdmModel;
-use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, motion_in, poses_out};
+use crate::model::{SinmdmModel, model_arg};
+use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, pose_slices, poses_in, poses_out};
 use crate::run::{feet_arg, method_arg};
 use crate::status::{Failure, SinmdmStatus, guard};
 use crate::text::{give, handle, slice_arg};
@@ -48,7 +48,7 @@ pub unsafe extern "C" fn sinmdm_stream_new(
     out: *mut *mut SinmdmStream,
 ) -> SinmdmStatus {
     guard(|| {
-        let model = unsafe { handle(model.cast_mut(), "model") }?;
+        let model = unsafe { model_arg(model) }?;
         let o = *unsafe { handle(options.cast_mut(), "options") }?;
         if out.is_null() {
             return Err(Failure::null("out"));
@@ -72,7 +72,7 @@ pub unsafe extern "C" fn sinmdm_stream_new(
             method: method_arg(o.method, o.eta)?,
             ..StreamOptions::default()
         };
-        let stream = Stream::new(model.model.metadata(), options)?;
+        let stream = Stream::new(model.metadata(), options)?;
         unsafe { give(out, SinmdmStream { stream }) };
         Ok(())
     })
@@ -93,9 +93,10 @@ pub unsafe extern "C" fn sinmdm_stream_supply(
 ) -> SinmdmStatus {
     guard(|| {
         let stream = unsafe { handle(stream, "stream") }?;
-        let model = unsafe { handle(model.cast_mut(), "model") }?;
-        let (_, list) = unsafe { motion_in(model, poses, "poses") }?;
-        stream.stream.supply(&list)?;
+        let model = unsafe { model_arg(model) }?;
+        stream
+            .stream
+            .supply(&unsafe { poses_in(model, poses, "poses") }?)?;
         Ok(())
     })
 }
@@ -115,41 +116,9 @@ pub unsafe extern "C" fn sinmdm_stream_next(
     guard(|| {
         let stream = unsafe { handle(stream, "stream") }?;
         let model = unsafe { handle(model, "model") }?;
-        let buffers_ref = unsafe { handle(buffers.cast_mut(), "buffers") }?;
         let joints = model.model.skeleton().len();
-        // Check the buffers before making anything, so a short one loses no motion.
-        let need = [
-            (
-                buffers_ref.root_positions_capacity,
-                3 * frames,
-                "root_positions",
-            ),
-            (
-                buffers_ref.rotations_capacity,
-                4 * joints * frames,
-                "rotations",
-            ),
-        ];
-        for (capacity, needed, name) in need {
-            if capacity < needed {
-                return Err(Failure::new(
-                    SinmdmStatus::SinmdmBufferTooSmall,
-                    format!("{name} holds {capacity} values, {needed} are needed"),
-                ));
-            }
-        }
-        if !buffers_ref.translations.is_null()
-            && buffers_ref.translations_capacity < 3 * joints * frames
-        {
-            return Err(Failure::new(
-                SinmdmStatus::SinmdmBufferTooSmall,
-                format!(
-                    "translations holds {} values, {} are needed",
-                    buffers_ref.translations_capacity,
-                    3 * joints * frames
-                ),
-            ));
-        }
+        // Check the buffers before making anything, so a bad one loses no motion.
+        unsafe { pose_slices(buffers, frames, joints) }?;
         if model.model.metadata() != stream.stream.metadata() {
             return Err(Failure::invalid("the stream was made with another model"));
         }

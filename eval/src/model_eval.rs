@@ -57,17 +57,22 @@ where
     TaskError: From<D::Error>,
 {
     let plan = sinmdm::plan(metadata, request)?;
-    if plan.frames() < COVERAGE_WINDOW {
-        return Err(EvalError::TooShort {
-            what: "sample length".into(),
-            frames: plan.frames(),
-            needed: COVERAGE_WINDOW,
-        }
-        .into());
-    }
+    check_sample_length(plan.frames())?;
     let started = Instant::now();
     let generated = plan.run(denoiser, progress)?;
     evaluate_generated(generated, clip, threads, started.elapsed().as_secs_f64())
+}
+
+/// Samples shorter than the coverage window cannot be scored; said before any work.
+fn check_sample_length(frames: usize) -> Result<(), EvalError> {
+    if frames < COVERAGE_WINDOW {
+        return Err(EvalError::TooShort {
+            what: "sample length".into(),
+            frames,
+            needed: COVERAGE_WINDOW,
+        });
+    }
+    Ok(())
 }
 
 /// Scores samples made elsewhere (a stream's, say) against `clip`, raw features `[F, N]` in the
@@ -79,14 +84,7 @@ pub fn evaluate_generated(
     threads: usize,
     sampling_seconds: f64,
 ) -> Result<ModelEvaluation, ModelEvalError> {
-    if generated.frames() < COVERAGE_WINDOW {
-        return Err(EvalError::TooShort {
-            what: "sample length".into(),
-            frames: generated.frames(),
-            needed: COVERAGE_WINDOW,
-        }
-        .into());
-    }
+    check_sample_length(generated.frames())?;
     let started = Instant::now();
     let layout = generated.layout();
     let clip_metric = metric_features(layout, clip);

@@ -6,9 +6,9 @@ use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
-use sinmdm::motion::encode_motion;
 use sinmdm::{
-    Feet, Model, ModelOptions, Pose, Request, Span, Stream, StreamOptions, Task, motion_from_poses,
+    Feet, Model, ModelOptions, Pose, Request, Span, Stream, StreamOptions, Task,
+    features_from_poses,
 };
 
 pub fn repo() -> PathBuf {
@@ -123,10 +123,7 @@ pub fn expected() -> BTreeMap<String, String> {
     .unwrap();
     pose_lines("dpm2m", &quick.poses(0).unwrap(), &mut out);
     let layout = model.metadata().layout.clone();
-    let reference = encode_motion(
-        &layout,
-        &motion_from_poses(&layout.skeleton, layout.fps, &crowd.poses(0).unwrap()).unwrap(),
-    );
+    let reference = features_from_poses(&layout, &crowd.poses(0).unwrap()).unwrap();
     let between = sinmdm::run(
         &mut model,
         &Request {

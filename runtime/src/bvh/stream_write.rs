@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use super::error::{BvhError, BvhErrorKind};
 use super::write::{header_text, push_row};
+use crate::files::temporary_path;
 use crate::motion::clip::LocalMotion;
 use crate::motion::skeleton::{Channel, Skeleton};
 
@@ -41,17 +42,7 @@ impl BvhStreamWriter {
             line: None,
             kind: BvhErrorKind::Io(e),
         };
-        let name = path.file_name().ok_or_else(|| {
-            io(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                "not a file path",
-            ))
-        })?;
-        let temp = path.with_file_name(format!(
-            ".{}.{}.partial",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
+        let temp = temporary_path(&path).map_err(io)?;
         let mut file = BufWriter::new(File::create(&temp).map_err(io)?);
         let written = file.write_all(header_text(skeleton, fps, frames).as_bytes());
         let mut writer = BvhStreamWriter {

@@ -6,7 +6,7 @@ use std::collections::VecDeque;
 use ndarray::{Array2, s};
 
 use crate::model_file::ModelMetadata;
-use crate::motion::{MotionError, Pose, encode_motion, motion_from_poses};
+use crate::motion::{MotionError, Pose, features_from_poses, motion_from_poses};
 
 /// Supplied poses by stream frame.
 #[derive(Debug, Clone, Default)]
@@ -62,9 +62,7 @@ impl Guide {
         let poses: Vec<Pose> = (from..to)
             .map(|frame| self.poses[frame - self.first].clone())
             .collect();
-        let layout = &metadata.layout;
-        let motion = motion_from_poses(&layout.skeleton, layout.fps, &poses)?;
-        let raw = encode_motion(layout, &motion);
+        let raw = features_from_poses(&metadata.layout, &poses)?;
         let normalized = metadata.normalizer.normalize(raw.view());
         let skip = start - from.min(start);
         let first = from.max(start);
