@@ -20,6 +20,9 @@ pub const CHECKPOINT_DIR: &str = "checkpoints";
 pub const LATEST_FILE: &str = "latest";
 /// Model weights inside a checkpoint (burnpack).
 pub const MODEL_FILE: &str = "model.bpk";
+/// The weight average inside a checkpoint (burnpack), when the run keeps one; it is what the
+/// export writes.
+pub const AVERAGE_FILE: &str = "average.bpk";
 /// Optimiser state inside a checkpoint (burnpack).
 pub const OPTIMIZER_FILE: &str = "optimizer.bpk";
 /// Everything else inside a checkpoint.
@@ -57,10 +60,12 @@ fn record(path: &Path) -> impl FnOnce(burn::store::RecordError) -> TrainError + 
     }
 }
 
-/// Saves a complete checkpoint of `state.step` and points `latest` at it; returns its folder.
+/// Saves a complete checkpoint of `state.step` (with the averaged weights when the run keeps
+/// them) and points `latest` at it; returns its folder.
 pub fn save(
     run: &Path,
     model: &QnaUnet,
+    average: Option<&QnaUnet>,
     optimizer: &ModuleOptimizer,
     state: &CheckpointState,
 ) -> Result<PathBuf, TrainError> {
@@ -77,6 +82,12 @@ pub fn save(
         .clone()
         .save_file(partial.join(MODEL_FILE))
         .map_err(record(&partial))?;
+    if let Some(average) = average {
+        average
+            .clone()
+            .save_file(partial.join(AVERAGE_FILE))
+            .map_err(record(&partial))?;
+    }
     optimizer
         .save(partial.join(OPTIMIZER_FILE))
         .map_err(record(&partial))?;
@@ -173,7 +184,29 @@ pub fn load_state(dir: &Path) -> Result<CheckpointState, TrainError> {
 
 /// Loads a checkpoint's weights into `model` (which must have the checkpoint's shape).
 pub fn load_model(dir: &Path, model: QnaUnet) -> Result<QnaUnet, TrainError> {
-    let file = dir.join(MODEL_FILE);
+    load_weights(&dir.join(MODEL_FILE), model)
+}
+
+/// Loads a checkpoint's averaged weights into `model`, or `None` when it keeps no average.
+pub fn load_average(dir: &Path, model: QnaUnet) -> Result<Option<QnaUnet>, TrainError> {
+    let file = dir.join(AVERAGE_FILE);
+    if !file.is_file() {
+        return Ok(None);
+    }
+    load_weights(&file, model).map(Some)
+}
+
+/// The weights the export writes: the average when the checkpoint keeps one, else the trained
+/// weights.
+pub fn load_exported(dir: &Path, model: QnaUnet) -> Result<QnaUnet, TrainError> {
+    match load_average(dir, model.clone())? {
+        Some(average) => Ok(average),
+        None => load_model(dir, model),
+    }
+}
+
+fn load_weights(file: &Path, model: QnaUnet) -> Result<QnaUnet, TrainError> {
+    let file = file.to_path_buf();
     model.try_load_file(&file).map_err(|e| {
         let text = e.to_string();
         let mismatches: Vec<&str> = text

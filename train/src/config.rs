@@ -52,8 +52,18 @@ pub struct TrainingConfig {
     pub batch_size: usize,
     /// AdamW learning rate at step 0.
     pub learning_rate: f64,
-    /// Factor applied to the learning rate after every step.
+    /// Factor applied to the learning rate after every step (the `exponential` schedule).
     pub lr_decay: f64,
+    /// How the learning rate moves over the run; absent means `exponential` (by `lr_decay`).
+    #[serde(default, skip_serializing_if = "LrSchedule::is_exponential")]
+    pub lr_schedule: LrSchedule,
+    /// Steps of linear warm-up at the start of the `cosine` schedule.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub warmup_steps: u64,
+    /// Decay of an exponential moving average of the weights, kept beside the trained ones and
+    /// exported instead of them; absent or `null` keeps no average.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ema_decay: Option<f64>,
     /// AdamW weight decay.
     pub weight_decay: f64,
     /// Smallest temporal resampling factor of the clip per step.
@@ -68,6 +78,57 @@ pub struct TrainingConfig {
     /// so a step costs the same whatever the clip's length; absent or `null` uses the whole clip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub window_frames: Option<usize>,
+}
+
+/// How the learning rate moves over a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LrSchedule {
+    /// Multiplied by `lr_decay` after every step.
+    #[default]
+    Exponential,
+    /// A linear warm-up over `warmup_steps`, then half a cosine from `learning_rate` down to
+    /// zero at `steps`.
+    Cosine,
+}
+
+impl LrSchedule {
+    fn is_exponential(&self) -> bool {
+        *self == LrSchedule::Exponential
+    }
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
+}
+
+impl TrainingConfig {
+    /// The learning rate of step `step` (counting from 0) under the `cosine` schedule.
+    pub fn cosine_rate(&self, step: u64) -> f64 {
+        let peak = self.learning_rate;
+        if step < self.warmup_steps {
+            return peak * (step + 1) as f64 / self.warmup_steps as f64;
+        }
+        let span = self.steps.saturating_sub(self.warmup_steps).max(1) as f64;
+        let progress = ((step - self.warmup_steps) as f64 / span).min(1.0);
+        0.5 * peak * (1.0 + (std::f64::consts::PI * progress).cos())
+    }
+
+    /// The learning rate of the first step.
+    pub fn first_rate(&self) -> f64 {
+        match self.lr_schedule {
+            LrSchedule::Exponential => self.learning_rate,
+            LrSchedule::Cosine => self.cosine_rate(0),
+        }
+    }
+
+    /// The learning rate of the step after `completed` steps, given the rate of the last one.
+    pub fn next_rate(&self, completed: u64, last: f64) -> f64 {
+        match self.lr_schedule {
+            LrSchedule::Exponential => last * self.lr_decay,
+            LrSchedule::Cosine => self.cosine_rate(completed),
+        }
+    }
 }
 
 /// How the clip becomes features (SPEC §2).
@@ -177,6 +238,22 @@ impl TrainConfig {
                 t.lr_decay
             ));
         }
+        if let Some(d) = t.ema_decay
+            && !(d > 0.0 && d < 1.0)
+        {
+            return Err(format!(
+                "training.ema_decay must be between 0 and 1 (exclusive) or null, got {d}"
+            ));
+        }
+        if t.warmup_steps > 0 && t.lr_schedule != LrSchedule::Cosine {
+            return Err("training.warmup_steps applies to lr_schedule: cosine only".into());
+        }
+        if t.warmup_steps >= t.steps {
+            return Err(format!(
+                "training.warmup_steps ({}) must be fewer than training.steps ({})",
+                t.warmup_steps, t.steps
+            ));
+        }
         if !(t.weight_decay.is_finite() && t.weight_decay >= 0.0) {
             return Err(format!(
                 "training.weight_decay must be zero or positive, got {}",
@@ -264,6 +341,7 @@ mod tests {
             TINY,
             include_str!("../../configs/cpu.yaml"),
             include_str!("../../configs/paper.yaml"),
+            include_str!("../../configs/default.yaml"),
         ] {
             TrainConfig::parse(text).unwrap();
         }
@@ -272,6 +350,61 @@ mod tests {
         assert_eq!(paper.training.batch_size, 64);
         assert_eq!(paper.training.steps, 60_000);
         assert_eq!(paper.model.receptive_field(), 23);
+    }
+
+    #[test]
+    fn the_cosine_schedule_warms_up_then_falls_to_zero() {
+        let mut t = TrainConfig::parse(include_str!("../../configs/default.yaml"))
+            .unwrap()
+            .training;
+        t.steps = 1100;
+        t.warmup_steps = 100;
+        t.learning_rate = 1.0;
+        assert_eq!(t.lr_schedule, LrSchedule::Cosine);
+        assert!((t.first_rate() - 0.01).abs() < 1e-12);
+        assert!((t.cosine_rate(49) - 0.5).abs() < 1e-12);
+        assert!((t.cosine_rate(100) - 1.0).abs() < 1e-12);
+        // Half way through the cosine part: half the peak; a quarter: (1 + cos(pi/4)) / 2.
+        assert!((t.cosine_rate(600) - 0.5).abs() < 1e-12);
+        let quarter = 0.5 * (1.0 + std::f64::consts::FRAC_1_SQRT_2);
+        assert!((t.cosine_rate(350) - quarter).abs() < 1e-12);
+        assert!(t.cosine_rate(1100).abs() < 1e-12);
+        assert!(t.cosine_rate(5000).abs() < 1e-12);
+        // next_rate follows the formula, not the last rate.
+        assert_eq!(t.next_rate(600, 123.0), t.cosine_rate(600));
+        let mut e = t.clone();
+        e.lr_schedule = LrSchedule::Exponential;
+        e.lr_decay = 0.5;
+        assert_eq!(e.first_rate(), 1.0);
+        assert_eq!(e.next_rate(7, 0.25), 0.125);
+    }
+
+    #[test]
+    fn schedule_and_average_settings_are_checked() {
+        let cases = [
+            ("ema_decay: 0.999", "ema_decay: 1.0", "training.ema_decay"),
+            (
+                "warmup_steps: 500",
+                "warmup_steps: 30000",
+                "training.warmup_steps",
+            ),
+            (
+                "lr_schedule: cosine",
+                "lr_schedule: exponential",
+                "cosine only",
+            ),
+            (
+                "lr_schedule: cosine",
+                "lr_schedule: linear",
+                "unknown variant `linear`",
+            ),
+        ];
+        let default = include_str!("../../configs/default.yaml");
+        for (from, to, expected) in cases {
+            assert!(default.contains(from), "default.yaml lacks `{from}`");
+            let err = TrainConfig::parse(&default.replacen(from, to, 1)).unwrap_err();
+            assert!(err.contains(expected), "{to}: {err}");
+        }
     }
 
     #[test]

@@ -79,13 +79,14 @@ pub fn export_model(
 }
 
 /// Writes the ONNX file of the checkpoint at `path` (a checkpoint folder, or a run folder for its
-/// newest checkpoint) to `out`; returns the checkpoint's state.
+/// newest checkpoint) to `out`, with the averaged weights when the run keeps an average; returns
+/// the checkpoint's state.
 pub fn export_checkpoint(path: &Path, out: &Path) -> Result<CheckpointState, TrainError> {
     let dir = checkpoint::resolve(path)?;
     let state = checkpoint::load_state(&dir)?;
     let device = Device::flex();
     let model = QnaUnet::new(state.features, &state.config.model, &device);
-    let model = checkpoint::load_model(&dir, model)?;
+    let model = checkpoint::load_exported(&dir, model)?;
     export_model(&model.valid(), &state, out)?;
     Ok(state)
 }

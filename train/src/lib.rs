@@ -17,6 +17,7 @@ pub mod memory;
 pub mod model;
 mod shards;
 pub mod trainer;
+pub mod weight_average;
 
 pub use config::TrainConfig;
 pub use error::TrainError;

@@ -19,6 +19,7 @@ use crate::error::{TrainError, io};
 use crate::loss_log::LossLog;
 use crate::model::{QnaUnet, on_cpu};
 use crate::shards::sharded_gradients;
+use crate::weight_average::WeightAverage;
 
 /// Copy of the clip inside the run folder, so a run resumes without the original file.
 pub const CLIP_COPY: &str = "clip.bvh";
@@ -58,6 +59,7 @@ pub struct Trainer {
     run: PathBuf,
     device: Device,
     model: Option<QnaUnet>,
+    average: Option<WeightAverage>,
     optimizer: ModuleOptimizer,
     schedule: Schedule,
     clip: ClipData,
@@ -139,9 +141,13 @@ impl Trainer {
         device.seed(config.training.seed);
         let features = data.features.nrows();
         let model = QnaUnet::new(features, &config.model, &device);
+        let average = config
+            .training
+            .ema_decay
+            .map(|decay| WeightAverage::new(&model, decay, 0));
         let state = CheckpointState {
             step: 0,
-            learning_rate: config.training.learning_rate,
+            learning_rate: config.training.first_rate(),
             loss: f64::NAN,
             recent_loss: f64::NAN,
             elapsed_seconds: 0.0,
@@ -155,6 +161,7 @@ impl Trainer {
             run: run.to_path_buf(),
             device,
             model: Some(model),
+            average,
             optimizer: new_optimizer(&config),
             schedule: schedule(&config),
             clip: data,
@@ -214,6 +221,22 @@ impl Trainer {
         }
         let model = QnaUnet::new(state.features, &state.config.model, &device);
         let model = checkpoint::load_model(&dir, model)?;
+        let average = match state.config.training.ema_decay {
+            None => None,
+            Some(decay) => {
+                let shape = QnaUnet::new(state.features, &state.config.model, &Device::flex());
+                let saved = checkpoint::load_average(&dir, shape)?.ok_or_else(|| {
+                    TrainError::Checkpoint {
+                        path: dir.clone(),
+                        message: format!(
+                            "keeps no {} although the run averages its weights",
+                            checkpoint::AVERAGE_FILE
+                        ),
+                    }
+                })?;
+                Some(WeightAverage::new(&saved, decay, state.step))
+            }
+        };
         let optimizer = checkpoint::load_optimizer(&dir, new_optimizer(&state.config))?;
         let log = LossLog::resume(&run.join(LOSS_LOG), state.step)?;
         let elapsed_before = state.elapsed_seconds;
@@ -221,6 +244,7 @@ impl Trainer {
             run: run.to_path_buf(),
             device,
             model: Some(model),
+            average,
             optimizer,
             schedule: schedule(&state.config),
             clip: data,
@@ -285,16 +309,24 @@ impl Trainer {
         let learning_rate = self.state.learning_rate;
         let (model, value) =
             optimisation_step(model, &mut self.optimizer, noised, t, clean, learning_rate);
-        self.model = Some(model);
         if !value.is_finite() {
+            self.model = Some(model);
             return Err(TrainError::NonFiniteLoss {
                 loss: value,
                 step: step + 1,
                 last_checkpoint: self.last_checkpoint.clone(),
             });
         }
+        if let Some(average) = &mut self.average {
+            average.update(&model);
+        }
+        self.model = Some(model);
         self.state.step += 1;
-        self.state.learning_rate *= self.state.config.training.lr_decay;
+        self.state.learning_rate = self
+            .state
+            .config
+            .training
+            .next_rate(self.state.step, learning_rate);
         self.state.loss = value;
         self.recent.push_back(value);
         if self.recent.len() > RECENT_STEPS {
@@ -317,7 +349,14 @@ impl Trainer {
     pub fn save(&mut self) -> Result<PathBuf, TrainError> {
         self.log.flush()?;
         self.state.elapsed_seconds = self.elapsed();
-        let dir = checkpoint::save(&self.run, self.model(), &self.optimizer, &self.state)?;
+        let average = self.averaged_model();
+        let dir = checkpoint::save(
+            &self.run,
+            self.model(),
+            average.as_ref(),
+            &self.optimizer,
+            &self.state,
+        )?;
         self.last_checkpoint = Some(dir.clone());
         Ok(dir)
     }
@@ -348,8 +387,47 @@ impl Trainer {
         self.model().valid()
     }
 
+    /// The network with the averaged weights (without autodiff or dropout), when the run keeps
+    /// an average.
+    pub fn averaged_model(&self) -> Option<QnaUnet> {
+        self.average
+            .as_ref()
+            .map(|average| average.apply(self.inference_model()))
+    }
+
     /// The loss log's path.
     pub fn loss_log(&self) -> &Path {
         self.log.path()
     }
+}
+
+/// Seconds one optimiser step of `config` on `clip` takes on `device`: the median of `steps`
+/// timed steps (after two untimed ones) of a throw-away run in a temporary folder. This is
+/// what a time budget (`sinmdm-train --minutes`) turns into a step count.
+pub fn seconds_per_step(
+    clip: &Path,
+    config: &TrainConfig,
+    device: Device,
+    steps: u64,
+) -> Result<f64, TrainError> {
+    let folder = std::env::temp_dir().join(format!("sinmdm-timing-probe-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&folder);
+    let mut probe_config = config.clone();
+    probe_config.training.steps = steps + 2;
+    probe_config.training.warmup_steps = 0;
+    let measured = (|| {
+        let mut trainer = Trainer::start(clip, probe_config, &folder, device)?;
+        let mut times = Vec::new();
+        for i in 0..steps + 2 {
+            let begun = Instant::now();
+            trainer.step()?;
+            if i >= 2 {
+                times.push(begun.elapsed().as_secs_f64());
+            }
+        }
+        times.sort_by(f64::total_cmp);
+        Ok(times[times.len() / 2])
+    })();
+    let _ = std::fs::remove_dir_all(&folder);
+    measured
 }

@@ -68,11 +68,17 @@ fn stopped_and_resumed_run_reproduces_the_uninterrupted_one() {
     config.training.steps = 60;
     config.training.checkpoint_every = 25;
     config.model.dropout = 0.3; // exercise the reseeded dropout stream too
+    // ... and the cosine schedule and the weight average, which a resume must rebuild.
+    config.training.lr_schedule = sinmdm_train::config::LrSchedule::Cosine;
+    config.training.warmup_steps = 10;
+    config.training.ema_decay = Some(0.9);
     let whole = scratch("whole");
     let mut trainer =
         Trainer::start(&walk(), config.clone(), &whole, Device::flex().autodiff()).unwrap();
     trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
     let whole_weights = named_tensors(trainer.model());
+    let whole_average = named_tensors(&trainer.averaged_model().unwrap());
+    assert_ne!(whole_weights, whole_average);
 
     let parts = scratch("parts");
     let stop = AtomicBool::new(false);
@@ -93,6 +99,19 @@ fn stopped_and_resumed_run_reproduces_the_uninterrupted_one() {
 
     assert_eq!(losses(&whole), losses(&parts));
     assert_eq!(whole_weights, named_tensors(second.model()));
+    assert_eq!(
+        whole_average,
+        named_tensors(&second.averaged_model().unwrap())
+    );
+    // The export writes the average.
+    let checkpoint = sinmdm_train::checkpoint::latest(&parts).unwrap().unwrap();
+    let shape = sinmdm_train::QnaUnet::new(
+        second.state().features,
+        &second.state().config.model,
+        &Device::flex(),
+    );
+    let exported = sinmdm_train::checkpoint::load_exported(&checkpoint, shape).unwrap();
+    assert_eq!(whole_average, named_tensors(&exported));
     std::fs::remove_dir_all(&whole).unwrap();
     std::fs::remove_dir_all(&parts).unwrap();
 }
@@ -257,6 +276,47 @@ fn bad_input_gets_an_error_that_names_it() {
     assert!(
         err.to_string().contains("is not the clip this run learns"),
         "{err}"
+    );
+    std::fs::remove_dir_all(&run).unwrap();
+}
+
+#[test]
+fn a_time_budget_sets_the_steps_and_records_them() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let bin = env!("CARGO_BIN_EXE_sinmdm-train");
+    let run = scratch("budget");
+    let child = Command::new(bin)
+        .arg(walk())
+        .arg("--config")
+        .arg(root().join("configs/tiny.yaml"))
+        .args(["--minutes", "0.15", "--threads", "1", "--out"])
+        .arg(&run)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let probe = std::env::temp_dir().join(format!("sinmdm-timing-probe-{}", child.id()));
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let recorded = TrainConfig::load(&run.join("config.yaml")).unwrap();
+    let steps = recorded.training.steps;
+    assert_ne!(steps, tiny().training.steps, "{err}");
+    assert!(
+        err.contains(&format!("so {steps} steps")) && err.contains(&format!("done: {steps} steps")),
+        "{err}"
+    );
+    assert_eq!(losses(&run).len() as u64, steps);
+    // No timing probe is left behind.
+    assert!(!probe.exists());
+    // A resumed run keeps its own steps.
+    let again = Command::new(bin)
+        .args(["--resume", "--minutes", "1", "--out"])
+        .arg(&run)
+        .output()
+        .unwrap();
+    assert!(!again.status.success());
+    assert!(
+        String::from_utf8_lossy(&again.stderr).contains("--minutes sets the steps of a new run")
     );
     std::fs::remove_dir_all(&run).unwrap();
 }

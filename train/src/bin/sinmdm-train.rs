@@ -17,7 +17,8 @@ use sinmdm_train::{QnaUnet, RunEnd, TrainConfig, Trainer};
 /// Fit the single-motion QnA-UNet denoiser on one BVH clip.
 ///
 /// Examples:
-///   sinmdm-train tests/data/bvh/human_walk_cmu_131_01.bvh --config configs/cpu.yaml --out runs/walk
+///   sinmdm-train tests/data/bvh/human_walk_cmu_131_01.bvh --out runs/walk   (the default, ~10 min)
+///   sinmdm-train CLIP.bvh --minutes 5 --out runs/quick   (as many steps as fit in 5 minutes)
 ///   sinmdm-train --resume --out runs/walk            (continue after Ctrl-C or a crash)
 ///   sinmdm-train CLIP.bvh --config configs/paper.yaml --dry-run   (sizes only)
 #[derive(Parser, Debug)]
@@ -25,9 +26,20 @@ use sinmdm_train::{QnaUnet, RunEnd, TrainConfig, Trainer};
 struct Args {
     /// The BVH clip to learn (optional with --resume: the run keeps a copy).
     clip: Option<PathBuf>,
-    /// Training configuration (YAML); optional with --resume.
+    /// Training configuration (YAML). Without it a new run uses the default (configs/default.yaml,
+    /// built in) and a resumed run its own.
     #[arg(long)]
     config: Option<PathBuf>,
+    /// Time budget of a new run in minutes: a short timing probe sets training.steps so that
+    /// the run (probe and export included) ends within it. The steps chosen are recorded in the
+    /// run's config.yaml, so the run can be repeated exactly with that file.
+    #[arg(long, value_name = "M")]
+    minutes: Option<f64>,
+    /// Frame rate a new run learns the clip at, replacing the config's data.fps: a number of
+    /// frames per second, or `clip` for the clip's own. The receptive field is a number of frames,
+    /// so this sets how much time the model sees at once (23 frames: 0.77 s at 30 fps).
+    #[arg(long, value_name = "FPS|clip")]
+    fps: Option<String>,
     /// Run folder: checkpoints, loss.csv, loss.png.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -66,11 +78,73 @@ fn device(name: &str) -> Result<Device> {
     }
 }
 
-fn dry_run(args: &Args) -> Result<()> {
-    let (Some(clip), Some(config)) = (&args.clip, &args.config) else {
-        bail!("--dry-run needs a CLIP and a --config");
+/// The built-in default configuration (`configs/default.yaml`).
+fn default_config() -> TrainConfig {
+    TrainConfig::parse(include_str!("../../../configs/default.yaml"))
+        .expect("the shipped default configuration is valid")
+}
+
+/// The configuration of a new run: --config, else the default, with --fps applied.
+fn new_run_config(args: &Args) -> Result<TrainConfig> {
+    let mut config = match &args.config {
+        Some(path) => TrainConfig::load(path)?,
+        None => default_config(),
     };
-    let config = TrainConfig::load(config)?;
+    if let Some(fps) = &args.fps {
+        config.data.fps = match fps.as_str() {
+            "clip" => None,
+            number => match number.parse::<f64>() {
+                Ok(f) if f.is_finite() && f > 0.0 => Some(f),
+                _ => bail!(
+                    "--fps must be a positive number of frames per second or `clip`, got '{fps}'"
+                ),
+            },
+        };
+    }
+    Ok(config)
+}
+
+/// Timing steps of the probe behind --minutes.
+const PROBE_STEPS: u64 = 12;
+/// Seconds kept back from a --minutes budget for loading, checkpoints and the export.
+const BUDGET_RESERVE_SECONDS: f64 = 5.0;
+/// Share of a --minutes budget kept back for steps slower than the probe's.
+const BUDGET_MARGIN: f64 = 0.04;
+
+/// Sets `config.training.steps` (and a warm-up longer than a tenth of them) so that training
+/// ends within `minutes`, from a timing probe.
+fn fit_to_budget(
+    clip: &std::path::Path,
+    config: &mut TrainConfig,
+    device: &Device,
+    minutes: f64,
+) -> Result<()> {
+    if !(minutes.is_finite() && minutes > 0.0) {
+        bail!("--minutes must be a positive number, got {minutes}");
+    }
+    let begun = std::time::Instant::now();
+    let per_step =
+        sinmdm_train::trainer::seconds_per_step(clip, config, device.clone(), PROBE_STEPS)?;
+    let left = minutes * 60.0 - begun.elapsed().as_secs_f64() - BUDGET_RESERVE_SECONDS;
+    let steps = (left * (1.0 - BUDGET_MARGIN) / per_step).floor();
+    if steps < 1.0 {
+        bail!("--minutes {minutes} leaves no time to train: one step takes {per_step:.3} s here");
+    }
+    let training = &mut config.training;
+    training.steps = steps as u64;
+    training.warmup_steps = training.warmup_steps.min(training.steps / 10);
+    eprintln!(
+        "--minutes {minutes}: one step takes {per_step:.4} s here, so {} steps",
+        training.steps
+    );
+    Ok(())
+}
+
+fn dry_run(args: &Args) -> Result<()> {
+    let Some(clip) = &args.clip else {
+        bail!("--dry-run needs a CLIP");
+    };
+    let config = new_run_config(args)?;
     let data = ClipData::load(clip, &config.data, &config.model)?;
     let features = data.features.nrows();
     let model = QnaUnet::new(features, &config.model, &Device::flex());
@@ -128,16 +202,25 @@ fn main() -> Result<()> {
         }
     }
     let device = device(&args.device)?.autodiff();
-    let config = args.config.as_deref().map(TrainConfig::load).transpose()?;
+    if args.resume && args.minutes.is_some() {
+        bail!(
+            "--minutes sets the steps of a new run; a resumed run keeps its own (raise them with a --config)"
+        );
+    }
     let mut trainer = if args.resume {
+        if args.fps.is_some() {
+            bail!("--fps sets the frame rate of a new run; a resumed run keeps its own");
+        }
+        let config = args.config.as_deref().map(TrainConfig::load).transpose()?;
         Trainer::resume(out, args.clip.as_deref(), config, device)?
     } else {
         let Some(clip) = &args.clip else {
             bail!("a CLIP to train on is required (or --resume an existing run)");
         };
-        let Some(config) = config else {
-            bail!("--config is required for a new run (for example configs/cpu.yaml)");
-        };
+        let mut config = new_run_config(&args)?;
+        if let Some(minutes) = args.minutes {
+            fit_to_budget(clip, &mut config, &device, minutes)?;
+        }
         Trainer::start(clip, config, out, device)?
     };
 

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Trains the default configuration (configs/default.yaml) on each of the project's clips, one
+# after another, scores every model with `sinmdm eval` (20 samples of twice the clip's length,
+# default sampling, seed 0) and prints one Markdown table: training time, coverage, diversity,
+# intra-diversity difference and jitter against the clip's.
+#
+# Usage: scripts/train_table.sh [OUT_DIR] [DOG_CLIP.bvh]
+#   OUT_DIR   runs, models and eval JSON (default out/train_table); finished runs are kept and
+#             not trained again, an interrupted one resumes
+#   DOG_CLIP  the MANN dog walk (60 fps, learned at its own rate), if you have it
+# Pause any other training or benchmark while this runs: the times are wall-clock on this machine.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:-out/train_table}
+dog=${2:-}
+mkdir -p "$out"
+train=target/release/sinmdm-train
+sinmdm=target/release/sinmdm
+[ -x "$train" ] || cargo build --release -p sinmdm-train --quiet
+[ -x "$sinmdm" ] || cargo build --release -p sinmdm-cli --quiet
+
+# name : clip : extra sinmdm-train arguments
+clips=("human_walk_cmu:tests/data/bvh/human_walk_cmu_131_01.bvh:"
+       "human_hop_cmu:tests/data/bvh/human_hop_cmu_131_03.bvh:"
+       "fox_survey_khronos:tests/data/bvh/fox_survey_khronos.bvh:"
+       "human_dance_rokoko:tests/data/bvh/human_dance_rokoko_jesse.bvh:")
+[ -n "$dog" ] && clips+=("dog_walk_mann_60fps:$dog:--fps clip")
+
+for entry in "${clips[@]}"; do
+  IFS=: read -r name clip extra <<<"$entry"
+  run="$out/$name"
+  model="$out/$name.onnx"
+  if [ ! -f "$model" ]; then
+    if [ -f "$run/latest" ]; then
+      # shellcheck disable=SC2086
+      "$train" --resume --out "$run" --export "$model"
+    else
+      # shellcheck disable=SC2086
+      "$train" "$clip" --out "$run" --export "$model" $extra
+    fi
+  fi
+  [ -f "$out/$name.json" ] || "$sinmdm" eval -m "$model" --clip "$clip" --samples 20 \
+    --quiet --json "$out/$name.json" >/dev/null
+done
+
+python3 - "$out" <<'PY'
+import json, pathlib, sys
+out = pathlib.Path(sys.argv[1])
+print("| clip | frames (fps) | steps | training time | coverage | global diversity | intra diff | jitter x clip | s per sample |")
+print("|---|---|---|---|---|---|---|---|---|")
+for path in sorted(out.glob("*.json")):
+    d = json.loads(path.read_text())
+    run = out / path.stem
+    latest = (run / "latest").read_text().strip()
+    state = json.loads((run / latest / "state.json").read_text())
+    r = d["report"]
+    fps = state["clip"]["layout"]["fps"]
+    print(f"| {path.stem} | {state['clip']['frames']} ({fps:g}) | {state['step']} | "
+          f"{state['elapsed_seconds'] / 60:.1f} min | {r['coverage']['mean']:.1f} | "
+          f"{r['global_diversity']['mean']:.3f} | {r['intra_diversity_diff']:.3f} | "
+          f"{d['feet']['raw']['jitter_ratio']:.2f} | {d['sampling_seconds'] / d['samples']:.3f} |")
+PY
