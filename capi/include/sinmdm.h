@@ -12,9 +12,10 @@
 #include <stdlib.h>
 
 /*
- Respaced sampling steps of the command line; a good default for `SinmdmSampling::steps`.
+ Respaced sampling steps of the command line (the library's `DEFAULT_STEPS`); a good default
+ for `SinmdmSampling::steps`.
  */
-#define SINMDM_DEFAULT_STEPS 100
+#define SINMDM_DEFAULT_STEPS 50
 
 /*
  Feet: contact points held still on the ground (the default).

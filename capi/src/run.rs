@@ -9,8 +9,9 @@ use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, poses_in, poses_out};
 use crate::status::{Failure, SinmdmStatus, guard};
 use crate::text::{give, handle, slice_arg};
 
-/// Respaced sampling steps of the command line; a good default for `SinmdmSampling::steps`.
-pub const SINMDM_DEFAULT_STEPS: u32 = 100;
+/// Respaced sampling steps of the command line (the library's `DEFAULT_STEPS`); a good default
+/// for `SinmdmSampling::steps`.
+pub const SINMDM_DEFAULT_STEPS: u32 = 50;
 
 /// Feet: contact points held still on the ground (the default).
 pub const SINMDM_FEET_PLANTED: u32 = 0;
@@ -331,5 +332,13 @@ pub unsafe extern "C" fn sinmdm_result_poses(
 pub unsafe extern "C" fn sinmdm_result_free(result: *mut SinmdmResult) {
     if !result.is_null() {
         drop(unsafe { Box::from_raw(result) });
+    }
+}
+
+#[cfg(test)]
+mod default_steps_tests {
+    #[test]
+    fn the_c_default_is_the_library_default() {
+        assert_eq!(super::SINMDM_DEFAULT_STEPS as usize, sinmdm::DEFAULT_STEPS);
     }
 }

@@ -62,7 +62,7 @@ pub unsafe extern "C" fn sinmdm_stream_new(
         let options = StreamOptions {
             seed: o.seed,
             steps: Some(if o.steps == 0 {
-                sinmdm::stream::STREAM_DEFAULT_STEPS
+                sinmdm::DEFAULT_STEPS
             } else {
                 o.steps as usize
             }),

@@ -20,8 +20,9 @@ use sinmdm_render::{Camera, Figure};
 
 use crate::render::write_picture;
 
-/// Default respaced sampling steps of the command line (see the README for the measurement).
-pub const DEFAULT_STEPS: &str = "100";
+/// Default respaced sampling steps of the command line: the library's `sinmdm::DEFAULT_STEPS`
+/// (clap needs it as text; a test checks they agree).
+pub const DEFAULT_STEPS: &str = "50";
 
 /// Options shared by `generate`, `inbetween`, `expand`, `compose` and `harmonize`.
 #[derive(Debug, Args)]
@@ -348,4 +349,15 @@ pub fn run_with_progress(model: &mut Model, plan: &Plan, quiet: bool) -> Result<
     })?;
     bar.finish_and_clear();
     Ok(generated)
+}
+
+#[cfg(test)]
+mod default_steps_tests {
+    #[test]
+    fn the_command_line_default_is_the_library_default() {
+        assert_eq!(
+            super::DEFAULT_STEPS.parse::<usize>(),
+            Ok(sinmdm::DEFAULT_STEPS)
+        );
+    }
 }

@@ -55,7 +55,7 @@ mod onnxruntime;
 pub mod stream;
 pub mod tasks;
 
-pub use diffusion::{Denoiser, Method, Sampler, SamplerError};
+pub use diffusion::{DEFAULT_STEPS, Denoiser, Method, Sampler, SamplerError};
 pub use model::{Model, ModelError, ModelOptions};
 pub use model_file::ModelMetadata;
 pub use motion::{

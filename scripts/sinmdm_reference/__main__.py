@@ -37,7 +37,7 @@ def main(argv=None):
         p.add_argument("-o", "--output", required=True, help="features JSON to write")
         p.add_argument("--count", type=int, default=1)
         p.add_argument("--seed", type=int, default=0)
-        p.add_argument("--steps", default="100", help="respaced steps S, or 'all'")
+        p.add_argument("--steps", default="50", help="respaced steps S, or 'all'")
         p.add_argument("--threads", type=int, default=None)
         p.add_argument("--sampler", choices=["ancestral", "ddim", "dpm2m"], default="ancestral")
         p.add_argument("--eta", type=float, default=0.0)

@@ -31,9 +31,6 @@ use crate::tasks::{INBETWEEN_RAMP, MAX_FRAMES, TaskError};
 use blocks::{BlockSizes, block_seed};
 use guide::Guide;
 
-/// Respaced sampling steps of a stream unless told otherwise (the command line's default).
-pub const STREAM_DEFAULT_STEPS: usize = 100;
-
 /// Joints (and the root's travel) that a stream takes from poses the game supplies.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct StreamCompose {
@@ -72,7 +69,7 @@ impl Default for StreamOptions {
     fn default() -> Self {
         StreamOptions {
             seed: 0,
-            steps: Some(STREAM_DEFAULT_STEPS),
+            steps: Some(crate::DEFAULT_STEPS),
             block_frames: None,
             context_frames: None,
             ramp: INBETWEEN_RAMP,
