@@ -102,6 +102,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         ),
         (
+            "legs only (the root does not follow the stance)",
+            PlantOptions {
+                root_follows_stance: false,
+                ..base
+            },
+        ),
+        (
+            "stance smoothed over 0.2 s",
+            PlantOptions {
+                stance_smoothing_seconds: 0.2,
+                ..base
+            },
+        ),
+        (
+            "stance smoothed over 0.3 s",
+            PlantOptions {
+                stance_smoothing_seconds: 0.3,
+                ..base
+            },
+        ),
+        (
+            "stance smoothed over 0.5 s",
+            PlantOptions {
+                stance_smoothing_seconds: 0.5,
+                ..base
+            },
+        ),
+        (
             "root moves to reach",
             PlantOptions {
                 reach_with_root: true,

@@ -136,6 +136,16 @@ fn bone_lengths(pose: &GlobalPose, motion: &LocalMotion) -> Vec<f64> {
 
 #[test]
 fn a_sliding_foot_is_held_still_through_its_span_with_exact_bones() {
+    for root_follows_stance in [true, false] {
+        let options = PlantOptions {
+            root_follows_stance,
+            ..options()
+        };
+        sliding_foot_is_held(&options);
+    }
+}
+
+fn sliding_foot_is_held(options: &PlantOptions) {
     let (layout, motion) = sliding_leg();
     let h = layout.skeleton_height;
     let before = global_poses(&motion);
@@ -145,7 +155,7 @@ fn a_sliding_foot_is_held_still_through_its_span_with_exact_bones() {
     );
     assert!(slide > 0.15, "the synthetic foot must slide ({slide})");
     let (planted, stats) =
-        plant_feet(&layout, &motion, &labels(), &Kept::default(), &options()).unwrap();
+        plant_feet(&layout, &motion, &labels(), &Kept::default(), options).unwrap();
     let after = global_poses(&planted);
     let held = after[SPAN.start].contact_point(3);
     for f in SPAN {
@@ -159,14 +169,39 @@ fn a_sliding_foot_is_held_still_through_its_span_with_exact_bones() {
         {
             assert!((x - y).abs() < 1e-9, "a bone changed length: {x} -> {y}");
         }
-        // The hips and the spine are the network's: only the leg turned.
-        assert!(distance(b.joints[0], a.joints[0]) < 1e-12);
-        assert!(distance(b.joints[4], a.joints[4]) < 1e-12);
+        // The spine is the network's: it keeps its place on the hips ...
+        let spine = |p: &GlobalPose| math::sub(p.joints[4], p.joints[0]);
+        assert!(distance(spine(b), spine(a)) < 1e-12);
+        // ... and the hips keep their height; they move along the ground only to travel with
+        // the stance foot, and not at all when told not to.
+        assert!((b.joints[0][1] - a.joints[0][1]).abs() < 1e-12);
+        if !options.root_follows_stance {
+            assert!(distance(b.joints[0], a.joints[0]) < 1e-12);
+        }
     }
-    // Far from the span (beyond its blend border) the motion is untouched.
+    if options.root_follows_stance {
+        // The foot slid forward with the hips, so the hips were carried back by the stance,
+        // by at most the slide.
+        let back = before[SPAN.end - 1].joints[0][2] - after[SPAN.end - 1].joints[0][2];
+        assert!(
+            back > 0.0 && back <= slide + 1e-9,
+            "{back} against a slide of {slide}"
+        );
+        assert!(stats.max_root_travel > 0.0);
+    } else {
+        assert_eq!(stats.max_root_travel, 0.0);
+    }
+    // Before the span (beyond its blend border and the stance's smoothing) the motion is
+    // untouched; after it, moved along the ground by the root's travel at most.
     let blend = (PlantOptions::default().blend_seconds * 30.0).round() as usize;
-    for f in (0..SPAN.start - blend - 1).chain(SPAN.end + blend + 1..FRAMES) {
+    let smoothing = (options.stance_smoothing_seconds * 30.0).round() as usize;
+    for f in 0..SPAN.start - blend.max(smoothing) - 1 {
         assert!(distance(after[f].contact_point(3), before[f].contact_point(3)) < 1e-12);
+    }
+    for f in SPAN.end + blend + 1..FRAMES {
+        let moved = math::sub(after[f].contact_point(3), before[f].contact_point(3));
+        let travel = math::sub(after[f].joints[0], before[f].joints[0]);
+        assert!(distance(moved, travel) < 1e-12, "frame {f}");
     }
     assert_eq!(stats.spans, 1);
     assert_eq!(stats.planted_frames, SPAN.len());

@@ -7,12 +7,14 @@
 //! - [`spans`]: contact spans from labels (hysteresis, shortest span) and blend weights;
 //! - [`chain`]: which joints above a contact joint may turn;
 //! - [`ground`]: the ground level of a motion;
-//! - [`plant`]: the pass itself, on the inverse kinematics of [`crate::motion::ik`].
+//! - [`plant`]: the pass itself, on the inverse kinematics of [`crate::motion::ik`];
+//! - `stance`: the root's horizontal travel with the feet in contact, before the legs turn.
 
 pub mod chain;
 pub mod ground;
 pub mod plant;
 pub mod spans;
+mod stance;
 
 pub use chain::{LegChain, leg_chain};
 pub use ground::{GROUND_PERCENTILE, ground_level};

@@ -1,12 +1,13 @@
-//! The planting pass: predicted contact spans held still on the ground, by rotations of each
-//! leg's chain; the root moved up or down only where no leg can reach or something would go
-//! through the floor.
+//! The planting pass: predicted contact spans held still on the ground, by carrying the root
+//! along with the feet in contact and then by rotations of each leg's chain; the root moved up
+//! or down only where no leg can reach or something would go through the floor.
 
 use std::ops::Range;
 
 use super::chain::{LegChain, leg_chain};
 use super::ground::ground_level;
 use super::spans::{contact_spans, span_weights};
+use super::stance::stance_travel;
 use crate::motion::clip::LocalMotion;
 use crate::motion::features::{FeatureLayout, MotionError};
 use crate::motion::fk::{GlobalPose, global_pose, global_poses};
@@ -51,6 +52,14 @@ pub struct PlantOptions {
     /// past this, it follows the generated point at this distance (a foot the network drags a
     /// long way is let go rather than the leg stretched after it).
     pub max_hold: f64,
+    /// Whether the root travels horizontally with the feet in contact before the legs are
+    /// turned: where planted feet slide together, the body is carried along instead, which
+    /// leaves the legs' rotations (what the model made) as they are. Frames whose root a task
+    /// kept are not moved.
+    pub root_follows_stance: bool,
+    /// The root's travel with the stance is averaged over this many seconds on each side of a
+    /// frame (a root that followed every tremor of a foot would shake the whole body).
+    pub stance_smoothing_seconds: f64,
 }
 
 impl Default for PlantOptions {
@@ -64,6 +73,8 @@ impl Default for PlantOptions {
             grow_within: 0.08,
             soft_reach: 0.2,
             max_hold: 0.2,
+            root_follows_stance: true,
+            stance_smoothing_seconds: 0.3,
         }
     }
 }
@@ -117,6 +128,9 @@ pub struct PlantStats {
     pub max_miss: f64,
     /// The mean distance of points from their targets, over every frame with a target.
     pub mean_miss: f64,
+    /// The largest horizontal move of the root made so that it travels with the feet in
+    /// contact ([`PlantOptions::root_follows_stance`]).
+    pub max_root_travel: f64,
 }
 
 /// Coordinates below this size can be subtracted, squared and summed without overflow.
@@ -125,8 +139,9 @@ const OVERFLOW_SAFE: f64 = 1e150;
 /// Holds every contact joint of `motion` (decoded in `layout`, the file's frame) still during
 /// the spans its `labels` (one series per contact joint, as the features carry them) mark, on
 /// or above the ground, easing in and out over [`PlantOptions::blend_seconds`]; and lifts
-/// whatever would go below the ground. Only rotations of the chains above contact joints
-/// ([`leg_chain`]) and the root's height change, so every bone keeps its length. Joints and
+/// whatever would go below the ground. Only the root's position (carried along with the feet in
+/// contact, [`PlantOptions::root_follows_stance`], and raised where needed) and rotations of the
+/// chains above contact joints ([`leg_chain`]) change, so every bone keeps its length. Joints and
 /// root positions in `kept` are left exactly as they are. The ground is the layout's (from the
 /// training clip), or this motion's own ([`ground_level`]) for a model file without one.
 pub fn plant_feet(
@@ -143,8 +158,9 @@ pub fn plant_feet(
             frames,
         });
     }
-    let original = to_canonical(motion, layout.up);
-    let poses = global_poses(&original);
+    let canonical = to_canonical(motion, layout.up);
+    let mut original = canonical.clone();
+    let mut poses = global_poses(&original);
     let ground = layout
         .ground
         .unwrap_or_else(|| ground_level(&layout.contact_joints, &poses));
@@ -182,18 +198,63 @@ pub fn plant_feet(
     // Per contact joint and frame: the point it should be at, or None to leave it.
     let min_frames = (options.min_span_seconds * layout.fps).round().max(1.0) as usize;
     let blend = (options.blend_seconds * layout.fps).round().max(0.0) as usize;
+    let contact_points = |poses: &[GlobalPose], chain: &LegChain| -> Vec<Vec3> {
+        poses
+            .iter()
+            .map(|p| p.contact_point(chain.contact))
+            .collect()
+    };
+    // Spans depend on heights only, which the root's horizontal travel leaves as they are.
+    let chain_spans: Vec<Vec<Range<usize>>> = chains
+        .iter()
+        .enumerate()
+        .map(|(k, chain)| {
+            let Some(chain) = chain else {
+                return Vec::new();
+            };
+            let points = contact_points(&poses, chain);
+            let low = |f: usize| height_of(points[f]) - ground < options.grow_within * height;
+            grow_spans(contact_spans(&labels[k], min_frames), frames, low)
+        })
+        .collect();
+    let top = top_joint(&original);
+    if options.root_follows_stance {
+        let (mut points, mut weights) = (Vec::new(), Vec::new());
+        for (chain, spans) in chains.iter().zip(&chain_spans) {
+            let Some(chain) = chain else { continue };
+            points.push(contact_points(&poses, chain));
+            weights.push(
+                (0..frames)
+                    .map(|f| {
+                        let inside = spans.iter().any(|s| s.contains(&f));
+                        let kept = chain.joints.iter().any(|&j| kept.joint(f, j));
+                        if inside && !kept { 1.0 } else { 0.0 }
+                    })
+                    .collect::<Vec<f64>>(),
+            );
+        }
+        let kept_root: Vec<bool> = (0..frames)
+            .map(|f| kept.root(f) || kept.joint(f, top))
+            .collect();
+        let radius = (options.stance_smoothing_seconds * layout.fps)
+            .round()
+            .max(0.0) as usize;
+        let travel = stance_travel(&points, &weights, &kept_root, radius);
+        let joints = original.skeleton.len();
+        for (f, t) in travel.iter().enumerate() {
+            let root = &mut original.translations[f * joints + top];
+            *root = math::add(*root, *t);
+            stats.max_root_travel = stats.max_root_travel.max(math::norm(*t) / height);
+        }
+        poses = global_poses(&original);
+    }
     let mut targets: Vec<Vec<Option<Vec3>>> = Vec::with_capacity(chains.len());
-    for (k, chain) in chains.iter().enumerate() {
+    for (chain, spans) in chains.iter().zip(chain_spans) {
         let Some(chain) = chain else {
             targets.push(vec![None; frames]);
             continue;
         };
-        let points: Vec<Vec3> = poses
-            .iter()
-            .map(|p| p.contact_point(chain.contact))
-            .collect();
-        let low = |f: usize| height_of(points[f]) - ground < options.grow_within * height;
-        let spans = grow_spans(contact_spans(&labels[k], min_frames), frames, low);
+        let points = contact_points(&poses, chain);
         stats.spans += spans.len();
         let anchors: Vec<Vec3> = spans
             .iter()
@@ -248,7 +309,6 @@ pub fn plant_feet(
             _ => Vec::new(),
         })
         .collect();
-    let top = top_joint(&original);
     let mut out = original.clone();
     let frame_targets = |f: usize| -> Vec<Wanted<'_>> {
         chains
@@ -322,8 +382,8 @@ pub fn plant_feet(
     for f in 0..frames {
         for j in 0..joints {
             if kept.joint(f, j) {
-                out.rotations[f * joints + j] = original.rotations[f * joints + j];
-                out.translations[f * joints + j] = original.translations[f * joints + j];
+                out.rotations[f * joints + j] = canonical.rotations[f * joints + j];
+                out.translations[f * joints + j] = canonical.translations[f * joints + j];
             }
         }
     }
@@ -333,8 +393,8 @@ pub fn plant_feet(
     for f in 0..frames {
         for j in 0..joints {
             let k = f * joints + j;
-            if out.rotations[k] == original.rotations[k]
-                && out.translations[k] == original.translations[k]
+            if out.rotations[k] == canonical.rotations[k]
+                && out.translations[k] == canonical.translations[k]
             {
                 planted.rotations[k] = motion.rotations[k];
                 planted.translations[k] = motion.translations[k];
