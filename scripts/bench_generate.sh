@@ -16,7 +16,7 @@ trap 'rm -rf "$work"' EXIT
 times=()
 for round in $(seq "$rounds"); do
   start=$(date +%s.%N)
-  "$sinmdm" generate -m "$model" --count 20 --frames 498 --quiet -o "$work/sample.bvh" "$@"
+  "$sinmdm" generate -m "$model" --count 20 --frames 498 --quiet -o "$work/sample.bvh" "$@" >/dev/null
   end=$(date +%s.%N)
   t=$(echo "$end - $start" | bc)
   times+=("$t")

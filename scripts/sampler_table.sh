@@ -9,8 +9,8 @@ out=${1:-out/sampler_table}
 mkdir -p "$out"
 sinmdm=target/release/sinmdm
 [ -x "$sinmdm" ] || cargo build --release -p sinmdm-cli --quiet
-configs=("ancestral 1000:all" "ancestral 100:100" "dpm2m 10:10" "dpm2m 15:15" "dpm2m 20:20"
-         "dpm2m 30:30" "ddim 20:20" "ddim 50:50")
+configs=("ancestral 1000:all" "ancestral 100:100" "ancestral 50:50" "ancestral 40:40" "ancestral 30:30"
+         "dpm2m 20:20" "dpm2m 30:30" "ddim 50:50")
 for pair in "human_walk_cmu:human_walk_cmu_131_01" "human_hop_cmu:human_hop_cmu_131_03" \
             "fox_survey_khronos:fox_survey_khronos"; do
   model=${pair%%:*}

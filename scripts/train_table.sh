@@ -46,8 +46,8 @@ done
 python3 - "$out" <<'PY'
 import json, pathlib, sys
 out = pathlib.Path(sys.argv[1])
-print("| clip | frames (fps) | steps | training time | coverage | global diversity | intra diff | jitter x clip | s per sample |")
-print("|---|---|---|---|---|---|---|---|---|")
+print("| clip | frames (fps) | steps | training time | coverage | global diversity | intra diff | clip's own intra diversity | jitter x clip | s per sample |")
+print("|---|---|---|---|---|---|---|---|---|---|")
 for path in sorted(out.glob("*.json")):
     d = json.loads(path.read_text())
     run = out / path.stem
@@ -58,5 +58,6 @@ for path in sorted(out.glob("*.json")):
     print(f"| {path.stem} | {state['clip']['frames']} ({fps:g}) | {state['step']} | "
           f"{state['elapsed_seconds'] / 60:.1f} min | {r['coverage']['mean']:.1f} | "
           f"{r['global_diversity']['mean']:.3f} | {r['intra_diversity_diff']:.3f} | "
+          f"{r['clip_intra_diversity']:.3f} | "
           f"{d['feet']['raw']['jitter_ratio']:.2f} | {d['sampling_seconds'] / d['samples']:.3f} |")
 PY

@@ -143,6 +143,9 @@ namespace Sinmdm
     /// library find it through ORT_DYLIB_PATH).</summary>
     public static class Runtime
     {
+        /// <summary>Respaced sampling steps used unless told otherwise (SINMDM_DEFAULT_STEPS).</summary>
+        public const uint DefaultSteps = 50;
+
         public static void Load(string path) => Native.Check(Native.sinmdm_load_onnxruntime(path == null ? null : Native.Utf8(path)));
     }
 
@@ -188,7 +191,7 @@ namespace Sinmdm
         }
 
         /// <summary>New motion: `count` samples of `frames` frames.</summary>
-        public Result Generate(int frames, ulong seed, int count = 1, uint steps = 100, Feet feet = Feet.Planted,
+        public Result Generate(int frames, ulong seed, int count = 1, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted,
                                Method method = Method.Ancestral, double eta = 0.0)
         {
             var sampling = new Native.Sampling { Seed = seed, Count = (uint)count, Steps = steps, Feet = (uint)feet,
@@ -199,7 +202,7 @@ namespace Sinmdm
 
         /// <summary>In-betweening: keep the spans of the reference given as start, end pairs
         /// (end excluded), fill the gaps.</summary>
-        public Result Inbetween(Poses reference, int[] keep, int ramp, ulong seed, uint steps = 100, Feet feet = Feet.Planted)
+        public Result Inbetween(Poses reference, int[] keep, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted)
         {
             var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
             var spans = new Native.Span[keep.Length / 2];
@@ -215,7 +218,7 @@ namespace Sinmdm
         }
 
         /// <summary>Expansion: new frames before and after the reference.</summary>
-        public Result Expand(Poses reference, int prefix, int suffix, int ramp, ulong seed, uint steps = 100, Feet feet = Feet.Planted)
+        public Result Expand(Poses reference, int prefix, int suffix, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted)
         {
             var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
             IntPtr result = IntPtr.Zero;
@@ -229,7 +232,7 @@ namespace Sinmdm
 
         /// <summary>Composition: the joints (and the root's travel when root) from the reference on
         /// every frame, the rest of the body generated.</summary>
-        public Result Compose(Poses reference, int[] joints, bool root, int ramp, ulong seed, uint steps = 100, Feet feet = Feet.Planted)
+        public Result Compose(Poses reference, int[] joints, bool root, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted)
         {
             var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
             var indices = Array.ConvertAll(joints, j => (UIntPtr)j);
@@ -244,7 +247,7 @@ namespace Sinmdm
         }
 
         /// <summary>Harmonization (style transfer): the content's low frequencies in the model's style.</summary>
-        public Result Harmonize(Poses content, int factor, double freeShare, ulong seed, uint steps = 100, Feet feet = Feet.Planted)
+        public Result Harmonize(Poses content, int factor, double freeShare, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted)
         {
             var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
             IntPtr result = IntPtr.Zero;
@@ -304,7 +307,7 @@ namespace Sinmdm
         IntPtr handle;
         readonly Model model;
 
-        public Stream(Model model, ulong seed, uint steps = 100, uint blockFrames = 0, Feet feet = Feet.Planted,
+        public Stream(Model model, ulong seed, uint steps = Runtime.DefaultSteps, uint blockFrames = 0, Feet feet = Feet.Planted,
                       Method method = Method.Ancestral)
         {
             this.model = model;

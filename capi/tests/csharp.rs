@@ -9,6 +9,16 @@ use std::process::Command;
 use common::*;
 
 #[test]
+fn the_csharp_default_steps_are_the_c_abis() {
+    let source = std::fs::read_to_string(repo().join("bindings/csharp/Sinmdm.cs")).unwrap();
+    let declared = format!(
+        "public const uint DefaultSteps = {};",
+        sinmdm_c::SINMDM_DEFAULT_STEPS
+    );
+    assert!(source.contains(&declared), "Sinmdm.cs lacks `{declared}`");
+}
+
+#[test]
 fn the_csharp_binding_gets_the_rust_values_under_mono() {
     let dir = work_dir("csharp");
     let exe = dir.join("example.exe");

@@ -1,7 +1,8 @@
 //! Seconds per training step against the clip's length, with the whole clip in every batch item
 //! and with random windows (`training.window_frames`): the batch is made from a clip of 250,
-//! 1 000 and 2 000 frames (F 191, the CMU skeleton) and one optimisation step taken (C 128,
-//! batch 8, the CPU configuration). Medians of the timed steps, side by side in one run.
+//! 1 000 and 2 000 frames (F 191, the CMU skeleton) and one optimisation step taken with the
+//! default configuration's model, batch and window. Medians of the timed steps, side by side in
+//! one run.
 //! Run: `cargo bench -p sinmdm-train --bench clip_length` (`SINMDM_BENCH_STEPS`, default 3).
 
 use std::time::Instant;
@@ -17,7 +18,11 @@ use sinmdm_train::trainer::{new_optimizer, optimisation_step};
 fn main() {
     sinmdm_train::memory::keep_freed_memory();
     let config: TrainConfig =
-        TrainConfig::parse(include_str!("../../configs/cpu.yaml")).expect("cpu config");
+        TrainConfig::parse(include_str!("../../configs/default.yaml")).expect("default config");
+    let window = config
+        .training
+        .window_frames
+        .expect("the default trains on windows");
     let timed: usize = std::env::var("SINMDM_BENCH_STEPS")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -31,14 +36,16 @@ fn main() {
     );
     println!(
         "{:>7} {:>14} {:>14}",
-        "frames", "whole clip s", "window 128 s"
+        "frames",
+        "whole clip s",
+        format!("window {window} s")
     );
     for frames in [250usize, 1000, 2000] {
         let clip = Array2::from_shape_fn((f, frames), |(r, c)| {
             ((r as f32) * 0.37 + (c as f32) * 0.05).sin()
         });
         let mut row = Vec::new();
-        for window in [None, Some(128)] {
+        for window in [None, Some(window)] {
             let device = Device::flex().autodiff();
             device.seed(0);
             let mut model = QnaUnet::new(f, &config.model, &device);

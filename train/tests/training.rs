@@ -337,6 +337,38 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
     assert!(text.contains("parameters      5288675"), "{text}");
     assert!(text.contains("receptive field 23 frames"), "{text}");
 
+    // Without --config, the built-in default; --fps replaces its frame rate.
+    let default = TrainConfig::load(&root().join("configs/default.yaml")).unwrap();
+    let out = Command::new(bin)
+        .arg(walk())
+        .arg("--dry-run")
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(
+        text.contains(&format!("channels C      {}", default.model.channels))
+            && text.contains(&format!(
+                "steps           {} (batch",
+                default.training.steps
+            ))
+            && text.contains("(249 frames at 30 fps)"),
+        "{text}"
+    );
+    let out = Command::new(bin)
+        .arg(walk())
+        .args(["--fps", "clip", "--dry-run"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("(994 frames at 120"), "{text}");
+    let out = Command::new(bin)
+        .arg(walk())
+        .args(["--fps", "fast", "--dry-run"])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--fps must be"));
+
     let bad = scratch("bad.yaml");
     let text = std::fs::read_to_string(root().join("configs/tiny.yaml"))
         .unwrap()

@@ -111,7 +111,12 @@ mod tests {
         let weights: Vec<f64> = (0..frames)
             .map(|f| if (3..12).contains(&f) { 1.0 } else { 0.0 })
             .collect();
-        let offset = stance_travel(&[points.clone()], &[weights], &vec![false; frames], 0);
+        let offset = stance_travel(
+            std::slice::from_ref(&points),
+            &[weights],
+            &vec![false; frames],
+            0,
+        );
         for f in 3..12 {
             let held = math::add(points[f], offset[f]);
             let first = math::add(points[3], offset[3]);
@@ -147,7 +152,12 @@ mod tests {
         let mut kept = vec![false; frames];
         kept[0] = true;
         kept[19] = true;
-        let offset = stance_travel(&[points.clone()], &[weights.clone()], &kept, 2);
+        let offset = stance_travel(
+            std::slice::from_ref(&points),
+            std::slice::from_ref(&weights),
+            &kept,
+            2,
+        );
         assert_eq!(offset[0], [0.0; 3]);
         assert_eq!(offset[19], [0.0; 3]);
         // The hand-back leaves the run's middle moving less than the foot, but still against it.

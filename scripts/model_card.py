@@ -1,0 +1,108 @@
+"""Writes a shipped model's card (onnx-models/NAME.md) from its training run and `sinmdm eval`.
+
+Usage (from the repository root, after training with the default configuration):
+    python3 scripts/model_card.py NAME CLIP.bvh RUN_DIR [--about FILE.md]
+
+It copies nothing: put the run's model at onnx-models/NAME.onnx first. The card's clip line
+and any "What it is for" section are kept from the card it replaces; the evaluation is run
+anew (`target/release/sinmdm eval`, 20 samples of twice the clip's length, default sampling,
+seed 0, and the same with all 1 000 steps).
+"""
+
+import json
+import pathlib
+import re
+import subprocess
+import sys
+
+
+def eval_text(model: pathlib.Path, clip: str, extra: list[str]) -> str:
+    out = subprocess.run(
+        ["target/release/sinmdm", "eval", "-m", str(model), "--clip", clip, "--quiet", *extra],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    return "\n".join(line for line in out.splitlines() if not line.startswith("wrote ")).strip()
+
+
+def grouped(n: int) -> str:
+    """An integer with its thousands set apart by spaces (10 000)."""
+    return f"{n:,}".replace(",", " ")
+
+
+def kept_parts(old: str) -> tuple[str, str]:
+    """The clip row and the section on what the model is for, from the old card."""
+    clip = next((line for line in old.splitlines() if line.startswith("| clip |")), "")
+    about = ""
+    match = re.search(r"^## What it is for.*?(?=^## )", old, flags=re.S | re.M)
+    if match:
+        about = match.group(0).strip() + "\n\n"
+    return clip, about
+
+
+def main() -> None:
+    name, clip, run = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
+    card = pathlib.Path("onnx-models") / f"{name}.md"
+    model = pathlib.Path("onnx-models") / f"{name}.onnx"
+    clip_row, about = kept_parts(card.read_text() if card.exists() else "")
+    latest = (run / "latest").read_text().strip()
+    state = json.loads((run / latest / "state.json").read_text())
+    config = state["config"]
+    m, t, d = config["model"], config["training"], config["data"]
+    layout = state["clip"]["layout"]
+    contacts = len(layout["contact_joints"])
+    joints = len(layout["skeleton"]["joints"])
+    fps = "the clip's own rate" if d["fps"] is None else f"{d['fps']:g} fps"
+    config_row = (
+        f"the default (`configs/default.yaml`: C {m['channels']}, {m['heads']} heads, window "
+        f"{m['window']}, batch {t['batch_size']}, dropout {m['dropout']}, cosine learning rate "
+        f"from {t['learning_rate']:g} after {t['warmup_steps']} warm-up steps, weight average "
+        f"{t.get('ema_decay')}, windows of {t.get('window_frames')} frames, {fps}, seed {t['seed']})"
+    )
+    size_mb = model.stat().st_size / 1e6
+    extra_args = " --fps clip" if d["fps"] is None else ""
+    rows = [
+        ("clip", clip_row.split("|")[2].strip() if clip_row else f"`{clip}`"),
+        ("config", config_row),
+        ("steps", grouped(state["step"])),
+        (
+            "training time",
+            f"{state['elapsed_seconds']:.0f} s ({state['elapsed_seconds'] / 60:.1f} min) on a "
+            "2-core AMD EPYC virtual machine, nothing else running",
+        ),
+        ("loss", f"last step {state['loss']:.4f}, mean of the last 100 steps {state['recent_loss']:.4f}"),
+        (
+            "size",
+            f"{size_mb:.1f} MB, {grouped(state['parameters'])} parameters, F {state['features']} "
+            f"({joints} joints, {contacts} contacts)",
+        ),
+    ]
+    text = [f"# {name}.onnx", "", "| | |", "|---|---|"]
+    text += [f"| {k} | {v} |" for k, v in rows]
+    text += [
+        "",
+        f"Made with `sinmdm-train {clip} --out runs/{name}{extra_args} --export onnx-models/{name}.onnx`.",
+        "",
+        about.rstrip(),
+        "",
+        "## Evaluation",
+        "",
+        f"`sinmdm eval -m onnx-models/{name}.onnx --clip {clip}` (20 samples of twice the clip's "
+        "length, default sampling, seed 0): the samples as the network made them, then with their "
+        "feet planted (the default output; coverage and diversity measured on the planted motion "
+        "re-encoded), then the feet and smoothness figures of SPEC section 9.",
+        "",
+        eval_text(model, clip, []),
+        "",
+        "With all 1 000 steps (`--steps all`):",
+        "",
+        eval_text(model, clip, ["--steps", "all"]),
+        "",
+    ]
+    card.write_text("\n".join(line for line in text if line is not None).replace("\n\n\n", "\n\n"))
+    print(f"wrote {card}")
+
+
+if __name__ == "__main__":
+    main()
