@@ -1,12 +1,12 @@
 """Writes a shipped model's card (onnx-models/NAME.md) from its training run and `sinmdm eval`.
 
 Usage (from the repository root, after training with the default configuration):
-    python3 scripts/model_card.py NAME CLIP.bvh RUN_DIR [--about FILE.md]
+    python3 scripts/model_card.py NAME CLIP.bvh RUN_DIR
 
-It copies nothing: put the run's model at onnx-models/NAME.onnx first. The card's clip line
-and any "What it is for" section are kept from the card it replaces; the evaluation is run
-anew (`target/release/sinmdm eval`, 20 samples of twice the clip's length, default sampling,
-seed 0, and the same with all 1 000 steps).
+It copies nothing: put the run's model at onnx-models/NAME.onnx first. The card's clip line and
+its hand-written sections (those before "## Evaluation") are kept from the card it replaces;
+the evaluation is run anew (`target/release/sinmdm eval`, 20 samples of twice the clip's length,
+default sampling, seed 0, and the same with all 1 000 steps).
 """
 
 import json
@@ -32,10 +32,11 @@ def grouped(n: int) -> str:
 
 
 def kept_parts(old: str) -> tuple[str, str]:
-    """The clip row and the section on what the model is for, from the old card."""
+    """The clip row and the hand-written sections (every one before "## Evaluation") of the old
+    card."""
     clip = next((line for line in old.splitlines() if line.startswith("| clip |")), "")
     about = ""
-    match = re.search(r"^## What it is for.*?(?=^## )", old, flags=re.S | re.M)
+    match = re.search(r"^## (?!Evaluation).*?(?=^## Evaluation)", old, flags=re.S | re.M)
     if match:
         about = match.group(0).strip() + "\n\n"
     return clip, about
@@ -100,7 +101,7 @@ def main() -> None:
         eval_text(model, clip, ["--steps", "all"]),
         "",
     ]
-    card.write_text("\n".join(line for line in text if line is not None).replace("\n\n\n", "\n\n"))
+    card.write_text("\n".join(text).replace("\n\n\n", "\n\n"))
     print(f"wrote {card}")
 
 

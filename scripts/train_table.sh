@@ -32,7 +32,6 @@ for entry in "${clips[@]}"; do
   model="$out/$name.onnx"
   if [ ! -f "$model" ]; then
     if [ -f "$run/latest" ]; then
-      # shellcheck disable=SC2086
       "$train" --resume --out "$run" --export "$model"
     else
       # shellcheck disable=SC2086
