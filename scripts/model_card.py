@@ -85,8 +85,7 @@ def main() -> None:
         "",
         f"Made with `sinmdm-train {clip} --out runs/{name}{extra_args} --export onnx-models/{name}.onnx`.",
         "",
-        about.rstrip(),
-        "",
+        *([about.rstrip(), ""] if about.strip() else []),
         "## Evaluation",
         "",
         f"`sinmdm eval -m onnx-models/{name}.onnx --clip {clip}` (20 samples of twice the clip's "
@@ -101,7 +100,7 @@ def main() -> None:
         eval_text(model, clip, ["--steps", "all"]),
         "",
     ]
-    card.write_text("\n".join(text).replace("\n\n\n", "\n\n"))
+    card.write_text("\n".join(text))
     print(f"wrote {card}")
 
 

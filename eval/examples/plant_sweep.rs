@@ -1,64 +1,107 @@
-//! Foot planting under several settings on saved samples: the feet figures of SPEC section 9
-//! for each, to choose the defaults. Usage:
+//! Foot planting under several settings on saved samples, to choose the defaults: for each
+//! setting, the feet figures of SPEC section 9 and the coverage and global diversity of the
+//! planted motion (re-encoded, the model's contact labels kept), beside the raw samples'. It
+//! also plants the clip itself with its own labels: a pass that changes the clip much is
+//! holding feet that the clip lets move. Usage:
 //! `cargo run --release -p sinmdm-eval --example plant_sweep -- MODEL.onnx CLIP.bvh SAMPLES.json`
-//! (SAMPLES.json from `sinmdm generate --features-json`).
+//! (SAMPLES.json from `sinmdm generate --feet raw --features-json`).
 
 use std::path::Path;
 
+use ndarray::{Array2, ArrayView2};
 use sinmdm::bvh::read_bvh;
 use sinmdm::features_file::read_features;
 use sinmdm::motion::feet::{Anchor, Kept, PlantOptions, plant_feet};
-use sinmdm::motion::{decode, encode_for_model};
+use sinmdm::motion::{FeatureLayout, LocalMotion, decode, encode_for_model, encode_motion};
 use sinmdm::{Model, ModelOptions};
-use sinmdm_eval::{FeetReference, mean_scores};
+use sinmdm_eval::{FeetReference, evaluate, mean_scores, metric_features};
+
+/// Metric features of `motion`, its contact labels taken from `made` (planting leaves labels).
+fn metric_of(
+    layout: &FeatureLayout,
+    motion: &LocalMotion,
+    made: ArrayView2<'_, f32>,
+) -> Array2<f64> {
+    let mut features = encode_motion(layout, motion);
+    for row in layout.contact_rows() {
+        features.row_mut(row).assign(&made.row(row));
+    }
+    metric_features(layout, features.view())
+}
+
+/// Mean over frames of the per-frame distance between two metric feature tables.
+fn mean_frame_distance(a: &Array2<f64>, b: &Array2<f64>) -> f64 {
+    let total: f64 = a
+        .outer_iter()
+        .zip(b.outer_iter())
+        .map(|(x, y)| {
+            x.iter()
+                .zip(&y)
+                .map(|(p, q)| (p - q).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .sum();
+    total / a.nrows().max(1) as f64
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
+    if args.len() != 4 {
+        return Err("usage: plant_sweep MODEL.onnx CLIP.bvh SAMPLES.json".into());
+    }
     let model = Model::open(&args[1], &ModelOptions::default())?;
     let layout = &model.metadata().layout;
     let clip = encode_for_model(&read_bvh(Path::new(&args[2]))?, layout, None)?;
     let clip_motion = decode(layout, clip.features.view())?;
+    let clip_metric = metric_features(layout, clip.features.view());
     let reference = FeetReference::new(layout, &clip_motion);
     let (features, _) = read_features(Path::new(&args[3]))?;
     let contact_rows = layout.contact_rows();
-    let samples: Vec<_> = features
+    let labels_of = |f: ArrayView2<'_, f32>| -> Vec<Vec<f32>> {
+        contact_rows.iter().map(|&r| f.row(r).to_vec()).collect()
+    };
+    let samples = features
         .outer_iter()
-        .map(|s| {
-            let labels: Vec<Vec<f32>> = contact_rows.iter().map(|&r| s.row(r).to_vec()).collect();
-            (decode(layout, s).unwrap(), labels)
-        })
-        .collect();
-    let clip_scores = reference.scores(&clip_motion);
-    let raw = mean_scores(
-        &samples
+        .map(|s| Ok((decode(layout, s)?, labels_of(s))))
+        .collect::<Result<Vec<_>, sinmdm::motion::MotionError>>()?;
+    let benchmark = |motions: &[&LocalMotion]| -> Result<String, Box<dyn std::error::Error>> {
+        let rows: Vec<_> = motions
             .iter()
-            .map(|(m, _)| reference.scores(m))
-            .collect::<Vec<_>>(),
-    );
-    println!(
-        "ground {:.4} (layout {:?})",
-        reference.ground(),
-        layout.ground
-    );
-    println!(
-        "setting | skating % | deepest H | floor frames % | jitter ratio to raw | lifted | reach | unreached | ms/sample"
-    );
-    println!(
-        "clip | {:.1} | {:.4} | {:.1} | {:.3}",
-        100.0 * clip_scores.skating_ratio,
-        clip_scores.max_penetration,
-        100.0 * clip_scores.penetrating_frames,
-        clip_scores.jitter / raw.jitter
-    );
-    println!(
-        "raw | {:.1} | {:.4} | {:.1} | 1.000",
-        100.0 * raw.skating_ratio,
-        raw.max_penetration,
-        100.0 * raw.penetrating_frames
-    );
+            .zip(features.outer_iter())
+            .map(|(m, made)| metric_of(layout, m, made))
+            .collect();
+        let r = evaluate(clip_metric.view(), &rows, 2)?;
+        Ok(format!(
+            "{:.1} / {:.3}",
+            r.coverage.mean, r.global_diversity.mean
+        ))
+    };
+
     let base = PlantOptions::default();
     let settings = [
         ("default", base),
+        (
+            "legs only (no root travel)",
+            PlantOptions {
+                root_follows_stance: false,
+                ..base
+            },
+        ),
+        (
+            "labelled spans only",
+            PlantOptions {
+                grow_within: 0.0,
+                ..base
+            },
+        ),
+        (
+            "spans grown within 0.08 H",
+            PlantOptions {
+                grow_within: 0.08,
+                ..base
+            },
+        ),
         (
             "max hold 0.1 H",
             PlantOptions {
@@ -70,20 +113,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "max hold 0.3 H",
             PlantOptions {
                 max_hold: 0.3,
-                ..base
-            },
-        ),
-        (
-            "soft reach 0.1",
-            PlantOptions {
-                soft_reach: 0.1,
-                ..base
-            },
-        ),
-        (
-            "labelled spans only",
-            PlantOptions {
-                grow_within: 0.0,
                 ..base
             },
         ),
@@ -102,23 +131,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         ),
         (
-            "legs only (the root does not follow the stance)",
+            "soft reach 0.1",
             PlantOptions {
-                root_follows_stance: false,
+                soft_reach: 0.1,
                 ..base
             },
         ),
         (
-            "stance smoothed over 0.2 s",
+            "stance smoothed over 0.1 s",
             PlantOptions {
-                stance_smoothing_seconds: 0.2,
-                ..base
-            },
-        ),
-        (
-            "stance smoothed over 0.3 s",
-            PlantOptions {
-                stance_smoothing_seconds: 0.3,
+                stance_smoothing_seconds: 0.1,
                 ..base
             },
         ),
@@ -137,12 +159,64 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         ),
     ];
+
+    let clip_labels = labels_of(clip.features.view());
+    println!(
+        "the clip planted with its own labels (how much a setting changes motion that is right):"
+    );
+    for (name, options) in &settings[..4] {
+        let (planted, _) = plant_feet(
+            layout,
+            &clip_motion,
+            &clip_labels,
+            &Kept::default(),
+            options,
+        )?;
+        let moved = mean_frame_distance(
+            &metric_of(layout, &planted, clip.features.view()),
+            &clip_metric,
+        );
+        println!(
+            "  {name}: mean per-frame distance to the clip {moved:.3}, skating {:.1} %",
+            100.0 * reference.scores(&planted).skating_ratio
+        );
+    }
+
+    let clip_scores = reference.scores(&clip_motion);
+    let raw = mean_scores(
+        &samples
+            .iter()
+            .map(|(m, _)| reference.scores(m))
+            .collect::<Vec<_>>(),
+    );
+    println!(
+        "ground {:.4} (layout {:?})",
+        reference.ground(),
+        layout.ground
+    );
+    println!(
+        "setting | skating % | deepest H | floor frames % | jitter ratio to raw | coverage / global diversity | lifted | reach | miss mean/max H | ms/sample"
+    );
+    println!(
+        "clip | {:.1} | {:.4} | {:.1} | {:.3} | | | | |",
+        100.0 * clip_scores.skating_ratio,
+        clip_scores.max_penetration,
+        100.0 * clip_scores.penetrating_frames,
+        clip_scores.jitter / raw.jitter
+    );
+    println!(
+        "raw | {:.1} | {:.4} | {:.1} | 1.000 | {} | | | |",
+        100.0 * raw.skating_ratio,
+        raw.max_penetration,
+        100.0 * raw.penetrating_frames,
+        benchmark(&samples.iter().map(|(m, _)| m).collect::<Vec<_>>())?
+    );
     for (name, options) in settings {
         let started = std::time::Instant::now();
-        let planted: Vec<_> = samples
+        let planted = samples
             .iter()
-            .map(|(m, l)| plant_feet(layout, m, l, &Kept::default(), &options).unwrap())
-            .collect();
+            .map(|(m, l)| plant_feet(layout, m, l, &Kept::default(), &options))
+            .collect::<Result<Vec<_>, _>>()?;
         let ms = started.elapsed().as_secs_f64() * 1000.0 / samples.len() as f64;
         let s = mean_scores(
             &planted
@@ -152,13 +226,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
         let lifted: usize = planted.iter().map(|(_, s)| s.lifted_frames).sum();
         let reach: usize = planted.iter().map(|(_, s)| s.reach_frames).sum();
-        let unreached = format!(
+        let miss = format!(
             "{:.4}/{:.4}",
             planted.iter().map(|(_, s)| s.mean_miss).sum::<f64>() / planted.len() as f64,
             planted.iter().map(|(_, s)| s.max_miss).fold(0.0, f64::max)
         );
+        let scores = benchmark(&planted.iter().map(|(m, _)| m).collect::<Vec<_>>())?;
         println!(
-            "{name} | {:.1} | {:.4} | {:.1} | {:.3} | {lifted} | {reach} | {unreached} | {ms:.1}",
+            "{name} | {:.1} | {:.4} | {:.1} | {:.3} | {scores} | {lifted} | {reach} | {miss} | {ms:.1}",
             100.0 * s.skating_ratio,
             s.max_penetration,
             100.0 * s.penetrating_frames,

@@ -42,7 +42,9 @@ pub struct PlantOptions {
     pub reach_with_root: bool,
     /// A span grows on both sides while its contact point stays within this many skeleton
     /// heights of the ground (a point on the floor does not slide, whatever the label says); 0
-    /// keeps the labelled spans.
+    /// keeps the labelled spans. The default is the height band in which SPEC section 9 counts
+    /// a point as on the ground: growing further holds feet that swing low, which costs the
+    /// motion more than it fixes.
     pub grow_within: f64,
     /// Soft reach: over the last share of a chain's length the distance it reaches eases in
     /// exponentially instead of snapping straight (a knee that straightens smoothly); 0 for a
@@ -58,7 +60,8 @@ pub struct PlantOptions {
     /// kept are not moved.
     pub root_follows_stance: bool,
     /// The root's travel with the stance is averaged over this many seconds on each side of a
-    /// frame (a root that followed every tremor of a foot would shake the whole body).
+    /// frame, with weights falling linearly to the edges (a root that followed every tremor of
+    /// a foot would shake the whole body).
     pub stance_smoothing_seconds: f64,
 }
 
@@ -70,7 +73,7 @@ impl Default for PlantOptions {
             anchor: Anchor::Mean,
             iterations: 20,
             reach_with_root: false,
-            grow_within: 0.08,
+            grow_within: 0.05,
             soft_reach: 0.2,
             max_hold: 0.2,
             root_follows_stance: true,

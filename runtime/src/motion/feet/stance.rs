@@ -13,8 +13,9 @@ use crate::motion::up::horizontal;
 /// point's horizontal step counts with the smaller of its two weights; the root takes the
 /// opposite of their weighted mean step, scaled by the total weight (up to 1), so a point
 /// planted alone stays put and a swinging one pulls nothing. The per-frame moves are averaged
-/// over `2 radius + 1` frames (a root that follows every tremor of a foot would shake the whole
-/// body) and summed into offsets.
+/// over `2 radius + 1` frames with triangular weights (a root that follows every tremor of a
+/// foot would shake the whole body; a triangle lets through less of that tremor than a flat
+/// average of the same width) and summed into offsets.
 ///
 /// Where `kept[f]` the root is a task's reference and its offset is 0; a run of free frames
 /// that ends at a kept frame hands its accumulated offset back linearly over the run, so the
@@ -53,11 +54,13 @@ pub(super) fn stance_travel(
                 return [0.0; 3];
             }
             let window = f.saturating_sub(radius)..(f + radius + 1).min(frames);
-            let n = window.len() as f64;
-            math::scale(
-                step[window].iter().fold([0.0; 3], |a, &s| math::add(a, s)),
-                1.0 / n,
-            )
+            let (mut sum, mut total) = ([0.0; 3], 0.0);
+            for g in window {
+                let w = (radius + 1 - g.abs_diff(f)) as f64;
+                sum = math::add(sum, math::scale(step[g], w));
+                total += w;
+            }
+            math::scale(sum, 1.0 / total)
         })
         .collect();
     let mut offset = vec![[0.0; 3]; frames];
