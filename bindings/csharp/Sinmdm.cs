@@ -146,6 +146,10 @@ namespace Sinmdm
         /// <summary>Respaced sampling steps used unless told otherwise (SINMDM_DEFAULT_STEPS).</summary>
         public const uint DefaultSteps = 50;
 
+        /// <summary>A `steps` value that runs all of the model's diffusion steps T (SINMDM_ALL_STEPS;
+        /// slow, the reference quality). 0 gives DefaultSteps.</summary>
+        public const uint AllSteps = 4294967295;
+
         public static void Load(string path) => Native.Check(Native.sinmdm_load_onnxruntime(path == null ? null : Native.Utf8(path)));
     }
 

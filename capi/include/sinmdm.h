@@ -12,10 +12,15 @@
 #include <stdlib.h>
 
 /*
- Respaced sampling steps of the command line (the library's `DEFAULT_STEPS`); a good default
- for `SinmdmSampling::steps`.
+ Respaced sampling steps of the command line (the library's `DEFAULT_STEPS`); what a `steps`
+ of 0 gives in `SinmdmSampling` and `SinmdmStreamOptions`.
  */
 #define SINMDM_DEFAULT_STEPS 50
+
+/*
+ A `steps` value that runs all of the model's diffusion steps T (slow; the reference quality).
+ */
+#define SINMDM_ALL_STEPS UINT32_MAX
 
 /*
  Feet: contact points held still on the ground (the default).
@@ -185,7 +190,8 @@ typedef struct SinmdmSampling {
    */
   uint32_t count;
   /*
-   Respaced denoising steps; 0 runs all of the model's T steps.
+   Respaced denoising steps; 0 for `SINMDM_DEFAULT_STEPS`, `SINMDM_ALL_STEPS` for all of
+   the model's T.
    */
   uint32_t steps;
   /*
@@ -257,7 +263,8 @@ typedef struct SinmdmStreamOptions {
    */
   uint64_t seed;
   /*
-   Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STEPS`.
+   Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STEPS`, `SINMDM_ALL_STEPS` for
+   all of the model's T.
    */
   uint32_t steps;
   /*

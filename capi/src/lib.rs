@@ -37,9 +37,9 @@ pub use model::{
 };
 pub use poses::{SinmdmPoseBuffers, SinmdmPoses, sinmdm_write_bvh};
 pub use run::{
-    SINMDM_DEFAULT_STEPS, SINMDM_FEET_PLANTED, SINMDM_FEET_RAW, SINMDM_METHOD_ANCESTRAL,
-    SINMDM_METHOD_DDIM, SINMDM_METHOD_DPM2M, SinmdmResult, SinmdmSampling, SinmdmSpan,
-    sinmdm_compose, sinmdm_expand, sinmdm_generate, sinmdm_harmonize, sinmdm_inbetween,
+    SINMDM_ALL_STEPS, SINMDM_DEFAULT_STEPS, SINMDM_FEET_PLANTED, SINMDM_FEET_RAW,
+    SINMDM_METHOD_ANCESTRAL, SINMDM_METHOD_DDIM, SINMDM_METHOD_DPM2M, SinmdmResult, SinmdmSampling,
+    SinmdmSpan, sinmdm_compose, sinmdm_expand, sinmdm_generate, sinmdm_harmonize, sinmdm_inbetween,
     sinmdm_result_count, sinmdm_result_frames, sinmdm_result_free, sinmdm_result_poses,
 };
 pub use status::{SinmdmStatus, sinmdm_last_error};

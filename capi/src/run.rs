@@ -9,9 +9,21 @@ use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, poses_in, poses_out};
 use crate::status::{Failure, SinmdmStatus, guard};
 use crate::text::{give, handle, slice_arg};
 
-/// Respaced sampling steps of the command line (the library's `DEFAULT_STEPS`); a good default
-/// for `SinmdmSampling::steps`.
+/// Respaced sampling steps of the command line (the library's `DEFAULT_STEPS`); what a `steps`
+/// of 0 gives in `SinmdmSampling` and `SinmdmStreamOptions`.
 pub const SINMDM_DEFAULT_STEPS: u32 = 50;
+
+/// A `steps` value that runs all of the model's diffusion steps T (slow; the reference quality).
+pub const SINMDM_ALL_STEPS: u32 = u32::MAX;
+
+/// The library's step count for a C `steps` value: 0 is the default, `SINMDM_ALL_STEPS` all T.
+pub(crate) fn steps_arg(steps: u32) -> Option<usize> {
+    match steps {
+        0 => Some(sinmdm::DEFAULT_STEPS),
+        SINMDM_ALL_STEPS => None,
+        n => Some(n as usize),
+    }
+}
 
 /// Feet: contact points held still on the ground (the default).
 pub const SINMDM_FEET_PLANTED: u32 = 0;
@@ -63,7 +75,8 @@ pub struct SinmdmSampling {
     pub seed: u64,
     /// Samples in the batch (a crowd when more than 1).
     pub count: u32,
-    /// Respaced denoising steps; 0 runs all of the model's T steps.
+    /// Respaced denoising steps; 0 for `SINMDM_DEFAULT_STEPS`, `SINMDM_ALL_STEPS` for all of
+    /// the model's T.
     pub steps: u32,
     /// `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
     pub feet: u32,
@@ -109,7 +122,7 @@ unsafe fn run_task(
             task,
             count: sampling.count as usize,
             seed: sampling.seed,
-            steps: (sampling.steps > 0).then_some(sampling.steps as usize),
+            steps: steps_arg(sampling.steps),
             feet: feet_arg(sampling.feet)?,
             method: method_arg(sampling.method, sampling.eta)?,
         };
@@ -337,8 +350,14 @@ pub unsafe extern "C" fn sinmdm_result_free(result: *mut SinmdmResult) {
 
 #[cfg(test)]
 mod default_steps_tests {
+    use super::*;
+
     #[test]
     fn the_c_default_is_the_library_default() {
-        assert_eq!(super::SINMDM_DEFAULT_STEPS as usize, sinmdm::DEFAULT_STEPS);
+        assert_eq!(SINMDM_DEFAULT_STEPS as usize, sinmdm::DEFAULT_STEPS);
+        assert_eq!(steps_arg(0), Some(sinmdm::DEFAULT_STEPS));
+        assert_eq!(steps_arg(SINMDM_DEFAULT_STEPS), Some(sinmdm::DEFAULT_STEPS));
+        assert_eq!(steps_arg(SINMDM_ALL_STEPS), None);
+        assert_eq!(steps_arg(7), Some(7));
     }
 }

@@ -4,7 +4,7 @@ use sinmdm::{Stream, StreamCompose, StreamOptions};
 
 use crate::model::{SinmdmModel, model_arg};
 use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, pose_slices, poses_in, poses_out};
-use crate::run::{feet_arg, method_arg};
+use crate::run::{feet_arg, method_arg, steps_arg};
 use crate::status::{Failure, SinmdmStatus, guard};
 use crate::text::{give, handle, slice_arg};
 
@@ -19,7 +19,8 @@ pub struct SinmdmStream {
 pub struct SinmdmStreamOptions {
     /// Seed of the portable noise.
     pub seed: u64,
-    /// Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STEPS`.
+    /// Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STEPS`, `SINMDM_ALL_STEPS` for
+    /// all of the model's T.
     pub steps: u32,
     /// Frames each block makes final; 0 for the length of the model's training clip.
     pub block_frames: u32,
@@ -61,11 +62,7 @@ pub unsafe extern "C" fn sinmdm_stream_new(
         });
         let options = StreamOptions {
             seed: o.seed,
-            steps: Some(if o.steps == 0 {
-                sinmdm::DEFAULT_STEPS
-            } else {
-                o.steps as usize
-            }),
+            steps: steps_arg(o.steps),
             block_frames: (o.block_frames > 0).then_some(o.block_frames as usize),
             feet: feet_arg(o.feet)?,
             compose,

@@ -16,6 +16,11 @@ fn the_csharp_default_steps_are_the_c_abis() {
         sinmdm_c::SINMDM_DEFAULT_STEPS
     );
     assert!(source.contains(&declared), "Sinmdm.cs lacks `{declared}`");
+    let all = format!(
+        "public const uint AllSteps = {};",
+        sinmdm_c::SINMDM_ALL_STEPS
+    );
+    assert!(source.contains(&all), "Sinmdm.cs lacks `{all}`");
 }
 
 #[test]

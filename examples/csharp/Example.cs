@@ -42,6 +42,8 @@ static class Example
             }
             using (var quick = model.Generate(40, seed: 5, steps: 8, feet: Feet.Raw, method: Method.DpmSolver2M))
                 Print("dpm2m", quick.Poses(0));
+            using (var byDefault = model.Generate(30, seed: 9, feet: Feet.Raw))
+                Print("default_steps", byDefault.Poses(0));
             using (var between = model.Inbetween(first, new[] { 0, 10, 30, 40 }, 5, seed: 3, steps: 4))
                 Print("inbetween", between.Poses(0));
             using (var expanded = model.Expand(first, 5, 7, 3, seed: 2, steps: 3))

@@ -140,6 +140,17 @@ int main(int argc, char **argv) {
   poses_free(&quick_poses);
   sinmdm_result_free(quick);
 
+  /* Zeroed steps: the default step count (SINMDM_DEFAULT_STEPS). */
+  SinmdmSampling zeroed = {9, 1, 0, SINMDM_FEET_RAW, SINMDM_METHOD_ANCESTRAL, 0.0};
+  SinmdmResult *by_default = NULL;
+  CHECK_OK(sinmdm_generate(model, &zeroed, 30, &by_default));
+  Poses default_poses = poses_alloc(30, joints);
+  SinmdmPoseBuffers bd = buffers_of(&default_poses);
+  CHECK_OK(sinmdm_result_poses(by_default, 0, &bd));
+  print_poses("default_steps", &default_poses);
+  poses_free(&default_poses);
+  sinmdm_result_free(by_default);
+
   /* An in-between of sample 0: keep 0..10 and 30..40. */
   SinmdmPoses reference = input_of(&sample0);
   SinmdmSpan keep[2] = {{0, 10}, {30, 40}};

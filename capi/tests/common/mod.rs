@@ -122,6 +122,21 @@ pub fn expected() -> BTreeMap<String, String> {
     )
     .unwrap();
     pose_lines("dpm2m", &quick.poses(0).unwrap(), &mut out);
+    // A zeroed `steps` in C is the library's default step count.
+    let default_steps = sinmdm::run(
+        &mut model,
+        &Request {
+            task: Task::Generate { frames: 30 },
+            count: 1,
+            seed: 9,
+            steps: Some(sinmdm::DEFAULT_STEPS),
+            feet: Feet::Raw,
+            method: Default::default(),
+        },
+        go,
+    )
+    .unwrap();
+    pose_lines("default_steps", &default_steps.poses(0).unwrap(), &mut out);
     let layout = model.metadata().layout.clone();
     let reference = features_from_poses(&layout, &crowd.poses(0).unwrap()).unwrap();
     let between = sinmdm::run(
