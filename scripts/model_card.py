@@ -42,6 +42,15 @@ def kept_parts(old: str) -> tuple[str, str]:
     return clip, about
 
 
+def frames_seen(t: dict) -> str:
+    """What a step sees of the clip, as the run's configuration says."""
+    if t.get("frames_per_step"):
+        return f"{t['frames_per_step']} frames per step"
+    if t.get("window_frames"):
+        return f"windows of {t['window_frames']} frames"
+    return "the whole clip"
+
+
 def main() -> None:
     name, clip, run = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
     card = pathlib.Path("onnx-models") / f"{name}.md"
@@ -59,7 +68,7 @@ def main() -> None:
         f"the default (`configs/default.yaml`: C {m['channels']}, {m['heads']} heads, window "
         f"{m['window']}, batch {t['batch_size']}, dropout {m['dropout']}, cosine learning rate "
         f"from {t['learning_rate']:g} after {t['warmup_steps']} warm-up steps, weight average "
-        f"{t.get('ema_decay')}, windows of {t.get('window_frames')} frames, {fps}, seed {t['seed']})"
+        f"{t.get('ema_decay')}, {frames_seen(t)}, {fps}, seed {t['seed']})"
     )
     size_mb = model.stat().st_size / 1e6
     extra_args = " --fps clip" if d["fps"] is None else ""

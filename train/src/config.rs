@@ -78,6 +78,24 @@ pub struct TrainingConfig {
     /// so a step costs the same whatever the clip's length; absent or `null` uses the whole clip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub window_frames: Option<usize>,
+    /// Frames a step sees in all, in place of `batch_size` copies of the clip: a clip of F
+    /// frames gets round(frames_per_step / F) batch items (at least 1, at most `batch_size`),
+    /// each the whole stretched clip, or a random window of `frames_per_step` frames of one
+    /// that is longer. A step then costs about the same whatever the clip's length, and
+    /// GroupNorm's statistics are those of the whole clip, as when sampling. Absent or `null`:
+    /// `batch_size` items of `window_frames`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frames_per_step: Option<usize>,
+}
+
+/// What every step's batch is made of, for one clip ([`TrainingConfig::batch_shape`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BatchShape {
+    /// Batch items (each with its own timestep and noise).
+    pub items: usize,
+    /// Frames of the stretched clip each item sees: a random window, or the whole clip when
+    /// `None` or longer than the clip.
+    pub window: Option<usize>,
 }
 
 /// How the learning rate moves over a run.
@@ -103,6 +121,22 @@ fn is_zero(n: &u64) -> bool {
 }
 
 impl TrainingConfig {
+    /// The batch of every step for a clip of `clip_frames` frames (at the training frame
+    /// rate, before stretching).
+    pub fn batch_shape(&self, clip_frames: usize) -> BatchShape {
+        match self.frames_per_step {
+            Some(budget) => BatchShape {
+                items: ((budget as f64 / clip_frames.max(1) as f64).round() as usize)
+                    .clamp(1, self.batch_size.max(1)),
+                window: Some(budget),
+            },
+            None => BatchShape {
+                items: self.batch_size,
+                window: self.window_frames,
+            },
+        }
+    }
+
     /// The learning rate of step `step` (counting from 0) under the `cosine` schedule.
     pub fn cosine_rate(&self, step: u64) -> f64 {
         let peak = self.learning_rate;
@@ -266,13 +300,25 @@ impl TrainConfig {
                 t.resample_min, t.resample_max
             ));
         }
-        if let Some(w) = t.window_frames
-            && w < m.receptive_field()
-        {
-            return Err(format!(
-                "training.window_frames must be at least the receptive field ({} frames), got {w}",
-                m.receptive_field()
-            ));
+        for (key, frames) in [
+            ("training.window_frames", t.window_frames),
+            ("training.frames_per_step", t.frames_per_step),
+        ] {
+            if let Some(w) = frames
+                && w < m.receptive_field()
+            {
+                return Err(format!(
+                    "{key} must be at least the receptive field ({} frames), got {w}",
+                    m.receptive_field()
+                ));
+            }
+        }
+        if t.window_frames.is_some() && t.frames_per_step.is_some() {
+            return Err(
+                "training.window_frames and training.frames_per_step are two ways of bounding a \
+                 step's cost: set one of them (or neither)"
+                    .into(),
+            );
         }
         if let Some(fps) = self.data.fps
             && !(fps.is_finite() && fps > 0.0)
@@ -350,6 +396,52 @@ mod tests {
         assert_eq!(paper.training.batch_size, 64);
         assert_eq!(paper.training.steps, 60_000);
         assert_eq!(paper.model.receptive_field(), 23);
+    }
+
+    #[test]
+    fn frames_per_step_sets_items_and_window_from_the_clip_length() {
+        let default = TrainConfig::parse(include_str!("../../configs/default.yaml")).unwrap();
+        let t = &default.training;
+        assert_eq!(t.frames_per_step, Some(2048));
+        // 2048 / 249 = 8.2: the batch size; 2048 / 276 = 7.4; 2048 / 1054 = 1.9; a long clip
+        // gets one window of 2048 frames; a short one never more than batch_size items.
+        let shape = |frames| {
+            let s = t.batch_shape(frames);
+            (s.items, s.window)
+        };
+        assert_eq!(shape(249), (8, Some(2048)));
+        assert_eq!(shape(276), (7, Some(2048)));
+        assert_eq!(shape(1054), (2, Some(2048)));
+        assert_eq!(shape(5000), (1, Some(2048)));
+        assert_eq!(shape(60), (8, Some(2048)));
+        // Without it: batch_size items of window_frames.
+        let mut fixed = t.clone();
+        fixed.frames_per_step = None;
+        fixed.window_frames = Some(128);
+        assert_eq!(
+            fixed.batch_shape(1054),
+            BatchShape {
+                items: 8,
+                window: Some(128)
+            }
+        );
+    }
+
+    #[test]
+    fn frames_per_step_excludes_window_frames_and_covers_the_receptive_field() {
+        let text = include_str!("../../configs/default.yaml");
+        let both = text.replace(
+            "  frames_per_step: 2048",
+            "  frames_per_step: 2048\n  window_frames: 256",
+        );
+        let err = TrainConfig::parse(&both).unwrap_err();
+        assert!(err.contains("set one of them"), "{err}");
+        let tiny = text.replace("  frames_per_step: 2048", "  frames_per_step: 10");
+        let err = TrainConfig::parse(&tiny).unwrap_err();
+        assert!(
+            err.contains("training.frames_per_step must be at least"),
+            "{err}"
+        );
     }
 
     #[test]

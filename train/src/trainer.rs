@@ -291,12 +291,13 @@ impl Trainer {
         self.device.seed(sinmdm::diffusion::noise::mix(
             config.training.seed ^ step.wrapping_mul(0x9E37_79B9),
         ));
+        let shape = config.training.batch_shape(self.clip.features.ncols());
         let batch = make_batch(
             self.clip.features.view(),
             &self.schedule,
-            config.training.batch_size,
+            shape.items,
             (config.training.resample_min, config.training.resample_max),
-            config.training.window_frames,
+            shape.window,
             config.training.seed,
             step,
         );
@@ -401,9 +402,11 @@ impl Trainer {
     }
 }
 
-/// Seconds one optimiser step of `config` on `clip` takes on `device`: the median of `steps`
-/// timed steps (after two untimed ones) of a throw-away run in a temporary folder. This is
-/// what a time budget (`sinmdm-train --minutes`) turns into a step count.
+/// Seconds one optimiser step of `config` on `clip` takes on `device`: the mean of `steps`
+/// timed steps (after two untimed ones) of a throw-away run in a temporary folder. The mean,
+/// not the median: each step stretches the clip by its own random factor, and a budget is
+/// spent on the sum of the steps, slow ones included. This is what a time budget
+/// (`sinmdm-train --minutes`) turns into a step count.
 pub fn seconds_per_step(
     clip: &Path,
     config: &TrainConfig,
@@ -425,8 +428,7 @@ pub fn seconds_per_step(
                 times.push(begun.elapsed().as_secs_f64());
             }
         }
-        times.sort_by(f64::total_cmp);
-        Ok(times[times.len() / 2])
+        Ok(times.iter().sum::<f64>() / times.len().max(1) as f64)
     })();
     let _ = std::fs::remove_dir_all(&folder);
     measured

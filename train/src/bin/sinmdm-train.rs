@@ -105,11 +105,11 @@ fn new_run_config(args: &Args) -> Result<TrainConfig> {
 }
 
 /// Timing steps of the probe behind --minutes.
-const PROBE_STEPS: u64 = 12;
+const PROBE_STEPS: u64 = 16;
 /// Seconds kept back from a --minutes budget for loading, checkpoints and the export.
 const BUDGET_RESERVE_SECONDS: f64 = 5.0;
 /// Share of a --minutes budget kept back for steps slower than the probe's.
-const BUDGET_MARGIN: f64 = 0.04;
+const BUDGET_MARGIN: f64 = 0.06;
 
 /// Sets `config.training.steps` (and a warm-up longer than a tenth of them) so that training
 /// ends within `minutes`, from a timing probe.
@@ -162,9 +162,14 @@ fn dry_run(args: &Args) -> Result<()> {
     println!("channels C      {}", config.model.channels);
     println!("parameters      {}", model.num_params());
     println!("receptive field {} frames", config.model.receptive_field());
+    let shape = config.training.batch_shape(data.features.ncols());
+    let window = match shape.window {
+        Some(w) if w < data.features.ncols() => format!("random windows of {w} frames"),
+        _ => "the whole clip".into(),
+    };
     println!(
-        "steps           {} (batch {})",
-        config.training.steps, config.training.batch_size
+        "steps           {} (batch {} x {window})",
+        config.training.steps, shape.items
     );
     Ok(())
 }
