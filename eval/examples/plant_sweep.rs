@@ -110,9 +110,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         ),
         (
-            "max hold 0.3 H",
+            "max hold 0.2 H",
             PlantOptions {
-                max_hold: 0.3,
+                max_hold: 0.2,
+                ..base
+            },
+        ),
+        (
+            "max hold 0.25 H",
+            PlantOptions {
+                max_hold: 0.25,
+                ..base
+            },
+        ),
+        (
+            "max hold 0.4 H",
+            PlantOptions {
+                max_hold: 0.4,
                 ..base
             },
         ),

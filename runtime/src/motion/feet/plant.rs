@@ -75,9 +75,9 @@ impl Default for PlantOptions {
             reach_with_root: false,
             grow_within: 0.05,
             soft_reach: 0.2,
-            max_hold: 0.2,
+            max_hold: 0.3,
             root_follows_stance: true,
-            stance_smoothing_seconds: 0.3,
+            stance_smoothing_seconds: 0.4,
         }
     }
 }
