@@ -12,22 +12,9 @@ use ndarray::{Array2, ArrayView2};
 use sinmdm::bvh::read_bvh;
 use sinmdm::features_file::read_features;
 use sinmdm::motion::feet::{Anchor, Kept, PlantOptions, plant_feet};
-use sinmdm::motion::{FeatureLayout, LocalMotion, decode, encode_for_model, encode_motion};
+use sinmdm::motion::{LocalMotion, decode, encode_for_model};
 use sinmdm::{Model, ModelOptions};
-use sinmdm_eval::{FeetReference, evaluate, mean_scores, metric_features};
-
-/// Metric features of `motion`, its contact labels taken from `made` (planting leaves labels).
-fn metric_of(
-    layout: &FeatureLayout,
-    motion: &LocalMotion,
-    made: ArrayView2<'_, f32>,
-) -> Array2<f64> {
-    let mut features = encode_motion(layout, motion);
-    for row in layout.contact_rows() {
-        features.row_mut(row).assign(&made.row(row));
-    }
-    metric_features(layout, features.view())
-}
+use sinmdm_eval::{FeetReference, evaluate, mean_scores, metric_features, motion_metric_features};
 
 /// Mean over frames of the per-frame distance between two metric feature tables.
 fn mean_frame_distance(a: &Array2<f64>, b: &Array2<f64>) -> f64 {
@@ -69,7 +56,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let rows: Vec<_> = motions
             .iter()
             .zip(features.outer_iter())
-            .map(|(m, made)| metric_of(layout, m, made))
+            .map(|(m, made)| motion_metric_features(layout, m, made))
             .collect();
         let r = evaluate(clip_metric.view(), &rows, 2)?;
         Ok(format!(
@@ -187,7 +174,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             options,
         )?;
         let moved = mean_frame_distance(
-            &metric_of(layout, &planted, clip.features.view()),
+            &motion_metric_features(layout, &planted, clip.features.view()),
             &clip_metric,
         );
         println!(

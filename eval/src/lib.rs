@@ -39,7 +39,7 @@ use ndarray::{Array2, ArrayView2, Axis};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use sinmdm::motion::{ColumnKind, FeatureLayout};
+use sinmdm::motion::{ColumnKind, FeatureLayout, LocalMotion, encode_motion};
 
 pub use feet::{
     FeetReference, FeetReport, FeetScores, GROUND_BAND, PENETRATION_TOLERANCE, SKATING_SPEED,
@@ -114,6 +114,21 @@ pub fn metric_features(layout: &FeatureLayout, features: ArrayView2<'_, f32>) ->
     Array2::from_shape_fn((frames, columns.len()), |(n, c)| {
         f64::from(features[[columns[c], n]])
     })
+}
+
+/// The metric features of decoded `motion` (planted feet, say), re-encoded in `layout`, with
+/// the contact labels of `made`, the features `[F, N]` it came from: planting changes rotations
+/// and the root, never the labels the model predicted.
+pub fn motion_metric_features(
+    layout: &FeatureLayout,
+    motion: &LocalMotion,
+    made: ArrayView2<'_, f32>,
+) -> FrameRows {
+    let mut features = encode_motion(layout, motion);
+    for row in layout.contact_rows() {
+        features.row_mut(row).assign(&made.row(row));
+    }
+    metric_features(layout, features.view())
 }
 
 /// Share (0..=1) of the clip's `window`-frame windows whose best match in `sample` is closer

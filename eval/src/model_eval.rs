@@ -5,11 +5,14 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use ndarray::{Array2, ArrayView2};
-use sinmdm::motion::{MotionError, decode, encode_motion};
+use sinmdm::motion::{MotionError, decode};
 use sinmdm::{Denoiser, Generated, ModelMetadata, Request, TaskError};
 use thiserror::Error;
 
-use crate::{COVERAGE_WINDOW, EvalError, FeetReport, Report, evaluate, metric_features};
+use crate::{
+    COVERAGE_WINDOW, EvalError, FeetReport, Report, evaluate, metric_features,
+    motion_metric_features,
+};
 
 /// Why a model could not be scored.
 #[derive(Debug, Error)]
@@ -100,18 +103,10 @@ pub fn evaluate_generated(
     let planted = (0..generated.count())
         .map(|i| Ok(generated.planted_motion(i)?.0))
         .collect::<Result<Vec<_>, MotionError>>()?;
-    // Planting changes rotations and the root's height; the contact labels stay the model's.
-    let contact_rows = layout.contact_rows();
     let planted_samples: Vec<Array2<f64>> = planted
         .iter()
         .zip(generated.features.outer_iter())
-        .map(|(motion, made)| {
-            let mut features = encode_motion(layout, motion);
-            for &row in &contact_rows {
-                features.row_mut(row).assign(&made.row(row));
-            }
-            metric_features(layout, features.view())
-        })
+        .map(|(motion, made)| motion_metric_features(layout, motion, made))
         .collect();
     let planted_report = evaluate(clip_metric.view(), &planted_samples, threads.max(1))?;
     let feet = FeetReport::new(layout, &decode(layout, clip)?, &raw, &planted);

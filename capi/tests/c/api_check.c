@@ -86,6 +86,19 @@ static void poses_free(Poses *p) {
   free(p->trans);
 }
 
+/* Generates `frames` frames with `sampling` and prints the first sample under `label`. */
+static void print_generated(SinmdmModel *model, const SinmdmSampling *sampling, size_t frames,
+                            size_t joints, const char *label) {
+  SinmdmResult *result = NULL;
+  CHECK_OK(sinmdm_generate(model, sampling, frames, &result));
+  Poses poses = poses_alloc(frames, joints);
+  SinmdmPoseBuffers buffers = buffers_of(&poses);
+  CHECK_OK(sinmdm_result_poses(result, 0, &buffers));
+  print_poses(label, &poses);
+  poses_free(&poses);
+  sinmdm_result_free(result);
+}
+
 int main(int argc, char **argv) {
   if (argc != 4) {
     fprintf(stderr, "usage: api_check MODEL.onnx NOT_A_MODEL OUT.bvh\n");
@@ -131,25 +144,11 @@ int main(int argc, char **argv) {
 
   /* A few-step deterministic sample. */
   SinmdmSampling few = {5, 1, 8, SINMDM_FEET_RAW, SINMDM_METHOD_DPM2M, 0.0};
-  SinmdmResult *quick = NULL;
-  CHECK_OK(sinmdm_generate(model, &few, 40, &quick));
-  Poses quick_poses = poses_alloc(40, joints);
-  SinmdmPoseBuffers bq = buffers_of(&quick_poses);
-  CHECK_OK(sinmdm_result_poses(quick, 0, &bq));
-  print_poses("dpm2m", &quick_poses);
-  poses_free(&quick_poses);
-  sinmdm_result_free(quick);
+  print_generated(model, &few, 40, joints, "dpm2m");
 
   /* Zeroed steps: the default step count (SINMDM_DEFAULT_STEPS). */
   SinmdmSampling zeroed = {9, 1, 0, SINMDM_FEET_RAW, SINMDM_METHOD_ANCESTRAL, 0.0};
-  SinmdmResult *by_default = NULL;
-  CHECK_OK(sinmdm_generate(model, &zeroed, 30, &by_default));
-  Poses default_poses = poses_alloc(30, joints);
-  SinmdmPoseBuffers bd = buffers_of(&default_poses);
-  CHECK_OK(sinmdm_result_poses(by_default, 0, &bd));
-  print_poses("default_steps", &default_poses);
-  poses_free(&default_poses);
-  sinmdm_result_free(by_default);
+  print_generated(model, &zeroed, 30, joints, "default_steps");
 
   /* An in-between of sample 0: keep 0..10 and 30..40. */
   SinmdmPoses reference = input_of(&sample0);
