@@ -70,7 +70,7 @@ fn main() {
                 let x0 = Tensor::<3>::from_data(TensorData::new(b.clean, shape), &device);
                 let t: Vec<f32> = b.timesteps.iter().map(|&t| t as f32).collect();
                 let t = Tensor::<1>::from_data(TensorData::new(t, [items]), &device);
-                let (next, loss) = optimisation_step(model, &mut optimizer, xt, t, x0, 1e-4);
+                let (next, loss) = optimisation_step(model, &mut optimizer, xt, t, x0, 1e-4, None);
                 model = next;
                 assert!(loss.is_finite());
                 if step >= 1 {

@@ -58,6 +58,7 @@ fn main() {
                 t.clone(),
                 x0.clone(),
                 1e-4,
+                None,
             );
             model = next;
             assert!(loss.is_finite());

@@ -86,6 +86,11 @@ pub struct TrainingConfig {
     /// `batch_size` items of `window_frames`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub frames_per_step: Option<usize>,
+    /// Weight of the foot-contact term of the loss ([`crate::foot_contact`]): the squared
+    /// speed, in skeleton heights per second, of each predicted contact point where the clip's
+    /// label says the foot is on the ground. Absent or 0 leaves the term out.
+    #[serde(default, skip_serializing_if = "is_zero_weight")]
+    pub foot_contact_weight: f64,
 }
 
 /// What every step's batch is made of, for one clip ([`TrainingConfig::batch_shape`]).
@@ -118,6 +123,10 @@ impl LrSchedule {
 
 fn is_zero(n: &u64) -> bool {
     *n == 0
+}
+
+fn is_zero_weight(w: &f64) -> bool {
+    *w == 0.0
 }
 
 impl TrainingConfig {
@@ -249,6 +258,12 @@ impl TrainConfig {
             return Err(format!(
                 "model.heads ({}) must divide model.channels ({})",
                 m.heads, m.channels
+            ));
+        }
+        if !(t.foot_contact_weight.is_finite() && t.foot_contact_weight >= 0.0) {
+            return Err(format!(
+                "training.foot_contact_weight must be 0 or a positive number, got {}",
+                t.foot_contact_weight
             ));
         }
         if m.window.is_multiple_of(2) {
@@ -492,6 +507,23 @@ mod tests {
             ),
         ];
         let default = include_str!("../../configs/default.yaml");
+        assert_eq!(
+            TrainConfig::parse(default)
+                .unwrap()
+                .training
+                .foot_contact_weight,
+            0.0
+        );
+        let weighted = default.replace("foot_contact_weight: 0.0", "foot_contact_weight: 1.0");
+        assert_eq!(
+            TrainConfig::parse(&weighted)
+                .unwrap()
+                .training
+                .foot_contact_weight,
+            1.0
+        );
+        let err = TrainConfig::parse(&weighted.replace("weight: 1.0", "weight: -0.5")).unwrap_err();
+        assert!(err.contains("training.foot_contact_weight"), "{err}");
         for (from, to, expected) in cases {
             assert!(default.contains(from), "default.yaml lacks `{from}`");
             let err = TrainConfig::parse(&default.replacen(from, to, 1)).unwrap_err();

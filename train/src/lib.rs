@@ -11,6 +11,7 @@ pub mod config;
 pub mod data;
 pub mod error;
 pub mod export;
+pub mod foot_contact;
 pub mod loss_log;
 pub mod loss_plot;
 pub mod memory;
@@ -23,3 +24,11 @@ pub use config::TrainConfig;
 pub use error::TrainError;
 pub use model::QnaUnet;
 pub use trainer::{RunEnd, StepReport, Trainer};
+
+/// Tests that seed or draw from the CPU device's random generator, which every test thread
+/// shares, hold this lock, so that one test's draws never fall between another's seed and draw.
+#[cfg(test)]
+pub(crate) fn device_random_lock() -> std::sync::MutexGuard<'static, ()> {
+    static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    LOCK.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}

@@ -16,6 +16,7 @@ use crate::clip_data::ClipData;
 use crate::config::TrainConfig;
 use crate::data::make_batch;
 use crate::error::{TrainError, io};
+use crate::foot_contact::FootContact;
 use crate::loss_log::LossLog;
 use crate::model::{QnaUnet, on_cpu};
 use crate::shards::sharded_gradients;
@@ -69,6 +70,8 @@ pub struct Trainer {
     session_start: Instant,
     elapsed_before: f64,
     last_checkpoint: Option<PathBuf>,
+    /// The foot-contact term of the loss, when its weight is not 0 and the clip has contacts.
+    foot_contact: Option<FootContact>,
 }
 
 /// The optimiser of a configuration (AdamW, epsilon 1e-8 as in PyTorch).
@@ -88,7 +91,8 @@ pub fn new_optimizer(config: &TrainConfig) -> ModuleOptimizer {
 /// products (1.3-1.6x on 2 cores). Each shard's loss is weighted by its share of the batch, so the
 /// summed gradients are those of the whole batch's mean loss; GroupNorm's statistics are per
 /// item and the dropout masks are keyed by item, so nothing else depends on the split, which
-/// is fixed for a given thread count (same seed and `--threads`, same run).
+/// is fixed for a given thread count (same seed and `--threads`, same run). With
+/// `foot_contact`, its term times its weight is added to the loss.
 pub fn optimisation_step(
     model: QnaUnet,
     optimizer: &mut ModuleOptimizer,
@@ -96,6 +100,7 @@ pub fn optimisation_step(
     t: Tensor<1>,
     x0: Tensor<3>,
     learning_rate: f64,
+    foot_contact: Option<(&FootContact, f64)>,
 ) -> (QnaUnet, f64) {
     // A GPU runs one batch best whole.
     let shards = if on_cpu(&x_t.device()) {
@@ -103,9 +108,19 @@ pub fn optimisation_step(
     } else {
         1
     };
-    match sharded_gradients(&model, x_t, t, x0, shards) {
+    match sharded_gradients(&model, x_t, t, x0, shards, foot_contact) {
         (loss, Some(grads)) => (optimizer.step(learning_rate, model, grads), loss),
         (loss, None) => (model, loss),
+    }
+}
+
+/// The foot-contact term for `config` on `data`: none when its weight is 0 or the clip has no
+/// contact joint below its root.
+fn foot_contact_term(config: &TrainConfig, data: &ClipData) -> Option<FootContact> {
+    if config.training.foot_contact_weight > 0.0 {
+        FootContact::new(&data.facts.layout, &data.facts.normalizer)
+    } else {
+        None
     }
 }
 
@@ -157,6 +172,7 @@ impl Trainer {
             started: crate::clock::now(),
             config: config.clone(),
         };
+        let foot_contact = foot_contact_term(&config, &data);
         Ok(Trainer {
             run: run.to_path_buf(),
             device,
@@ -171,6 +187,7 @@ impl Trainer {
             session_start: Instant::now(),
             elapsed_before: 0.0,
             last_checkpoint: None,
+            foot_contact,
         })
     }
 
@@ -240,6 +257,7 @@ impl Trainer {
         let optimizer = checkpoint::load_optimizer(&dir, new_optimizer(&state.config))?;
         let log = LossLog::resume(&run.join(LOSS_LOG), state.step)?;
         let elapsed_before = state.elapsed_seconds;
+        let foot_contact = foot_contact_term(&state.config, &data);
         Ok(Trainer {
             run: run.to_path_buf(),
             device,
@@ -254,6 +272,7 @@ impl Trainer {
             session_start: Instant::now(),
             elapsed_before,
             last_checkpoint: Some(dir),
+            foot_contact,
         })
     }
 
@@ -308,8 +327,17 @@ impl Trainer {
         let t = Tensor::<1>::from_data(TensorData::new(t, [batch.batch]), &self.device);
         let model = self.model.take().expect("model present between steps");
         let learning_rate = self.state.learning_rate;
-        let (model, value) =
-            optimisation_step(model, &mut self.optimizer, noised, t, clean, learning_rate);
+        let weight = config.training.foot_contact_weight;
+        let foot_contact = self.foot_contact.as_ref().map(|term| (term, weight));
+        let (model, value) = optimisation_step(
+            model,
+            &mut self.optimizer,
+            noised,
+            t,
+            clean,
+            learning_rate,
+            foot_contact,
+        );
         if !value.is_finite() {
             self.model = Some(model);
             return Err(TrainError::NonFiniteLoss {

@@ -93,6 +93,7 @@ mod tests {
     use burn::tensor::Device;
 
     fn model(seed: u64) -> QnaUnet {
+        let _random = crate::device_random_lock();
         let device = Device::flex();
         device.seed(seed);
         let config = ModelConfig {
