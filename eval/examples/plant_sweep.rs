@@ -11,7 +11,7 @@ use std::path::Path;
 use ndarray::{Array2, ArrayView2};
 use sinmdm::bvh::read_bvh;
 use sinmdm::features_file::read_features;
-use sinmdm::motion::feet::{Anchor, Kept, PlantOptions, plant_feet};
+use sinmdm::motion::feet::{Anchor, Kept, LegSolver, PlantOptions, plant_feet};
 use sinmdm::motion::{LocalMotion, decode, encode_for_model};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_eval::{FeetReference, evaluate, mean_scores, metric_features, motion_metric_features};
@@ -66,15 +66,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
 
     let base = PlantOptions::default();
+    let positions = PlantOptions {
+        solver: LegSolver::Positions,
+        ..base
+    };
     let settings = [
         ("default", base),
-        (
-            "legs only (no root travel)",
-            PlantOptions {
-                root_follows_stance: false,
-                ..base
-            },
-        ),
+        ("positions solver (two-bone / FABRIK)", positions),
         (
             "labelled spans only",
             PlantOptions {
@@ -90,9 +88,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         ),
         (
-            "max hold 0.1 H",
+            "legs only (no root travel)",
             PlantOptions {
-                max_hold: 0.1,
+                root_follows_stance: false,
                 ..base
             },
         ),
@@ -100,13 +98,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "max hold 0.2 H",
             PlantOptions {
                 max_hold: 0.2,
-                ..base
-            },
-        ),
-        (
-            "max hold 0.25 H",
-            PlantOptions {
-                max_hold: 0.25,
                 ..base
             },
         ),
@@ -125,30 +116,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         ),
         (
-            "blend 0.3 s",
+            "blend 0.2 s",
             PlantOptions {
-                blend_seconds: 0.3,
+                blend_seconds: 0.2,
                 ..base
             },
         ),
         (
-            "soft reach 0.1",
+            "stance smoothed over 0.2 s",
             PlantOptions {
-                soft_reach: 0.1,
+                stance_smoothing_seconds: 0.2,
                 ..base
             },
         ),
         (
-            "stance smoothed over 0.1 s",
+            "stance smoothed over 0.4 s",
             PlantOptions {
-                stance_smoothing_seconds: 0.1,
+                stance_smoothing_seconds: 0.4,
                 ..base
             },
         ),
         (
-            "stance smoothed over 0.5 s",
+            "soft reach 0",
             PlantOptions {
-                stance_smoothing_seconds: 0.5,
+                soft_reach: 0.0,
                 ..base
             },
         ),
@@ -157,6 +148,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             PlantOptions {
                 reach_with_root: true,
                 ..base
+            },
+        ),
+        (
+            "positions solver, blend 0.2 s, stance over 0.4 s (the previous default)",
+            PlantOptions {
+                blend_seconds: 0.2,
+                stance_smoothing_seconds: 0.4,
+                ..positions
             },
         ),
     ];

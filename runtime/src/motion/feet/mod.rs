@@ -18,7 +18,7 @@ mod stance;
 
 pub use chain::{LegChain, leg_chain};
 pub use ground::{GROUND_PERCENTILE, ground_level};
-pub use plant::{Anchor, Kept, PlantOptions, PlantStats, plant_feet};
+pub use plant::{Anchor, Kept, LegSolver, PlantOptions, PlantStats, plant_feet};
 pub use spans::{CONTACT_OFF, CONTACT_ON, contact_spans};
 
 /// What happens to the feet of generated motion.

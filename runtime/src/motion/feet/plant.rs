@@ -11,7 +11,7 @@ use super::stance::stance_travel;
 use crate::motion::clip::LocalMotion;
 use crate::motion::features::{FeatureLayout, MotionError};
 use crate::motion::fk::{GlobalPose, global_pose, global_poses};
-use crate::motion::ik::{fabrik, rotation_between, two_bone, two_bone_bent};
+use crate::motion::ik::{TurnChain, fabrik, least_turn, rotation_between, two_bone, two_bone_bent};
 use crate::motion::math::{self, Mat3, Vec3};
 use crate::motion::skeleton::Skeleton;
 use crate::motion::up::{UP, height_of, horizontal, to_canonical, to_file};
@@ -36,7 +36,8 @@ pub struct PlantOptions {
     pub blend_seconds: f64,
     /// Where a planted point is held.
     pub anchor: Anchor,
-    /// Iterations of FABRIK for chains of three or more bones.
+    /// Iterations of the iterative solvers: FABRIK's passes ([`LegSolver::Positions`], chains of
+    /// three or more bones), or a quarter of the least-turn steps ([`LegSolver::LeastTurn`]).
     pub iterations: usize,
     /// Whether the root may move up or down so that a leg reaches its target.
     pub reach_with_root: bool,
@@ -63,13 +64,27 @@ pub struct PlantOptions {
     /// frame, with weights falling linearly to the edges (a root that followed every tremor of
     /// a foot would shake the whole body).
     pub stance_smoothing_seconds: f64,
+    /// How a leg's chain is turned to put its contact point on the target.
+    pub solver: LegSolver,
+}
+
+/// How planting turns a leg's chain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LegSolver {
+    /// The least turning of every joint of the chain, the foot included (damped least squares on
+    /// the rotations): what the network made changes as little as the target allows.
+    #[default]
+    LeastTurn,
+    /// Positions first: analytic two-bone IK with the generated bend direction for a leg, FABRIK
+    /// for longer chains; the effector (the foot) keeps its global rotation.
+    Positions,
 }
 
 impl Default for PlantOptions {
     fn default() -> Self {
         PlantOptions {
             min_span_seconds: 0.1,
-            blend_seconds: 0.2,
+            blend_seconds: 0.1,
             anchor: Anchor::Mean,
             iterations: 20,
             reach_with_root: false,
@@ -77,7 +92,8 @@ impl Default for PlantOptions {
             soft_reach: 0.2,
             max_hold: 0.3,
             root_follows_stance: true,
-            stance_smoothing_seconds: 0.4,
+            stance_smoothing_seconds: 0.3,
+            solver: LegSolver::LeastTurn,
         }
     }
 }
@@ -308,7 +324,9 @@ pub fn plant_feet(
     let bends: Vec<Vec<Vec3>> = chains
         .iter()
         .map(|chain| match chain {
-            Some(c) if c.bones() == 2 => smoothed_bends(&poses, &layout.skeleton, c, bend_window),
+            Some(c) if c.bones() == 2 && options.solver == LegSolver::Positions => {
+                smoothed_bends(&poses, &layout.skeleton, c, bend_window)
+            }
             _ => Vec::new(),
         })
         .collect();
@@ -596,73 +614,142 @@ fn solve_frame(
         return global_pose(out, f);
     }
     let pose = global_pose(out, f);
-    for Wanted {
-        chain,
-        target,
-        bend,
-    } in wanted
-    {
-        let old: Vec<Vec3> = chain.joints.iter().map(|&j| pose.joints[j]).collect();
-        let exact = effector_target(&pose, chain, *target);
-        let reach: f64 = crate::motion::ik::bone_lengths(&old).iter().sum();
-        if math::norm(math::sub(exact, old[old.len() - 1])) <= 1e-12 * reach.max(f64::MIN_POSITIVE)
-        {
-            continue;
-        }
-        let goal = soften(old[0], old[old.len() - 1], exact, reach, options.soft_reach);
-        let new: Vec<Vec3> = if old.len() == 3 {
-            let [mid, end] = match bend {
-                Some(bend) => {
-                    // The generated knee's own direction where it is bent; the smoothed one
-                    // decides only for a knee that is nearly straight.
-                    let frame = above_chain(&pose, &original.skeleton, chain);
-                    let line = math::normalize_or(math::sub(goal, old[0]), [0.0; 3]);
-                    let knee = math::sub(old[1], old[0]);
-                    let across = math::sub(knee, math::scale(line, math::dot(knee, line)));
-                    let thigh = math::norm(knee);
-                    let bend = math::add(
-                        across,
-                        math::scale(math::mat_vec(&frame, *bend), BEND_FLOOR * thigh),
-                    );
-                    two_bone_bent(
-                        old[0],
-                        [
-                            math::norm(math::sub(old[1], old[0])),
-                            math::norm(math::sub(old[2], old[1])),
-                        ],
-                        goal,
-                        bend,
-                        math::sub(old[2], old[0]),
-                    )
-                }
-                None => two_bone(old[0], old[1], old[2], goal),
-            };
-            vec![old[0], mid, end]
-        } else {
-            fabrik(&old, goal, options.iterations, 1e-6 * reach)
-        };
-        let globals: Vec<Mat3> = (0..old.len() - 1)
-            .map(|i| {
-                let turn =
-                    rotation_between(math::sub(old[i + 1], old[i]), math::sub(new[i + 1], new[i]));
-                math::mat_mul(&turn, &pose.rotations[chain.joints[i]])
-            })
-            .collect();
-        let first = chain.joints[0];
-        let parent_global = original.skeleton.joints[first]
-            .parent
-            .map_or(math::IDENTITY, |p| pose.rotations[p]);
-        for (i, &j) in chain.joints.iter().enumerate() {
-            let above = if i == 0 {
-                parent_global
-            } else {
-                globals[i - 1]
-            };
-            let global = globals.get(i).copied().unwrap_or(pose.rotations[j]);
-            out.rotations[f * joints + j] = math::mat_mul(&math::transpose(&above), &global);
+    for w in wanted {
+        match options.solver {
+            LegSolver::LeastTurn => turn_least(&pose, out, f, w, options),
+            LegSolver::Positions => place_by_positions(&pose, out, f, w, options),
         }
     }
     global_pose(out, f)
+}
+
+/// Damping of the least-turn solver, in shares of the chain's reach: it keeps a nearly straight
+/// leg from swinging about where no turn moves the foot along the leg.
+const LEAST_TURN_DAMPING: f64 = 0.05;
+
+/// Least-turn steps per FABRIK iteration ([`PlantOptions::iterations`]): each is a small
+/// first-order turn, where a FABRIK pass moves whole bones.
+const LEAST_TURN_STEPS_PER_ITERATION: usize = 4;
+
+/// One chain of frame `f` turned by [`least_turn`] so that its contact point reaches its target:
+/// every joint of the chain, the foot included, turns as little as it can. `pose` is the
+/// frame's global pose before any chain was turned (chains share no joint).
+fn turn_least(
+    pose: &GlobalPose,
+    out: &mut LocalMotion,
+    f: usize,
+    wanted: &Wanted<'_>,
+    options: &PlantOptions,
+) {
+    let chain = wanted.chain;
+    let joints = out.skeleton.len();
+    let effector = chain.effector();
+    let turn = TurnChain {
+        top: pose.joints[chain.joints[0]],
+        above: above_chain(pose, &out.skeleton, chain),
+        locals: chain
+            .joints
+            .iter()
+            .map(|&j| out.rotations[f * joints + j])
+            .collect(),
+        offsets: chain.joints[1..]
+            .iter()
+            .map(|&j| out.translations[f * joints + j])
+            .collect(),
+        tip: math::mat_vec(
+            &math::transpose(&pose.rotations[effector]),
+            math::sub(pose.contact_point(chain.contact), pose.joints[effector]),
+        ),
+    };
+    let reach = turn.reach();
+    let now = pose.contact_point(chain.contact);
+    let goal = soften(turn.top, now, wanted.target, reach, options.soft_reach);
+    let locals = least_turn(
+        &turn,
+        goal,
+        LEAST_TURN_STEPS_PER_ITERATION * options.iterations,
+        1e-6 * reach,
+        LEAST_TURN_DAMPING * reach,
+    );
+    for (&j, local) in chain.joints.iter().zip(locals) {
+        out.rotations[f * joints + j] = local;
+    }
+}
+
+/// One chain of frame `f` placed by positions: analytic two-bone IK with the generated bend
+/// direction for a leg, FABRIK for longer chains, each bone then turned from its old direction
+/// to its new one, the effector keeping its global rotation.
+fn place_by_positions(
+    pose: &GlobalPose,
+    out: &mut LocalMotion,
+    f: usize,
+    wanted: &Wanted<'_>,
+    options: &PlantOptions,
+) {
+    let Wanted {
+        chain,
+        target,
+        bend,
+    } = wanted;
+    let joints = out.skeleton.len();
+    let old: Vec<Vec3> = chain.joints.iter().map(|&j| pose.joints[j]).collect();
+    let exact = effector_target(pose, chain, *target);
+    let reach: f64 = crate::motion::ik::bone_lengths(&old).iter().sum();
+    if math::norm(math::sub(exact, old[old.len() - 1])) <= 1e-12 * reach.max(f64::MIN_POSITIVE) {
+        return;
+    }
+    let goal = soften(old[0], old[old.len() - 1], exact, reach, options.soft_reach);
+    let new: Vec<Vec3> = if old.len() == 3 {
+        let [mid, end] = match bend {
+            Some(bend) => {
+                // The generated knee's own direction where it is bent; the smoothed one
+                // decides only for a knee that is nearly straight.
+                let frame = above_chain(pose, &out.skeleton, chain);
+                let line = math::normalize_or(math::sub(goal, old[0]), [0.0; 3]);
+                let knee = math::sub(old[1], old[0]);
+                let across = math::sub(knee, math::scale(line, math::dot(knee, line)));
+                let thigh = math::norm(knee);
+                let bend = math::add(
+                    across,
+                    math::scale(math::mat_vec(&frame, *bend), BEND_FLOOR * thigh),
+                );
+                two_bone_bent(
+                    old[0],
+                    [
+                        math::norm(math::sub(old[1], old[0])),
+                        math::norm(math::sub(old[2], old[1])),
+                    ],
+                    goal,
+                    bend,
+                    math::sub(old[2], old[0]),
+                )
+            }
+            None => two_bone(old[0], old[1], old[2], goal),
+        };
+        vec![old[0], mid, end]
+    } else {
+        fabrik(&old, goal, options.iterations, 1e-6 * reach)
+    };
+    let globals: Vec<Mat3> = (0..old.len() - 1)
+        .map(|i| {
+            let turn =
+                rotation_between(math::sub(old[i + 1], old[i]), math::sub(new[i + 1], new[i]));
+            math::mat_mul(&turn, &pose.rotations[chain.joints[i]])
+        })
+        .collect();
+    let first = chain.joints[0];
+    let parent_global = out.skeleton.joints[first]
+        .parent
+        .map_or(math::IDENTITY, |p| pose.rotations[p]);
+    for (i, &j) in chain.joints.iter().enumerate() {
+        let above = if i == 0 {
+            parent_global
+        } else {
+            globals[i - 1]
+        };
+        let global = globals.get(i).copied().unwrap_or(pose.rotations[j]);
+        out.rotations[f * joints + j] = math::mat_mul(&math::transpose(&above), &global);
+    }
 }
 
 /// An envelope at least `values` everywhere that rises and falls over `radius` frames: a
