@@ -78,12 +78,13 @@ impl ClipData {
             source,
         })?;
         let frames = encoded.features.ncols();
-        if frames < model.receptive_field() {
+        let receptive_field = model.at_fps(encoded.layout.fps).receptive_field();
+        if frames < receptive_field {
             return Err(TrainError::ClipTooShort {
                 path: path.to_path_buf(),
                 frames,
                 fps: encoded.layout.fps,
-                receptive_field: model.receptive_field(),
+                receptive_field,
             });
         }
         let normalizer = Normalizer::fit(encoded.features.view());

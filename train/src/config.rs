@@ -32,6 +32,19 @@ pub struct ModelConfig {
     pub window: usize,
     /// Dropout probability inside the residual blocks, in [0, 1).
     pub dropout: f64,
+    /// Whether `window` is the window at [`WINDOW_REFERENCE_FPS`], widened in proportion for a
+    /// clip trained at a higher frame rate ([`ModelConfig::at_fps`]), so that the receptive
+    /// field keeps more of its span in seconds. A run saves the window it resolved to, with this
+    /// off.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub window_follows_fps: bool,
+}
+
+/// The frame rate at which a window that follows the frame rate is meant.
+pub const WINDOW_REFERENCE_FPS: f64 = 30.0;
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 /// The diffusion process (SPEC §4).
@@ -191,6 +204,14 @@ pub struct DataConfig {
 }
 
 impl TrainConfig {
+    /// The configuration as trained on a clip at `fps` ([`ModelConfig::at_fps`]).
+    pub fn at_fps(&self, fps: f64) -> TrainConfig {
+        TrainConfig {
+            model: self.model.at_fps(fps),
+            ..self.clone()
+        }
+    }
+
     /// Why a checkpoint trained under `self` cannot continue under `asked`: the first setting
     /// (by its YAML key) that differs, comparing the whole configurations except
     /// `training.steps` and `training.checkpoint_every`, the only two a resume may change.
@@ -347,6 +368,26 @@ impl TrainConfig {
 }
 
 impl ModelConfig {
+    /// The shape trained on a clip at `fps`: with [`ModelConfig::window_follows_fps`], the
+    /// window's half-width grows by `fps / 30` (never shrinks), rounded: window 3 stays 3 at 30
+    /// fps and below, becomes 5 at 60 fps and 7 at 90.
+    pub fn at_fps(&self, fps: f64) -> ModelConfig {
+        if !self.window_follows_fps {
+            return self.clone();
+        }
+        let scale = if fps.is_finite() {
+            (fps / WINDOW_REFERENCE_FPS).max(1.0)
+        } else {
+            1.0
+        };
+        let half = ((self.window / 2) as f64 * scale).round() as usize;
+        ModelConfig {
+            window: 2 * half + 1,
+            window_follows_fps: false,
+            ..self.clone()
+        }
+    }
+
     /// Frames on each side of a frame that can change its prediction: the input and output
     /// convolutions (1 each), two k3 convolutions in each of the 3 residual blocks (2 each) and
     /// the 3 QnA windows.
@@ -562,6 +603,46 @@ mod tests {
         let err =
             TrainConfig::parse(&TINY.replacen("batch_size: 4", "batch_size: -4", 1)).unwrap_err();
         assert!(err.contains("batch_size"), "{err}");
+    }
+
+    #[test]
+    fn a_window_that_follows_the_frame_rate_widens_with_it() {
+        let default = TrainConfig::parse(include_str!("../../configs/default.yaml")).unwrap();
+        assert!(default.model.window_follows_fps);
+        assert_eq!(default.model.window, 3);
+        let window = |fps| default.at_fps(fps).model.window;
+        // Half-width 1 frame at 30 fps: 1 x fps / 30 frames, rounded, never below 1.
+        for (fps, expected) in [
+            (24.0, 3),
+            (30.0, 3),
+            (44.0, 3),
+            (46.0, 5),
+            (60.0, 5),
+            (90.0, 7),
+        ] {
+            assert_eq!(window(fps), expected, "{fps} fps");
+        }
+        // Receptive field 23 frames at 30 fps (0.77 s); 29 at 60 fps (0.48 s, 0.38 s with window 3).
+        assert_eq!(default.at_fps(60.0).model.receptive_field(), 29);
+        assert_eq!(window(f64::NAN), 3);
+        // Resolved, the flag is off, so the saved config trains the same shape at any rate.
+        let resolved = default.at_fps(60.0);
+        assert!(!resolved.model.window_follows_fps);
+        assert_eq!(resolved.at_fps(120.0).model.window, 5);
+        // A resume that asks for the default again resolves it the same way: no difference.
+        assert_eq!(resolved.resume_difference(&default.at_fps(60.0)), None);
+        // Off (the paper's configs): the window is the one written, at any frame rate.
+        let paper = TrainConfig::parse(include_str!("../../configs/paper.yaml")).unwrap();
+        assert!(!paper.model.window_follows_fps);
+        assert_eq!(paper.at_fps(120.0).model.window, 3);
+        // The saved YAML records the flag only when it is on.
+        let saved = serde_yaml::to_string(&resolved).unwrap();
+        assert!(!saved.contains("window_follows_fps"), "{saved}");
+        assert!(
+            serde_yaml::to_string(&default)
+                .unwrap()
+                .contains("window_follows_fps: true")
+        );
     }
 
     #[test]

@@ -145,6 +145,8 @@ impl Trainer {
             });
         }
         let data = ClipData::load(clip, &config.data, &config.model)?;
+        // The run saves the shape it trains: a window that follows the frame rate, resolved.
+        let config = config.at_fps(data.facts.layout.fps);
         std::fs::create_dir_all(run).map_err(io("create the output folder", run))?;
         let yaml = serde_yaml::to_string(&config).expect("config serialises");
         sinmdm::files::write_atomically(&run.join(CONFIG_COPY), yaml.as_bytes())
@@ -206,7 +208,8 @@ impl Trainer {
         })?;
         let mut state = checkpoint::load_state(&dir)?;
         if let Some(asked) = &config {
-            if let Some(message) = state.config.resume_difference(asked) {
+            let asked = asked.at_fps(state.clip.layout.fps);
+            if let Some(message) = state.config.resume_difference(&asked) {
                 return Err(TrainError::Checkpoint { path: dir, message });
             }
             state.config.training.steps = asked.training.steps;

@@ -101,6 +101,7 @@ mod tests {
             heads: 4,
             window: 3,
             dropout: 0.0,
+            window_follows_fps: false,
         };
         perturb(QnaUnet::new(7, &config, &device), 0.1)
     }

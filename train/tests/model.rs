@@ -15,6 +15,7 @@ fn paper() -> ModelConfig {
         heads: 4,
         window: 3,
         dropout: 0.5,
+        window_follows_fps: false,
     }
 }
 
@@ -41,6 +42,7 @@ fn changing_one_frame_reaches_eleven_frames_each_side() {
         heads: 4,
         window: 3,
         dropout: 0.0,
+        window_follows_fps: false,
     };
     assert_eq!(config.receptive_field(), 23);
     let (f, n, i, j) = (6, 200, 60, 140);

@@ -117,6 +117,42 @@ fn stopped_and_resumed_run_reproduces_the_uninterrupted_one() {
 }
 
 #[test]
+fn a_window_that_follows_the_frame_rate_is_saved_resolved_and_resumes() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let run = scratch("window-fps");
+    let _ = std::fs::remove_dir_all(&run);
+    let mut config = tiny();
+    config.model.window_follows_fps = true;
+    config.data.fps = Some(60.0);
+    config.training.steps = 2;
+    config.training.checkpoint_every = 1;
+    let mut trainer =
+        Trainer::start(&walk(), config.clone(), &run, Device::flex().autodiff()).unwrap();
+    trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
+    // Window 3 at 30 fps is window 5 at 60, and the run records it as trained.
+    let saved = TrainConfig::load(&run.join("config.yaml")).unwrap();
+    assert_eq!(saved.model.window, 5);
+    assert!(!saved.model.window_follows_fps);
+    assert_eq!(trainer.state().config.model.receptive_field(), 29);
+    drop(trainer);
+    // Asking for the same (unresolved) config again continues the run.
+    config.training.steps = 3;
+    let mut resumed =
+        Trainer::resume(&run, None, Some(config.clone()), Device::flex().autodiff()).unwrap();
+    resumed.run(&AtomicBool::new(false), |_| {}).unwrap();
+    assert_eq!(resumed.state().step, 3);
+    drop(resumed);
+    // Another window is refused, by its key.
+    config.model.window_follows_fps = false;
+    config.training.steps = 4;
+    let err = Trainer::resume(&run, None, Some(config), Device::flex().autodiff())
+        .err()
+        .expect("a different window");
+    assert!(err.to_string().contains("model.window"), "{err}");
+    std::fs::remove_dir_all(&run).unwrap();
+}
+
+#[test]
 fn ctrl_c_saves_and_resume_finishes_like_an_uninterrupted_run() {
     let bin = env!("CARGO_BIN_EXE_sinmdm-train");
     let config = scratch("ctrlc-config.yaml");
@@ -352,7 +388,8 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
                 "steps           {} (batch",
                 default.training.steps
             ))
-            && text.contains("(249 frames at 30 fps)"),
+            && text.contains("(249 frames at 30 fps)")
+            && text.contains("receptive field 23 frames (QnA window 3)"),
         "{text}"
     );
     let out = Command::new(bin)
@@ -362,6 +399,11 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("(994 frames at 120"), "{text}");
+    // The default's QnA window follows the frame rate: 3 at 30 fps, 9 at 120.
+    assert!(
+        text.contains("receptive field 41 frames (QnA window 9)"),
+        "{text}"
+    );
     let out = Command::new(bin)
         .arg(walk())
         .args(["--fps", "fast", "--dry-run"])

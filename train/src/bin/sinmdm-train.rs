@@ -146,6 +146,7 @@ fn dry_run(args: &Args) -> Result<()> {
     };
     let config = new_run_config(args)?;
     let data = ClipData::load(clip, &config.data, &config.model)?;
+    let config = config.at_fps(data.facts.layout.fps);
     let features = data.features.nrows();
     let model = QnaUnet::new(features, &config.model, &Device::flex());
     println!(
@@ -161,7 +162,11 @@ fn dry_run(args: &Args) -> Result<()> {
     println!("features F      {features}");
     println!("channels C      {}", config.model.channels);
     println!("parameters      {}", model.num_params());
-    println!("receptive field {} frames", config.model.receptive_field());
+    println!(
+        "receptive field {} frames (QnA window {})",
+        config.model.receptive_field(),
+        config.model.window
+    );
     let shape = config.training.batch_shape(data.features.ncols());
     let window = match shape.window {
         Some(w) if w < data.features.ncols() => format!("random windows of {w} frames"),
