@@ -13,6 +13,7 @@ use ndarray::Array2;
 use sinmdm::diffusion::Schedule;
 use sinmdm_train::config::TrainConfig;
 use sinmdm_train::data::make_batch;
+use sinmdm_train::loss::LossTerms;
 use sinmdm_train::model::QnaUnet;
 use sinmdm_train::trainer::{new_optimizer, optimisation_step};
 
@@ -70,7 +71,15 @@ fn main() {
                 let x0 = Tensor::<3>::from_data(TensorData::new(b.clean, shape), &device);
                 let t: Vec<f32> = b.timesteps.iter().map(|&t| t as f32).collect();
                 let t = Tensor::<1>::from_data(TensorData::new(t, [items]), &device);
-                let (next, loss) = optimisation_step(model, &mut optimizer, xt, t, x0, 1e-4, None);
+                let (next, loss) = optimisation_step(
+                    model,
+                    &mut optimizer,
+                    xt,
+                    t,
+                    x0,
+                    1e-4,
+                    &LossTerms::default(),
+                );
                 model = next;
                 assert!(loss.is_finite());
                 if step >= 1 {

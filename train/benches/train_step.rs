@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use burn::tensor::{Device, Distribution, Tensor, TensorData};
 use sinmdm_train::config::{ModelConfig, TrainConfig};
+use sinmdm_train::loss::LossTerms;
 use sinmdm_train::model::QnaUnet;
 use sinmdm_train::trainer::{new_optimizer, optimisation_step};
 
@@ -58,7 +59,7 @@ fn main() {
                 t.clone(),
                 x0.clone(),
                 1e-4,
-                None,
+                &LossTerms::default(),
             );
             model = next;
             assert!(loss.is_finite());

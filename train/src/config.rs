@@ -104,6 +104,10 @@ pub struct TrainingConfig {
     /// label says the foot is on the ground. Absent or 0 leaves the term out.
     #[serde(default, skip_serializing_if = "is_zero_weight")]
     pub foot_contact_weight: f64,
+    /// Weight of the acceleration term of the loss ([`crate::loss`]): the squared second
+    /// differences in time of the predicted x0's error. Absent or 0 leaves the term out.
+    #[serde(default, skip_serializing_if = "is_zero_weight")]
+    pub acceleration_weight: f64,
 }
 
 /// What every step's batch is made of, for one clip ([`TrainingConfig::batch_shape`]).
@@ -279,6 +283,12 @@ impl TrainConfig {
             return Err(format!(
                 "model.heads ({}) must divide model.channels ({})",
                 m.heads, m.channels
+            ));
+        }
+        if !(t.acceleration_weight.is_finite() && t.acceleration_weight >= 0.0) {
+            return Err(format!(
+                "training.acceleration_weight must be 0 or a positive number, got {}",
+                t.acceleration_weight
             ));
         }
         if !(t.foot_contact_weight.is_finite() && t.foot_contact_weight >= 0.0) {
@@ -565,6 +575,17 @@ mod tests {
         );
         let err = TrainConfig::parse(&weighted.replace("weight: 1.0", "weight: -0.5")).unwrap_err();
         assert!(err.contains("training.foot_contact_weight"), "{err}");
+        let accelerated = default.replace("acceleration_weight: 0.0", "acceleration_weight: 0.5");
+        assert_eq!(
+            TrainConfig::parse(&accelerated)
+                .unwrap()
+                .training
+                .acceleration_weight,
+            0.5
+        );
+        let err =
+            TrainConfig::parse(&accelerated.replace("weight: 0.5", "weight: -0.5")).unwrap_err();
+        assert!(err.contains("training.acceleration_weight"), "{err}");
         for (from, to, expected) in cases {
             assert!(default.contains(from), "default.yaml lacks `{from}`");
             let err = TrainConfig::parse(&default.replacen(from, to, 1)).unwrap_err();

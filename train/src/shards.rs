@@ -2,24 +2,22 @@
 //! CPU backend runs element-wise operations on one thread, so this puts the other cores to work.
 
 use burn::module::{Module, ModuleMapper, ModuleVisitor, Param};
-use burn::nn::loss::{MseLoss, Reduction};
 use burn::optim::GradientsParams;
 use burn::tensor::{Device, Distribution, Tensor};
 
-use crate::foot_contact::FootContact;
+use crate::loss::LossTerms;
 use crate::model::QnaUnet;
 use crate::model::dropout::DropoutKey;
 
 /// The batch's mean loss and its gradients (none when the loss is not finite), computed in
-/// `shards` shards on as many threads. The loss is the x0 MSE, plus the foot-contact term
-/// times its weight when `foot_contact` is given.
+/// `shards` shards on as many threads. The loss is the x0 MSE plus the weighted `terms`.
 pub(crate) fn sharded_gradients(
     model: &QnaUnet,
     x_t: Tensor<3>,
     t: Tensor<1>,
     x0: Tensor<3>,
     shards: usize,
-    foot_contact: Option<(&FootContact, f64)>,
+    terms: &LossTerms,
 ) -> (f64, Option<GradientsParams>) {
     let batch = x_t.dims()[0];
     let seed = dropout_seed(&x_t.device());
@@ -38,10 +36,7 @@ pub(crate) fn sharded_gradients(
             Some(key),
         );
         let target = x0.clone().narrow(0, first, len);
-        let mut loss = MseLoss::new().forward(prediction.clone(), target.clone(), Reduction::Mean);
-        if let Some((term, weight)) = foot_contact {
-            loss = loss + term.loss(&prediction, &target).mul_scalar(weight);
-        }
+        let loss = terms.loss(&prediction, &target);
         let share = len as f64 / batch as f64;
         let value = f64::from(loss.clone().into_scalar::<f32>()) * share;
         if !value.is_finite() {
@@ -167,8 +162,14 @@ mod tests {
         );
         let gradients = |shards| {
             device.seed(9);
-            let (loss, grads) =
-                sharded_gradients(&model, x_t.clone(), t.clone(), x0.clone(), shards, None);
+            let (loss, grads) = sharded_gradients(
+                &model,
+                x_t.clone(),
+                t.clone(),
+                x0.clone(),
+                shards,
+                &LossTerms::default(),
+            );
             (loss, grads.expect("finite loss"))
         };
         let (whole_loss, whole) = gradients(1);

@@ -17,6 +17,7 @@ use crate::config::TrainConfig;
 use crate::data::make_batch;
 use crate::error::{TrainError, io};
 use crate::foot_contact::FootContact;
+use crate::loss::LossTerms;
 use crate::loss_log::LossLog;
 use crate::model::{QnaUnet, on_cpu};
 use crate::shards::sharded_gradients;
@@ -91,8 +92,8 @@ pub fn new_optimizer(config: &TrainConfig) -> ModuleOptimizer {
 /// products (1.3-1.6x on 2 cores). Each shard's loss is weighted by its share of the batch, so the
 /// summed gradients are those of the whole batch's mean loss; GroupNorm's statistics are per
 /// item and the dropout masks are keyed by item, so nothing else depends on the split, which
-/// is fixed for a given thread count (same seed and `--threads`, same run). With
-/// `foot_contact`, its term times its weight is added to the loss.
+/// is fixed for a given thread count (same seed and `--threads`, same run). The loss is the
+/// x0 MSE plus the weighted `terms`.
 pub fn optimisation_step(
     model: QnaUnet,
     optimizer: &mut ModuleOptimizer,
@@ -100,7 +101,7 @@ pub fn optimisation_step(
     t: Tensor<1>,
     x0: Tensor<3>,
     learning_rate: f64,
-    foot_contact: Option<(&FootContact, f64)>,
+    terms: &LossTerms,
 ) -> (QnaUnet, f64) {
     // A GPU runs one batch best whole.
     let shards = if on_cpu(&x_t.device()) {
@@ -108,7 +109,7 @@ pub fn optimisation_step(
     } else {
         1
     };
-    match sharded_gradients(&model, x_t, t, x0, shards, foot_contact) {
+    match sharded_gradients(&model, x_t, t, x0, shards, terms) {
         (loss, Some(grads)) => (optimizer.step(learning_rate, model, grads), loss),
         (loss, None) => (model, loss),
     }
@@ -331,7 +332,10 @@ impl Trainer {
         let model = self.model.take().expect("model present between steps");
         let learning_rate = self.state.learning_rate;
         let weight = config.training.foot_contact_weight;
-        let foot_contact = self.foot_contact.as_ref().map(|term| (term, weight));
+        let terms = LossTerms {
+            foot_contact: self.foot_contact.as_ref().map(|term| (term, weight)),
+            acceleration_weight: config.training.acceleration_weight,
+        };
         let (model, value) = optimisation_step(
             model,
             &mut self.optimizer,
@@ -339,7 +343,7 @@ impl Trainer {
             t,
             clean,
             learning_rate,
-            foot_contact,
+            &terms,
         );
         if !value.is_finite() {
             self.model = Some(model);
