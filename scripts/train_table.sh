@@ -7,7 +7,7 @@
 # Usage: scripts/train_table.sh [OUT_DIR] [DOG_CLIP.bvh]
 #   OUT_DIR   runs, models and eval JSON (default out/train_table); finished runs are kept and
 #             not trained again, an interrupted one resumes
-#   DOG_CLIP  the MANN dog walk (60 fps, learned at its own rate), if you have it
+#   DOG_CLIP  the MANN dog walk (60 fps), if you have it: learned at 30 fps and at its own rate
 # Pause any other training or benchmark while this runs: the times are wall-clock on this machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,7 +24,7 @@ clips=("human_walk_cmu:tests/data/bvh/human_walk_cmu_131_01.bvh:"
        "human_hop_cmu:tests/data/bvh/human_hop_cmu_131_03.bvh:"
        "fox_survey_khronos:tests/data/bvh/fox_survey_khronos.bvh:"
        "human_dance_rokoko:tests/data/bvh/human_dance_rokoko_jesse.bvh:")
-[ -n "$dog" ] && clips+=("dog_walk_mann_60fps:$dog:--fps clip")
+[ -n "$dog" ] && clips+=("dog_walk_mann:$dog:" "dog_walk_mann_60fps:$dog:--fps clip")
 
 for entry in "${clips[@]}"; do
   IFS=: read -r name clip extra <<<"$entry"

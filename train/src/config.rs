@@ -32,16 +32,22 @@ pub struct ModelConfig {
     pub window: usize,
     /// Dropout probability inside the residual blocks, in [0, 1).
     pub dropout: f64,
-    /// Whether `window` is the window at [`WINDOW_REFERENCE_FPS`], widened in proportion for a
-    /// clip trained at a higher frame rate ([`ModelConfig::at_fps`]), so that the receptive
-    /// field keeps more of its span in seconds. A run saves the window it resolved to, with this
-    /// off.
+    /// Whether `window` is the window at [`WINDOW_REFERENCE_FPS`], widened for a clip trained
+    /// at a higher frame rate ([`ModelConfig::at_fps`]) so that the receptive field keeps its
+    /// span in seconds. A run saves the window it resolved to, with this off.
     #[serde(default, skip_serializing_if = "is_false")]
     pub window_follows_fps: bool,
 }
 
 /// The frame rate at which a window that follows the frame rate is meant.
 pub const WINDOW_REFERENCE_FPS: f64 = 30.0;
+
+/// The part of the receptive half-width that does not depend on the QnA window: the input and
+/// output convolutions (1 frame each) and two k3 convolutions in each of the 3 residual blocks.
+const FIXED_RECEPTIVE_HALF_WIDTH: usize = 1 + 3 * 2 + 1;
+
+/// QnA blocks in the UNet, each seeing `(window - 1) / 2` frames on each side.
+const QNA_BLOCKS: usize = 3;
 
 fn is_false(b: &bool) -> bool {
     !*b
@@ -379,8 +385,11 @@ impl TrainConfig {
 
 impl ModelConfig {
     /// The shape trained on a clip at `fps`: with [`ModelConfig::window_follows_fps`], the
-    /// window's half-width grows by `fps / 30` (never shrinks), rounded: window 3 stays 3 at 30
-    /// fps and below, becomes 5 at 60 fps and 7 at 90.
+    /// window that keeps the receptive field's span in seconds what it is at 30 fps (never
+    /// narrower than `window`): the receptive half-width grows by `fps / 30` and the QnA windows,
+    /// the only part of it that can, take up the difference, rounded. Window 3 (23 frames,
+    /// 0.77 s) stays 3 at 30 fps and below, and becomes 11 at 60 fps (47 frames, 0.78 s) and 25
+    /// at 120.
     pub fn at_fps(&self, fps: f64) -> ModelConfig {
         if !self.window_follows_fps {
             return self.clone();
@@ -390,7 +399,9 @@ impl ModelConfig {
         } else {
             1.0
         };
-        let half = ((self.window / 2) as f64 * scale).round() as usize;
+        let wanted = self.receptive_half_width() as f64 * scale;
+        let half = ((wanted - FIXED_RECEPTIVE_HALF_WIDTH as f64) / QNA_BLOCKS as f64).round();
+        let half = (half as usize).max(self.window / 2);
         ModelConfig {
             window: 2 * half + 1,
             window_follows_fps: false,
@@ -402,7 +413,7 @@ impl ModelConfig {
     /// convolutions (1 each), two k3 convolutions in each of the 3 residual blocks (2 each) and
     /// the 3 QnA windows.
     pub fn receptive_half_width(&self) -> usize {
-        1 + 3 * 2 + 3 * (self.window - 1) / 2 + 1
+        FIXED_RECEPTIVE_HALF_WIDTH + QNA_BLOCKS * (self.window - 1) / 2
     }
 
     /// The receptive field in frames (23 for window 3).
@@ -632,24 +643,28 @@ mod tests {
         assert!(default.model.window_follows_fps);
         assert_eq!(default.model.window, 3);
         let window = |fps| default.at_fps(fps).model.window;
-        // Half-width 1 frame at 30 fps: 1 x fps / 30 frames, rounded, never below 1.
+        // Receptive half-width 11 frames at 30 fps; 8 of them come from the convolutions and
+        // 3 x (k - 1) / 2 from the QnA windows. At f fps it should be 11 f / 30, so
+        // (k - 1) / 2 = round((11 f / 30 - 8) / 3), never below 1.
         for (fps, expected) in [
             (24.0, 3),
             (30.0, 3),
-            (44.0, 3),
-            (46.0, 5),
-            (60.0, 5),
-            (90.0, 7),
+            (33.0, 3),   // (12.1 - 8) / 3 = 1.37 -> 1
+            (35.0, 5),   // (12.83 - 8) / 3 = 1.61 -> 2
+            (40.0, 5),   // (14.67 - 8) / 3 = 2.22 -> 2
+            (60.0, 11),  // (22 - 8) / 3 = 4.67 -> 5
+            (90.0, 17),  // (33 - 8) / 3 = 8.33 -> 8
+            (120.0, 25), // (44 - 8) / 3 = 12
         ] {
             assert_eq!(window(fps), expected, "{fps} fps");
         }
-        // Receptive field 23 frames at 30 fps (0.77 s); 29 at 60 fps (0.48 s, 0.38 s with window 3).
-        assert_eq!(default.at_fps(60.0).model.receptive_field(), 29);
+        // Receptive field 23 frames at 30 fps (0.77 s); 47 at 60 fps (0.78 s).
+        assert_eq!(default.at_fps(60.0).model.receptive_field(), 47);
         assert_eq!(window(f64::NAN), 3);
         // Resolved, the flag is off, so the saved config trains the same shape at any rate.
         let resolved = default.at_fps(60.0);
         assert!(!resolved.model.window_follows_fps);
-        assert_eq!(resolved.at_fps(120.0).model.window, 5);
+        assert_eq!(resolved.at_fps(120.0).model.window, 11);
         // A resume that asks for the default again resolves it the same way: no difference.
         assert_eq!(resolved.resume_difference(&default.at_fps(60.0)), None);
         // Off (the paper's configs): the window is the one written, at any frame rate.

@@ -129,11 +129,12 @@ fn a_window_that_follows_the_frame_rate_is_saved_resolved_and_resumes() {
     let mut trainer =
         Trainer::start(&walk(), config.clone(), &run, Device::flex().autodiff()).unwrap();
     trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
-    // Window 3 at 30 fps is window 5 at 60, and the run records it as trained.
+    // Window 3 at 30 fps is window 11 at 60 (the same 0.77 s receptive field: 47 frames), and
+    // the run records it as trained.
     let saved = TrainConfig::load(&run.join("config.yaml")).unwrap();
-    assert_eq!(saved.model.window, 5);
+    assert_eq!(saved.model.window, 11);
     assert!(!saved.model.window_follows_fps);
-    assert_eq!(trainer.state().config.model.receptive_field(), 29);
+    assert_eq!(trainer.state().config.model.receptive_field(), 47);
     drop(trainer);
     // Asking for the same (unresolved) config again continues the run.
     config.training.steps = 3;
