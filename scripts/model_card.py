@@ -2,11 +2,14 @@
 
 Usage (from the repository root, after training with the default configuration):
     python3 scripts/model_card.py NAME CLIP.bvh RUN_DIR
+    python3 scripts/model_card.py NAME CLIP.bvh    # the same model, only its evaluation anew
 
 It copies nothing: put the run's model at onnx-models/NAME.onnx first. The card's clip line and
 its hand-written sections (those before "## Evaluation") are kept from the card it replaces;
 the evaluation is run anew (`target/release/sinmdm eval`, 20 samples of twice the clip's length,
-default sampling, seed 0, and the same with all 1 000 steps).
+default sampling, seed 0, and the same with all 1 000 steps). Without RUN_DIR (the model is
+unchanged, the runtime or the scoring is not), everything before "## Evaluation" is kept as it
+is.
 """
 
 import json
@@ -51,10 +54,39 @@ def frames_seen(t: dict) -> str:
     return "the whole clip"
 
 
+def evaluation(name: str, clip: str, model: pathlib.Path) -> list[str]:
+    """The card's evaluation section, run anew."""
+    return [
+        "## Evaluation",
+        "",
+        f"`sinmdm eval -m onnx-models/{name}.onnx --clip {clip}` (20 samples of twice the clip's "
+        "length, default sampling, seed 0): the samples as the network made them, then with their "
+        "feet planted (the default output; coverage and diversity measured on the planted motion "
+        "re-encoded, beside the raw motion scored the same way), then the feet and smoothness "
+        "figures of SPEC section 9.",
+        "",
+        eval_text(model, clip, []),
+        "",
+        "With all 1 000 steps (`--steps all`):",
+        "",
+        eval_text(model, clip, ["--steps", "all"]),
+        "",
+    ]
+
+
 def main() -> None:
-    name, clip, run = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
+    if len(sys.argv) not in (3, 4):
+        sys.exit(__doc__)
+    name, clip = sys.argv[1], sys.argv[2]
     card = pathlib.Path("onnx-models") / f"{name}.md"
     model = pathlib.Path("onnx-models") / f"{name}.onnx"
+    if len(sys.argv) == 3:
+        old = card.read_text()
+        head = old[: old.index("## Evaluation")] if "## Evaluation" in old else old
+        card.write_text(head.rstrip() + "\n\n" + "\n".join(evaluation(name, clip, model)))
+        print(f"wrote {card} (evaluation only)")
+        return
+    run = pathlib.Path(sys.argv[3])
     clip_row, about = kept_parts(card.read_text() if card.exists() else "")
     latest = (run / "latest").read_text().strip()
     state = json.loads((run / latest / "state.json").read_text())
@@ -95,19 +127,7 @@ def main() -> None:
         f"Made with `sinmdm-train {clip} --out runs/{name}{extra_args} --export onnx-models/{name}.onnx`.",
         "",
         *([about.rstrip(), ""] if about.strip() else []),
-        "## Evaluation",
-        "",
-        f"`sinmdm eval -m onnx-models/{name}.onnx --clip {clip}` (20 samples of twice the clip's "
-        "length, default sampling, seed 0): the samples as the network made them, then with their "
-        "feet planted (the default output; coverage and diversity measured on the planted motion "
-        "re-encoded), then the feet and smoothness figures of SPEC section 9.",
-        "",
-        eval_text(model, clip, []),
-        "",
-        "With all 1 000 steps (`--steps all`):",
-        "",
-        eval_text(model, clip, ["--steps", "all"]),
-        "",
+        *evaluation(name, clip, model),
     ]
     card.write_text("\n".join(text))
     print(f"wrote {card}")

@@ -85,6 +85,7 @@ struct EvalFile<'a> {
     seed: u64,
     sampling_seconds: f64,
     report: &'a Report,
+    raw_motion_report: &'a Report,
     planted_report: &'a Report,
     feet: &'a FeetReport,
 }
@@ -192,6 +193,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     let ModelEvaluation {
         generated,
         report,
+        raw_motion_report,
         planted_report,
         feet,
         sampling_seconds,
@@ -226,6 +228,15 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     println!("samples with their feet planted (the default output):");
     print!("{}", planted_report.markdown_table());
     println!();
+    println!(
+        "(planting's cost: coverage / global diversity {:.1} / {:.3} planted against {:.1} / {:.3} \
+         for the raw motion as written, decoded and scored the same way)",
+        planted_report.coverage.mean,
+        planted_report.global_diversity.mean,
+        raw_motion_report.coverage.mean,
+        raw_motion_report.global_diversity.mean
+    );
+    println!();
     print!("{}", feet.markdown_table());
 
     if let Some(path) = &args.features_json {
@@ -246,6 +257,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             seed: args.seed,
             sampling_seconds,
             report: &report,
+            raw_motion_report: &raw_motion_report,
             planted_report: &planted_report,
             feet: &feet,
         };

@@ -103,6 +103,13 @@ fn eval_command_prints_the_table_and_writes_json() {
     assert!((0.0..=100.0).contains(&report.coverage.mean));
     assert!((0.0..=1.0).contains(&report.harmonic_mean));
     assert!(report.global_diversity.mean.is_finite() && report.global_diversity.mean >= 0.0);
+    // The raw motion as written and the planted motion are scored too, for the same samples.
+    for key in ["raw_motion_report", "planted_report"] {
+        let other: Report = serde_json::from_value(value[key].clone()).unwrap();
+        assert_eq!(other.per_sample.len(), 3, "{key}");
+        assert_eq!(other.sample_frames, 498, "{key}");
+    }
+    assert!(stdout.contains("planting's cost"), "{stdout}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

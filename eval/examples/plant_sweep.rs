@@ -88,6 +88,42 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         ),
         (
+            "spans grown by height alone, max hold 0.3 H (the previous default)",
+            PlantOptions {
+                grow_below_speed: f64::INFINITY,
+                max_hold: 0.3,
+                ..base
+            },
+        ),
+        (
+            "spans grown by height alone",
+            PlantOptions {
+                grow_below_speed: f64::INFINITY,
+                ..base
+            },
+        ),
+        (
+            "spans grown only below 1 H/s",
+            PlantOptions {
+                grow_below_speed: 1.0,
+                ..base
+            },
+        ),
+        (
+            "spans grown only below 2 H/s",
+            PlantOptions {
+                grow_below_speed: 2.0,
+                ..base
+            },
+        ),
+        (
+            "spans grown only below 3 H/s",
+            PlantOptions {
+                grow_below_speed: 3.0,
+                ..base
+            },
+        ),
+        (
             "legs only (no root travel)",
             PlantOptions {
                 root_follows_stance: false,
@@ -95,16 +131,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         ),
         (
-            "max hold 0.2 H",
+            "max hold 0.3 H",
             PlantOptions {
-                max_hold: 0.2,
+                max_hold: 0.3,
                 ..base
             },
         ),
         (
-            "max hold 0.4 H",
+            "max hold 0.5 H",
             PlantOptions {
-                max_hold: 0.4,
+                max_hold: 0.5,
                 ..base
             },
         ),
@@ -151,10 +187,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         ),
         (
-            "positions solver, blend 0.2 s, stance over 0.4 s (the previous default)",
+            "positions solver, blend 0.2 s, stance over 0.4 s, spans grown by height alone, max hold 0.3 H",
             PlantOptions {
                 blend_seconds: 0.2,
                 stance_smoothing_seconds: 0.4,
+                grow_below_speed: f64::INFINITY,
+                max_hold: 0.3,
                 ..positions
             },
         ),
@@ -164,7 +202,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "the clip planted with its own labels (how much a setting changes motion that is right):"
     );
-    for (name, options) in &settings[..4] {
+    for (name, options) in &settings[..5] {
         let (planted, _) = plant_feet(
             layout,
             &clip_motion,

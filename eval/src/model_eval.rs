@@ -35,6 +35,10 @@ pub struct ModelEvaluation {
     pub generated: Generated,
     /// Their scores against the clip, as the network made them.
     pub report: Report,
+    /// The same scores of the raw motion as `--feet raw` writes it: decoded and re-encoded,
+    /// as the planted motion is (the network's 6D values are not exact rotations, so decoding
+    /// alone moves the scores a little). Planting's cost is `planted_report` against this.
+    pub raw_motion_report: Report,
     /// The same scores with the samples' feet planted (the motion a user gets by default).
     pub planted_report: Report,
     /// Their feet and smoothness figures, raw and planted, beside the clip's.
@@ -100,6 +104,12 @@ pub fn evaluate_generated(
     let raw = (0..generated.count())
         .map(|i| generated.raw_motion(i))
         .collect::<Result<Vec<_>, _>>()?;
+    let raw_samples: Vec<Array2<f64>> = raw
+        .iter()
+        .zip(generated.features.outer_iter())
+        .map(|(motion, made)| motion_metric_features(layout, motion, made))
+        .collect();
+    let raw_motion_report = evaluate(clip_metric.view(), &raw_samples, threads.max(1))?;
     let planted = (0..generated.count())
         .map(|i| Ok(generated.planted_motion(i)?.0))
         .collect::<Result<Vec<_>, MotionError>>()?;
@@ -113,6 +123,7 @@ pub fn evaluate_generated(
     Ok(ModelEvaluation {
         generated,
         report,
+        raw_motion_report,
         planted_report,
         feet,
         sampling_seconds,

@@ -217,6 +217,44 @@ fn sliding_foot_is_held(options: &PlantOptions) {
 }
 
 #[test]
+fn spans_grow_over_low_frames_only_where_the_foot_is_slow() {
+    // The synthetic foot stays on the ground (within 0.05 H) in every frame and slides at the
+    // hips' pace, so a span may grow over the whole clip; whether it does is decided by the
+    // foot's speed along the ground, measured here from the poses.
+    let (layout, motion) = sliding_leg();
+    let h = layout.skeleton_height;
+    let ground = layout.ground.unwrap();
+    let poses = global_poses(&motion);
+    let toe = |f: usize| poses[f].contact_point(3);
+    assert!(
+        (0..FRAMES).all(|f| toe(f)[1] - ground < 0.05 * h),
+        "the synthetic foot must stay low"
+    );
+    let fastest = (0..FRAMES - 1)
+        .map(|f| {
+            let (a, b) = (toe(f), toe(f + 1));
+            (b[0] - a[0]).hypot(b[2] - a[2]) * 30.0 / h
+        })
+        .fold(0.0, f64::max);
+    assert!(fastest > 0.0);
+    let planted_frames = |grow_below_speed: f64| {
+        let options = PlantOptions {
+            grow_within: 0.05,
+            grow_below_speed,
+            ..options()
+        };
+        let (_, stats) =
+            plant_feet(&layout, &motion, &labels(), &Kept::default(), &options).expect("planting");
+        (stats.spans, stats.planted_frames)
+    };
+    // Slower than the gate everywhere: the span grows over every low frame, the whole clip.
+    assert_eq!(planted_frames(2.0 * fastest), (1, FRAMES));
+    assert_eq!(planted_frames(f64::INFINITY), (1, FRAMES));
+    // Faster than the gate everywhere: only the labelled span is held.
+    assert_eq!(planted_frames(0.5 * fastest), (1, SPAN.len()));
+}
+
+#[test]
 fn nothing_goes_below_the_ground() {
     let (mut layout, motion) = sliding_leg();
     // A ground above the toes' lowest point: the pass must lift them to it.

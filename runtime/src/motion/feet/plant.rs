@@ -47,6 +47,13 @@ pub struct PlantOptions {
     /// a point as on the ground: growing further holds feet that swing low, which costs the
     /// motion more than it fixes.
     pub grow_within: f64,
+    /// A span grows only over frames where its contact point also moves slower than this, in
+    /// skeleton heights per second along the ground: a foot that sweeps low and fast (a swing
+    /// that grazes the floor, a hop's take-off) is motion the network meant, not a slide, and
+    /// holding it turns the leg away from what the model made. `f64::INFINITY` grows by height
+    /// alone. The default, 2.5 H/s, is well above a sliding stance (SPEC section 9 counts a
+    /// slide from 0.3 H/s) and below a swinging foot.
+    pub grow_below_speed: f64,
     /// Soft reach: over the last share of a chain's length the distance it reaches eases in
     /// exponentially instead of snapping straight (a knee that straightens smoothly); 0 for a
     /// hard limit.
@@ -89,8 +96,9 @@ impl Default for PlantOptions {
             iterations: 20,
             reach_with_root: false,
             grow_within: 0.05,
+            grow_below_speed: 2.5,
             soft_reach: 0.2,
-            max_hold: 0.3,
+            max_hold: 0.4,
             root_follows_stance: true,
             stance_smoothing_seconds: 0.3,
             solver: LegSolver::LeastTurn,
@@ -223,7 +231,7 @@ pub fn plant_feet(
             .map(|p| p.contact_point(chain.contact))
             .collect()
     };
-    // Spans depend on heights only, which the root's horizontal travel leaves as they are.
+    // Spans are found on the generated motion, before the root travels with the stance.
     let chain_spans: Vec<Vec<Range<usize>>> = chains
         .iter()
         .enumerate()
@@ -232,7 +240,18 @@ pub fn plant_feet(
                 return Vec::new();
             };
             let points = contact_points(&poses, chain);
-            let low = |f: usize| height_of(points[f]) - ground < options.grow_within * height;
+            let speed = |f: usize| {
+                let next = if f + 1 < frames {
+                    f + 1
+                } else {
+                    f.saturating_sub(1)
+                };
+                math::norm(horizontal(math::sub(points[next], points[f]))) * layout.fps / height
+            };
+            let low = |f: usize| {
+                height_of(points[f]) - ground < options.grow_within * height
+                    && speed(f) < options.grow_below_speed
+            };
             grow_spans(contact_spans(&labels[k], min_frames), frames, low)
         })
         .collect();
