@@ -400,9 +400,10 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("(994 frames at 120"), "{text}");
-    // The default's QnA window follows the frame rate: 3 at 30 fps, 9 at 120.
+    // The default's QnA window follows the frame rate: 3 at 30 fps (23 frames, 0.77 s), 25 at
+    // 120 (89 frames, 0.74 s).
     assert!(
-        text.contains("receptive field 41 frames (QnA window 9)"),
+        text.contains("receptive field 89 frames (QnA window 25)"),
         "{text}"
     );
     let out = Command::new(bin)
