@@ -5,7 +5,7 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use ndarray::{Array2, ArrayView2};
-use sinmdm::motion::{MotionError, decode};
+use sinmdm::motion::{LocalMotion, MotionError, decode};
 use sinmdm::{Denoiser, Generated, ModelMetadata, Request, TaskError};
 use thiserror::Error;
 
@@ -104,21 +104,20 @@ pub fn evaluate_generated(
     let raw = (0..generated.count())
         .map(|i| generated.raw_motion(i))
         .collect::<Result<Vec<_>, _>>()?;
-    let raw_samples: Vec<Array2<f64>> = raw
-        .iter()
-        .zip(generated.features.outer_iter())
-        .map(|(motion, made)| motion_metric_features(layout, motion, made))
-        .collect();
-    let raw_motion_report = evaluate(clip_metric.view(), &raw_samples, threads.max(1))?;
     let planted = (0..generated.count())
         .map(|i| Ok(generated.planted_motion(i)?.0))
         .collect::<Result<Vec<_>, MotionError>>()?;
-    let planted_samples: Vec<Array2<f64>> = planted
-        .iter()
-        .zip(generated.features.outer_iter())
-        .map(|(motion, made)| motion_metric_features(layout, motion, made))
-        .collect();
-    let planted_report = evaluate(clip_metric.view(), &planted_samples, threads.max(1))?;
+    // Decoded motions are scored re-encoded, with the labels the model predicted.
+    let score_motions = |motions: &[LocalMotion]| {
+        let rows: Vec<Array2<f64>> = motions
+            .iter()
+            .zip(generated.features.outer_iter())
+            .map(|(motion, made)| motion_metric_features(layout, motion, made))
+            .collect();
+        evaluate(clip_metric.view(), &rows, threads.max(1))
+    };
+    let raw_motion_report = score_motions(&raw)?;
+    let planted_report = score_motions(&planted)?;
     let feet = FeetReport::new(layout, &decode(layout, clip)?, &raw, &planted);
     Ok(ModelEvaluation {
         generated,
