@@ -291,17 +291,15 @@ impl TrainConfig {
                 m.heads, m.channels
             ));
         }
-        if !(t.acceleration_weight.is_finite() && t.acceleration_weight >= 0.0) {
-            return Err(format!(
-                "training.acceleration_weight must be 0 or a positive number, got {}",
-                t.acceleration_weight
-            ));
-        }
-        if !(t.foot_contact_weight.is_finite() && t.foot_contact_weight >= 0.0) {
-            return Err(format!(
-                "training.foot_contact_weight must be 0 or a positive number, got {}",
-                t.foot_contact_weight
-            ));
+        for (key, weight) in [
+            ("training.acceleration_weight", t.acceleration_weight),
+            ("training.foot_contact_weight", t.foot_contact_weight),
+        ] {
+            if !(weight.is_finite() && weight >= 0.0) {
+                return Err(format!(
+                    "{key} must be 0 or a positive number, got {weight}"
+                ));
+            }
         }
         if m.window.is_multiple_of(2) {
             return Err(format!("model.window must be odd, got {}", m.window));
