@@ -114,6 +114,10 @@ pub struct TrainingConfig {
     /// differences in time of the predicted x0's error. Absent or 0 leaves the term out.
     #[serde(default, skip_serializing_if = "is_zero_weight")]
     pub acceleration_weight: f64,
+    /// The acceleration term counts only for batch items whose diffusion timestep is below
+    /// this, in `1..=diffusion.steps`. Absent or `null`: every item.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub acceleration_below_timestep: Option<usize>,
 }
 
 /// What every step's batch is made of, for one clip ([`TrainingConfig::batch_shape`]).
@@ -313,6 +317,15 @@ impl TrainConfig {
         if self.diffusion.steps < 2 {
             return Err(format!(
                 "diffusion.steps must be at least 2, got {}",
+                self.diffusion.steps
+            ));
+        }
+        if let Some(cut) = t.acceleration_below_timestep
+            && !(1..=self.diffusion.steps).contains(&cut)
+        {
+            return Err(format!(
+                "training.acceleration_below_timestep must be in 1..={} (diffusion.steps) or \
+                 null, got {cut}",
                 self.diffusion.steps
             ));
         }
@@ -595,6 +608,26 @@ mod tests {
         let err =
             TrainConfig::parse(&accelerated.replace("weight: 0.5", "weight: -0.5")).unwrap_err();
         assert!(err.contains("training.acceleration_weight"), "{err}");
+        let cut = accelerated.replace(
+            "acceleration_below_timestep: null",
+            "acceleration_below_timestep: 250",
+        );
+        assert_eq!(
+            TrainConfig::parse(&cut)
+                .unwrap()
+                .training
+                .acceleration_below_timestep,
+            Some(250)
+        );
+        for bad in ["0", "1001"] {
+            let err =
+                TrainConfig::parse(&cut.replace("timestep: 250", &format!("timestep: {bad}")))
+                    .unwrap_err();
+            assert!(
+                err.contains("training.acceleration_below_timestep"),
+                "{err}"
+            );
+        }
         for (from, to, expected) in cases {
             assert!(default.contains(from), "default.yaml lacks `{from}`");
             let err = TrainConfig::parse(&default.replacen(from, to, 1)).unwrap_err();

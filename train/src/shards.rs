@@ -30,13 +30,14 @@ pub(crate) fn sharded_gradients(
             seed,
             first_item: first,
         };
+        let timesteps = t.clone().narrow(0, first, len);
         let prediction = model.forward_training(
             x_t.clone().narrow(0, first, len),
-            t.clone().narrow(0, first, len),
+            timesteps.clone(),
             Some(key),
         );
         let target = x0.clone().narrow(0, first, len);
-        let loss = terms.loss(&prediction, &target);
+        let loss = terms.loss(&prediction, &target, &timesteps);
         let share = len as f64 / batch as f64;
         let value = f64::from(loss.clone().into_scalar::<f32>()) * share;
         if !value.is_finite() {

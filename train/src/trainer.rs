@@ -335,6 +335,7 @@ impl Trainer {
         let terms = LossTerms {
             foot_contact: self.foot_contact.as_ref().map(|term| (term, weight)),
             acceleration_weight: config.training.acceleration_weight,
+            acceleration_below_timestep: config.training.acceleration_below_timestep,
         };
         let (model, value) = optimisation_step(
             model,
