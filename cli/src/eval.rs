@@ -224,6 +224,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     println!();
     println!("samples as the network made them (--feet raw):");
     print!("{}", report.markdown_table());
+    print_rarely_made(&report, layout.fps);
     println!();
     println!("samples with their feet planted (the default output):");
     print!("{}", planted_report.markdown_table());
@@ -267,4 +268,30 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         eprintln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// Share of the samples under which a stretch of the clip counts as rarely made, in percent.
+const RARELY_MADE_BELOW: f64 = 50.0;
+
+/// Names the stretches of the clip that fewer than half of the samples make: where the model
+/// falls short of its clip, for a user to look at (or to clip out before training).
+fn print_rarely_made(report: &Report, fps: f64) {
+    let stretches = report.rarely_made(RARELY_MADE_BELOW);
+    if stretches.is_empty() {
+        println!(
+            "every {COVERAGE_WINDOW}-frame window of the clip is made by at least {RARELY_MADE_BELOW}% of the samples"
+        );
+        return;
+    }
+    println!("stretches of the clip that fewer than {RARELY_MADE_BELOW}% of the samples make:");
+    for stretch in stretches {
+        let end = stretch.last_frame + 1;
+        println!(
+            "  frames {}:{end} ({:.2}-{:.2} s), the least-made window by {:.0}% of them",
+            stretch.first_frame,
+            stretch.first_frame as f64 / fps,
+            end as f64 / fps,
+            stretch.least_share
+        );
+    }
 }

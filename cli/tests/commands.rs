@@ -103,6 +103,23 @@ fn eval_command_prints_the_table_and_writes_json() {
     assert!((0.0..=100.0).contains(&report.coverage.mean));
     assert!((0.0..=1.0).contains(&report.harmonic_mean));
     assert!(report.global_diversity.mean.is_finite() && report.global_diversity.mean >= 0.0);
+    // One share per 30-frame window of the clip; the stretches printed are the rare ones.
+    assert_eq!(report.clip_window_coverage.len(), 249 - 30 + 1);
+    let rare = report.rarely_made(50.0);
+    if rare.is_empty() {
+        assert!(
+            stdout.contains("every 30-frame window of the clip"),
+            "{stdout}"
+        );
+    }
+    for stretch in rare {
+        let frames = format!(
+            "frames {}:{} (",
+            stretch.first_frame,
+            stretch.last_frame + 1
+        );
+        assert!(stdout.contains(&frames), "missing {frames} in\n{stdout}");
+    }
     // The raw motion as written and the planted motion are scored too, for the same samples.
     for key in ["raw_motion_report", "planted_report"] {
         let other: Report = serde_json::from_value(value[key].clone()).unwrap();

@@ -134,11 +134,25 @@ pub fn motion_metric_features(
 /// Share (0..=1) of the clip's `window`-frame windows whose best match in `sample` is closer
 /// than `threshold` per frame.
 pub fn coverage(sample_vs_clip: &DiagonalSums, window: usize, threshold: f64) -> f64 {
-    let nearest = sample_vs_clip.nearest_b_windows(window);
-    if nearest.is_empty() {
+    let covered = covered_clip_windows(sample_vs_clip, window, threshold);
+    if covered.is_empty() {
         return 0.0;
     }
-    nearest.iter().filter(|&&d| d < threshold).count() as f64 / nearest.len() as f64
+    covered.iter().filter(|&&c| c).count() as f64 / covered.len() as f64
+}
+
+/// For each `window`-frame window of the clip, by its first frame: whether `sample` has a
+/// window closer than `threshold` per frame (the windows [`coverage`] counts).
+pub fn covered_clip_windows(
+    sample_vs_clip: &DiagonalSums,
+    window: usize,
+    threshold: f64,
+) -> Vec<bool> {
+    sample_vs_clip
+        .nearest_b_windows(window)
+        .into_iter()
+        .map(|d| d < threshold)
+        .collect()
 }
 
 /// Mean over the sample's `window`-frame windows of the per-frame distance to the nearest clip
@@ -244,6 +258,10 @@ pub struct Report {
     pub clip_frames: usize,
     /// Each sample's scores.
     pub per_sample: Vec<SampleScores>,
+    /// For each 30-frame window of the clip, by its first frame: the share of the samples, in
+    /// percent, that make it (have a window closer than the coverage threshold). Their mean is
+    /// the mean coverage; the low ones are the parts of the clip the model rarely makes.
+    pub clip_window_coverage: Vec<f64>,
 }
 
 /// The five scores mapped to `[0, 1]` (see the module documentation), in table order.
@@ -273,16 +291,24 @@ pub fn harmonic_mean(values: &[f64]) -> f64 {
     values.len() as f64 / values.iter().map(|v| 1.0 / v).sum::<f64>()
 }
 
-/// Scores of one sample against the clip (without the inter diversity).
-fn score_sample(sample: ArrayView2<'_, f64>, clip: ArrayView2<'_, f64>) -> SampleScores {
+/// Scores of one sample against the clip (without the inter diversity), and which of the
+/// clip's windows it makes.
+fn score_sample(
+    sample: ArrayView2<'_, f64>,
+    clip: ArrayView2<'_, f64>,
+) -> (SampleScores, Vec<bool>) {
     let sums = DiagonalSums::new(sample, clip, false);
-    SampleScores {
+    let scores = SampleScores {
         coverage: 100.0 * coverage(&sums, COVERAGE_WINDOW, COVERAGE_THRESHOLD),
         global_diversity: patched_nearest_neighbour(&sums, COVERAGE_WINDOW).unwrap_or(f64::NAN),
         local_diversity: local_diversity(&sums, LOCAL_WINDOW),
         inter_diversity: 0.0,
         intra_diversity: intra_diversity(sample, LOCAL_WINDOW),
-    }
+    };
+    (
+        scores,
+        covered_clip_windows(&sums, COVERAGE_WINDOW, COVERAGE_THRESHOLD),
+    )
 }
 
 /// Evaluates samples (metric features, rows = frames, all the same length) against the clip,
@@ -326,7 +352,8 @@ pub fn evaluate(
         }
     }
 
-    let threads = threads.clamp(1, samples.len());
+    let count = samples.len();
+    let threads = threads.clamp(1, count);
     let mut per_sample = vec![None; samples.len()];
     std::thread::scope(|scope| {
         let chunk = samples.len().div_ceil(threads);
@@ -338,11 +365,16 @@ pub fn evaluate(
             });
         }
     });
-    let mut per_sample: Vec<SampleScores> = per_sample
+    let (mut per_sample, covered): (Vec<SampleScores>, Vec<Vec<bool>>) = per_sample
         .into_iter()
         .map(|s| s.expect("every sample scored"))
+        .unzip();
+    let clip_window_coverage = (0..=clip.nrows() - COVERAGE_WINDOW)
+        .map(|w| {
+            let making = covered.iter().filter(|c| c[w]).count();
+            100.0 * making as f64 / count as f64
+        })
         .collect();
-    let count = samples.len();
     for i in 0..count {
         let previous = &samples[(i + count - 1) % count];
         per_sample[i].inter_diversity = inter_diversity(samples[i].view(), previous.view());
@@ -361,9 +393,48 @@ pub fn evaluate(
         sample_frames: samples[0].nrows(),
         clip_frames: clip.nrows(),
         per_sample,
+        clip_window_coverage,
     };
     report.harmonic_mean = harmonic_mean(&normalised_scores(&report));
     Ok(report)
+}
+
+/// A stretch of the clip that few samples make: the frames of coverage windows each made by
+/// fewer than the asked share of the samples (overlapping windows joined).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RarelyMade {
+    /// First frame of the stretch (its first window's first frame).
+    pub first_frame: usize,
+    /// Last frame of the stretch (its last window's last frame).
+    pub last_frame: usize,
+    /// The lowest share of samples, in percent, that make one of its windows.
+    pub least_share: f64,
+}
+
+impl Report {
+    /// The stretches of the clip whose coverage windows are each made by fewer than `below`
+    /// percent of the samples, in clip order; windows that share frames join one stretch.
+    pub fn rarely_made(&self, below: f64) -> Vec<RarelyMade> {
+        let mut stretches: Vec<RarelyMade> = Vec::new();
+        for (start, &share) in self.clip_window_coverage.iter().enumerate() {
+            if share >= below {
+                continue;
+            }
+            let last_frame = start + COVERAGE_WINDOW - 1;
+            match stretches.last_mut() {
+                Some(stretch) if start <= stretch.last_frame => {
+                    stretch.last_frame = last_frame;
+                    stretch.least_share = stretch.least_share.min(share);
+                }
+                _ => stretches.push(RarelyMade {
+                    first_frame: start,
+                    last_frame,
+                    least_share: share,
+                }),
+            }
+        }
+        stretches
+    }
 }
 
 #[cfg(test)]
@@ -420,6 +491,66 @@ mod tests {
         let near = Array2::from_elem((40, 1), 1.9);
         let sums = DiagonalSums::new(near.view(), clip.view(), false);
         assert_eq!(coverage(&sums, 30, 2.0), 1.0);
+    }
+
+    #[test]
+    fn clip_window_coverage_counts_the_samples_that_make_each_window() {
+        // Clip: a ramp of 60 frames, 1.0 apart, so a window matched s frames off lies s per
+        // frame away. Sample A is the clip's first 45 frames, then far away: it makes the clip
+        // windows starting at 0..=15 exactly and 16 one frame off (1.0 < 2.0), not 17 and on
+        // (2.0 is not under the threshold). Sample B is the whole clip; C is far from it all.
+        let clip = Array2::from_shape_fn((60, 1), |(f, _)| f as f64);
+        let mut a = Array2::from_elem((60, 1), 500.0);
+        a.slice_mut(ndarray::s![..45, ..])
+            .assign(&clip.slice(ndarray::s![..45, ..]));
+        let b = clip.clone();
+        let c = Array2::from_elem((60, 1), -500.0);
+        let report = evaluate(clip.view(), &[a, b, c], 2).unwrap();
+        assert_eq!(report.clip_window_coverage.len(), 31);
+        for (start, &share) in report.clip_window_coverage.iter().enumerate() {
+            let makers = if start <= 16 { 2.0 } else { 1.0 };
+            let expected = 100.0 * makers / 3.0;
+            assert!(
+                (share - expected).abs() < 1e-9,
+                "window {start}: {share} against {expected}"
+            );
+        }
+        let mean = report.clip_window_coverage.iter().sum::<f64>() / 31.0;
+        assert!((mean - report.coverage.mean).abs() < 1e-9);
+        // Under half of the samples make the windows 17..=30: frames 17..=59.
+        assert_eq!(
+            report.rarely_made(50.0),
+            vec![RarelyMade {
+                first_frame: 17,
+                last_frame: 59,
+                least_share: 100.0 / 3.0
+            }]
+        );
+        assert!(report.rarely_made(100.0 / 3.0).is_empty());
+    }
+
+    #[test]
+    fn rarely_made_stretches_are_runs_of_low_windows() {
+        let mut report = evaluate(
+            motion(40, 2, 1).view(),
+            std::slice::from_ref(&motion(40, 2, 2)),
+            1,
+        )
+        .unwrap();
+        // Windows 1, 2, 4 and 6 are low and share frames (one stretch, frames 1..=35); window
+        // 40 is low too, but its frames 40..=69 start after 35 (a second stretch).
+        let mut shares = vec![90.0; 41];
+        for (window, share) in [(1, 10.0), (2, 20.0), (4, 5.0), (6, 7.0), (40, 49.0)] {
+            shares[window] = share;
+        }
+        report.clip_window_coverage = shares;
+        let stretches: Vec<(usize, usize, f64)> = report
+            .rarely_made(50.0)
+            .iter()
+            .map(|r| (r.first_frame, r.last_frame, r.least_share))
+            .collect();
+        assert_eq!(stretches, vec![(1, 35, 5.0), (40, 69, 49.0)]);
+        assert!(report.rarely_made(5.0).is_empty());
     }
 
     #[test]

@@ -80,8 +80,10 @@ def test_eval_scores_match_the_literal_definitions(tmp_path):
     report = json.loads(scores_json.read_text())["report"]
     assert clip.shape[1] == 31 * 6 + 2 and len(samples) == 3 and samples[0].shape[0] == 80
 
+    made_by = np.zeros(len(clip) - 30 + 1)
     for i, (sample, scores) in enumerate(zip(samples, report["per_sample"])):
         covered = nearest_windows(clip, sample, 30) < 2.0
+        made_by += covered
         assert abs(scores["coverage"] - 100 * covered.mean()) < 1e-12, i
         assert abs(scores["global_diversity"] - patched_nn(sample, clip)) < 1e-12, i
         assert abs(scores["local_diversity"] - nearest_windows(sample, clip, 15).mean()) < 1e-12, i
@@ -89,5 +91,7 @@ def test_eval_scores_match_the_literal_definitions(tmp_path):
         inter = np.linalg.norm(sample - previous) / len(sample)
         assert abs(scores["inter_diversity"] - inter) < 1e-12, i
         assert abs(scores["intra_diversity"] - intra(sample)) < 1e-12, i
+    # Each clip window's share of the samples that make it.
+    assert np.abs(np.array(report["clip_window_coverage"]) - 100 * made_by / len(samples)).max() < 1e-12
     gap = abs(np.mean([intra(s) for s in samples]) - intra(clip))
     assert abs(report["intra_diversity_diff"] - gap) < 1e-12
