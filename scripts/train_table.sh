@@ -2,7 +2,9 @@
 # Trains the default configuration (configs/default.yaml) on each of the project's clips, one
 # after another, scores every model with `sinmdm eval` (20 samples of twice the clip's length,
 # default sampling, seed 0) and prints one Markdown table: training time, coverage, diversity,
-# intra-diversity difference and jitter against the clip's.
+# intra-diversity difference and jitter against the clip's. Twenty samples are a small crowd
+# (one seed's coverage can be 1-3 points off), so each model is also scored with seeds 1-4 and
+# the table gives the mean of the five and its standard error beside seed 0's figures.
 #
 # Usage: scripts/train_table.sh [OUT_DIR] [DOG_CLIP.bvh]
 #   OUT_DIR   runs, models and eval JSON (default out/train_table); finished runs are kept and
@@ -40,14 +42,27 @@ for entry in "${clips[@]}"; do
   fi
   [ -f "$out/$name.json" ] || "$sinmdm" eval -m "$model" --clip "$clip" --samples 20 \
     --quiet --json "$out/$name.json" >/dev/null
+  for seed in 1 2 3 4; do
+    [ -f "$out/$name.seed$seed.json" ] || "$sinmdm" eval -m "$model" --clip "$clip" \
+      --samples 20 --seed "$seed" --quiet --json "$out/$name.seed$seed.json" >/dev/null
+  done
 done
 
 python3 - "$out" <<'PY'
-import json, pathlib, sys
+import json, pathlib, statistics, sys
 out = pathlib.Path(sys.argv[1])
-print("| clip | frames (fps) | steps | training time | coverage | global diversity | intra diff | clip's own intra diversity | jitter x clip | s per sample |")
-print("|---|---|---|---|---|---|---|---|---|---|")
-for path in sorted(out.glob("*.json")):
+
+
+def five_seeds(name, key):
+    """Mean and standard error of a score over eval seeds 0-4."""
+    files = [out / f"{name}.json"] + [out / f"{name}.seed{s}.json" for s in range(1, 5)]
+    values = [json.loads(f.read_text())["report"][key]["mean"] for f in files]
+    return statistics.mean(values), statistics.stdev(values) / len(values) ** 0.5
+
+
+print("| clip | frames (fps) | steps | training time | coverage | global diversity | coverage, seeds 0-4 | global diversity, seeds 0-4 | intra diff | clip's own intra diversity | jitter x clip | s per sample |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+for path in sorted(p for p in out.glob("*.json") if ".seed" not in p.name):
     d = json.loads(path.read_text())
     run = out / path.stem
     latest = (run / "latest").read_text().strip()
@@ -56,7 +71,10 @@ for path in sorted(out.glob("*.json")):
     fps = state["clip"]["layout"]["fps"]
     print(f"| {path.stem} | {state['clip']['frames']} ({fps:g}) | {state['step']} | "
           f"{state['elapsed_seconds'] / 60:.1f} min | {r['coverage']['mean']:.1f} | "
-          f"{r['global_diversity']['mean']:.3f} | {r['intra_diversity_diff']:.3f} | "
+          f"{r['global_diversity']['mean']:.3f} | "
+          "{:.1f} ± {:.1f} | {:.3f} ± {:.3f} | ".format(
+              *five_seeds(path.stem, "coverage"), *five_seeds(path.stem, "global_diversity"))
+          + f"{r['intra_diversity_diff']:.3f} | "
           f"{r['clip_intra_diversity']:.3f} | "
           f"{d['feet']['raw']['jitter_ratio']:.2f} | {d['sampling_seconds'] / d['samples']:.3f} |")
 PY

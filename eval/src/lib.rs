@@ -400,7 +400,7 @@ pub fn evaluate(
 }
 
 /// A stretch of the clip that few samples make: the frames of coverage windows each made by
-/// fewer than the asked share of the samples (overlapping windows joined).
+/// fewer than the asked share of the samples (overlapping or touching windows joined).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RarelyMade {
     /// First frame of the stretch (its first window's first frame).
@@ -413,7 +413,8 @@ pub struct RarelyMade {
 
 impl Report {
     /// The stretches of the clip whose coverage windows are each made by fewer than `below`
-    /// percent of the samples, in clip order; windows that share frames join one stretch.
+    /// percent of the samples, in clip order; windows that share or touch frames join one
+    /// stretch.
     pub fn rarely_made(&self, below: f64) -> Vec<RarelyMade> {
         let mut stretches: Vec<RarelyMade> = Vec::new();
         for (start, &share) in self.clip_window_coverage.iter().enumerate() {
@@ -422,7 +423,7 @@ impl Report {
             }
             let last_frame = start + COVERAGE_WINDOW - 1;
             match stretches.last_mut() {
-                Some(stretch) if start <= stretch.last_frame => {
+                Some(stretch) if start <= stretch.last_frame + 1 => {
                     stretch.last_frame = last_frame;
                     stretch.least_share = stretch.least_share.min(share);
                 }
@@ -537,10 +538,18 @@ mod tests {
             1,
         )
         .unwrap();
-        // Windows 1, 2, 4 and 6 are low and share frames (one stretch, frames 1..=35); window
-        // 40 is low too, but its frames 40..=69 start after 35 (a second stretch).
-        let mut shares = vec![90.0; 41];
-        for (window, share) in [(1, 10.0), (2, 20.0), (4, 5.0), (6, 7.0), (40, 49.0)] {
+        // Windows 1, 2, 4 and 6 are low and share frames, and window 36 starts right after
+        // window 6's last frame: one stretch, frames 1..=65. Window 67 is low too, but a frame
+        // lies between them (a second stretch).
+        let mut shares = vec![90.0; 68];
+        for (window, share) in [
+            (1, 10.0),
+            (2, 20.0),
+            (4, 5.0),
+            (6, 7.0),
+            (36, 30.0),
+            (67, 49.0),
+        ] {
             shares[window] = share;
         }
         report.clip_window_coverage = shares;
@@ -549,7 +558,7 @@ mod tests {
             .iter()
             .map(|r| (r.first_frame, r.last_frame, r.least_share))
             .collect();
-        assert_eq!(stretches, vec![(1, 35, 5.0), (40, 69, 49.0)]);
+        assert_eq!(stretches, vec![(1, 65, 5.0), (67, 96, 49.0)]);
         assert!(report.rarely_made(5.0).is_empty());
     }
 

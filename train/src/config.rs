@@ -490,18 +490,20 @@ mod tests {
     fn frames_per_step_sets_items_and_window_from_the_clip_length() {
         let default = TrainConfig::parse(include_str!("../../configs/default.yaml")).unwrap();
         let t = &default.training;
-        assert_eq!(t.frames_per_step, Some(2048));
-        // 2048 / 249 = 8.2: the batch size; 2048 / 276 = 7.4; 2048 / 1054 = 1.9; a long clip
-        // gets one window of 2048 frames; a short one never more than batch_size items.
+        assert_eq!(t.frames_per_step, Some(1024));
+        // 1024 / 249 = 4.1; 1024 / 302 = 3.4; 1024 / 527 = 1.9; 1024 / 1054 = 0.97 is one item,
+        // and a clip longer than 1024 frames gets one window of 1024; a short one never more
+        // than batch_size items.
         let shape = |frames| {
             let s = t.batch_shape(frames);
             (s.items, s.window)
         };
-        assert_eq!(shape(249), (8, Some(2048)));
-        assert_eq!(shape(276), (7, Some(2048)));
-        assert_eq!(shape(1054), (2, Some(2048)));
-        assert_eq!(shape(5000), (1, Some(2048)));
-        assert_eq!(shape(60), (8, Some(2048)));
+        assert_eq!(shape(249), (4, Some(1024)));
+        assert_eq!(shape(302), (3, Some(1024)));
+        assert_eq!(shape(527), (2, Some(1024)));
+        assert_eq!(shape(1054), (1, Some(1024)));
+        assert_eq!(shape(5000), (1, Some(1024)));
+        assert_eq!(shape(60), (8, Some(1024)));
         // Without it: batch_size items of window_frames.
         let mut fixed = t.clone();
         fixed.frames_per_step = None;
@@ -519,12 +521,12 @@ mod tests {
     fn frames_per_step_excludes_window_frames_and_covers_the_receptive_field() {
         let text = include_str!("../../configs/default.yaml");
         let both = text.replace(
-            "  frames_per_step: 2048",
-            "  frames_per_step: 2048\n  window_frames: 256",
+            "  frames_per_step: 1024",
+            "  frames_per_step: 1024\n  window_frames: 256",
         );
         let err = TrainConfig::parse(&both).unwrap_err();
         assert!(err.contains("set one of them"), "{err}");
-        let tiny = text.replace("  frames_per_step: 2048", "  frames_per_step: 10");
+        let tiny = text.replace("  frames_per_step: 1024", "  frames_per_step: 10");
         let err = TrainConfig::parse(&tiny).unwrap_err();
         assert!(
             err.contains("training.frames_per_step must be at least"),
