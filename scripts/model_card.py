@@ -13,6 +13,7 @@ is.
 """
 
 import json
+import math
 import pathlib
 import re
 import subprocess
@@ -45,13 +46,16 @@ def kept_parts(old: str) -> tuple[str, str]:
     return clip, about
 
 
-def frames_seen(t: dict) -> str:
-    """What a step sees of the clip, as the run's configuration says."""
+def frames_seen(t: dict, clip_frames: int) -> str:
+    """What a step sees of the clip, as the run's configuration says (the batch items as
+    `TrainingConfig::batch_shape` makes them: round(frames_per_step / F), 1..=batch_size)."""
     if t.get("frames_per_step"):
-        return f"{t['frames_per_step']} frames per step"
+        items = min(max(math.floor(t["frames_per_step"] / clip_frames + 0.5), 1), t["batch_size"])
+        return f"{t['frames_per_step']} frames per step ({items} items of the clip)"
+    batch = f"batch {t['batch_size']}"
     if t.get("window_frames"):
-        return f"windows of {t['window_frames']} frames"
-    return "the whole clip"
+        return f"{batch}, windows of {t['window_frames']} frames"
+    return f"{batch}, the whole clip"
 
 
 def evaluation(name: str, clip: str, model: pathlib.Path) -> list[str]:
@@ -98,9 +102,9 @@ def main() -> None:
     fps = "the clip's own rate" if d["fps"] is None else f"{d['fps']:g} fps"
     config_row = (
         f"the default (`configs/default.yaml`: C {m['channels']}, {m['heads']} heads, window "
-        f"{m['window']}, batch {t['batch_size']}, dropout {m['dropout']}, cosine learning rate "
+        f"{m['window']}, dropout {m['dropout']}, cosine learning rate "
         f"from {t['learning_rate']:g} after {t['warmup_steps']} warm-up steps, weight average "
-        f"{t.get('ema_decay')}, {frames_seen(t)}, {fps}, seed {t['seed']})"
+        f"{t.get('ema_decay')}, {frames_seen(t, state['clip']['frames'])}, {fps}, seed {t['seed']})"
     )
     size_mb = model.stat().st_size / 1e6
     extra_args = " --fps clip" if d["fps"] is None else ""
