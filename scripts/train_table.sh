@@ -40,11 +40,11 @@ for entry in "${clips[@]}"; do
       "$train" "$clip" --out "$run" --export "$model" $extra
     fi
   fi
-  [ -f "$out/$name.json" ] || "$sinmdm" eval -m "$model" --clip "$clip" --samples 20 \
-    --quiet --json "$out/$name.json" >/dev/null
-  for seed in 1 2 3 4; do
-    [ -f "$out/$name.seed$seed.json" ] || "$sinmdm" eval -m "$model" --clip "$clip" \
-      --samples 20 --seed "$seed" --quiet --json "$out/$name.seed$seed.json" >/dev/null
+  for seed in 0 1 2 3 4; do
+    json="$out/$name.seed$seed.json"
+    [ "$seed" = 0 ] && json="$out/$name.json"
+    [ -f "$json" ] || "$sinmdm" eval -m "$model" --clip "$clip" --samples 20 --seed "$seed" \
+      --quiet --json "$json" >/dev/null
   done
 done
 

@@ -134,7 +134,11 @@ pub fn motion_metric_features(
 /// Share (0..=1) of the clip's `window`-frame windows whose best match in `sample` is closer
 /// than `threshold` per frame.
 pub fn coverage(sample_vs_clip: &DiagonalSums, window: usize, threshold: f64) -> f64 {
-    let covered = covered_clip_windows(sample_vs_clip, window, threshold);
+    covered_share(&covered_clip_windows(sample_vs_clip, window, threshold))
+}
+
+/// Share (0..=1) of the windows marked covered; 0 when there are none.
+fn covered_share(covered: &[bool]) -> f64 {
     if covered.is_empty() {
         return 0.0;
     }
@@ -298,17 +302,15 @@ fn score_sample(
     clip: ArrayView2<'_, f64>,
 ) -> (SampleScores, Vec<bool>) {
     let sums = DiagonalSums::new(sample, clip, false);
+    let covered = covered_clip_windows(&sums, COVERAGE_WINDOW, COVERAGE_THRESHOLD);
     let scores = SampleScores {
-        coverage: 100.0 * coverage(&sums, COVERAGE_WINDOW, COVERAGE_THRESHOLD),
+        coverage: 100.0 * covered_share(&covered),
         global_diversity: patched_nearest_neighbour(&sums, COVERAGE_WINDOW).unwrap_or(f64::NAN),
         local_diversity: local_diversity(&sums, LOCAL_WINDOW),
         inter_diversity: 0.0,
         intra_diversity: intra_diversity(sample, LOCAL_WINDOW),
     };
-    (
-        scores,
-        covered_clip_windows(&sums, COVERAGE_WINDOW, COVERAGE_THRESHOLD),
-    )
+    (scores, covered)
 }
 
 /// Evaluates samples (metric features, rows = frames, all the same length) against the clip,
@@ -354,9 +356,9 @@ pub fn evaluate(
 
     let count = samples.len();
     let threads = threads.clamp(1, count);
-    let mut per_sample = vec![None; samples.len()];
+    let mut per_sample = vec![None; count];
     std::thread::scope(|scope| {
-        let chunk = samples.len().div_ceil(threads);
+        let chunk = count.div_ceil(threads);
         for (block, out) in samples.chunks(chunk).zip(per_sample.chunks_mut(chunk)) {
             scope.spawn(move || {
                 for (sample, slot) in block.iter().zip(out.iter_mut()) {
