@@ -13,7 +13,6 @@ is.
 """
 
 import json
-import math
 import pathlib
 import re
 import subprocess
@@ -46,16 +45,20 @@ def kept_parts(old: str) -> tuple[str, str]:
     return clip, about
 
 
-def frames_seen(t: dict, clip_frames: int) -> str:
-    """What a step sees of the clip, as the run's configuration says (the batch items as
-    `TrainingConfig::batch_shape` makes them: round(frames_per_step / F), 1..=batch_size)."""
+def frames_seen(t: dict, state: dict) -> str:
+    """What a step saw of the clip: the batch the run recorded in its state.json."""
+    batch = state.get("batch")
+    if batch is None:
+        sys.exit("the run's state.json does not record its batch (a run saved before it was kept)")
+    items, window = batch["items"], batch["window"]
+    plural = "s" if items > 1 else ""
+    if window is not None and window < state["clip"]["frames"]:
+        seen = f"{items} random window{plural} of {window} frames"
+    else:
+        seen = f"{items} item{plural} of the clip"
     if t.get("frames_per_step"):
-        items = min(max(math.floor(t["frames_per_step"] / clip_frames + 0.5), 1), t["batch_size"])
-        return f"{t['frames_per_step']} frames per step ({items} items of the clip)"
-    batch = f"batch {t['batch_size']}"
-    if t.get("window_frames"):
-        return f"{batch}, windows of {t['window_frames']} frames"
-    return f"{batch}, the whole clip"
+        return f"{t['frames_per_step']} frames per step ({seen})"
+    return f"batch of {seen}"
 
 
 def evaluation(name: str, clip: str, model: pathlib.Path) -> list[str]:
@@ -104,7 +107,7 @@ def main() -> None:
         f"the default (`configs/default.yaml`: C {m['channels']}, {m['heads']} heads, window "
         f"{m['window']}, dropout {m['dropout']}, cosine learning rate "
         f"from {t['learning_rate']:g} after {t['warmup_steps']} warm-up steps, weight average "
-        f"{t.get('ema_decay')}, {frames_seen(t, state['clip']['frames'])}, {fps}, seed {t['seed']})"
+        f"{t.get('ema_decay')}, {frames_seen(t, state)}, {fps}, seed {t['seed']})"
     )
     size_mb = model.stat().st_size / 1e6
     extra_args = " --fps clip" if d["fps"] is None else ""

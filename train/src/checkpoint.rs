@@ -8,7 +8,7 @@ use burn::optim::ModuleOptimizer;
 use serde::{Deserialize, Serialize};
 
 use crate::clip_data::ClipFacts;
-use crate::config::TrainConfig;
+use crate::config::{BatchShape, TrainConfig};
 use crate::error::{TrainError, io};
 use crate::model::QnaUnet;
 
@@ -49,6 +49,11 @@ pub struct CheckpointState {
     pub config: TrainConfig,
     /// The clip the model learns.
     pub clip: ClipFacts,
+    /// The batch every step has: the configuration's rule
+    /// ([`crate::config::TrainingConfig::batch_shape`]) resolved for this clip, recorded so that
+    /// a reader of the run need not repeat the rule. Absent in runs saved before it was kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub batch: Option<BatchShape>,
     /// When the run started (UTC, RFC 3339).
     pub started: String,
 }

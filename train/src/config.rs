@@ -121,7 +121,7 @@ pub struct TrainingConfig {
 }
 
 /// What every step's batch is made of, for one clip ([`TrainingConfig::batch_shape`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct BatchShape {
     /// Batch items (each with its own timestep and noise).
     pub items: usize,

@@ -154,6 +154,35 @@ fn a_window_that_follows_the_frame_rate_is_saved_resolved_and_resumes() {
 }
 
 #[test]
+fn each_checkpoint_records_the_batch_its_steps_had() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let run = scratch("batch-shape");
+    let _ = std::fs::remove_dir_all(&run);
+    let mut config = tiny();
+    config.training.batch_size = 8;
+    config.training.frames_per_step = Some(1024);
+    config.data.fps = Some(60.0);
+    config.training.steps = 1;
+    config.training.checkpoint_every = 1;
+    let mut trainer = Trainer::start(&walk(), config, &run, Device::flex().autodiff()).unwrap();
+    trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
+    drop(trainer);
+    // The walk's 249 frames at 30 fps (8.27 s) are 497 at 60: 1 024 frames a step make 2
+    // whole clips (1 024 / 497 = 2.06), each within the 1 024-frame window.
+    let latest = std::fs::read_to_string(run.join("latest")).unwrap();
+    let state: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(run.join(latest.trim()).join("state.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(state["clip"]["frames"], 497);
+    assert_eq!(
+        state["batch"],
+        serde_json::json!({"items": 2, "window": 1024})
+    );
+    std::fs::remove_dir_all(&run).unwrap();
+}
+
+#[test]
 fn ctrl_c_saves_and_resume_finishes_like_an_uninterrupted_run() {
     let bin = env!("CARGO_BIN_EXE_sinmdm-train");
     let config = scratch("ctrlc-config.yaml");

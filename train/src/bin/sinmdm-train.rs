@@ -17,7 +17,7 @@ use sinmdm_train::{QnaUnet, RunEnd, TrainConfig, Trainer};
 /// Fit the single-motion QnA-UNet denoiser on one BVH clip.
 ///
 /// Examples:
-///   sinmdm-train tests/data/bvh/human_walk_cmu_131_01.bvh --out runs/walk   (the default, ~7 min)
+///   sinmdm-train tests/data/bvh/human_walk_cmu_131_01.bvh --out runs/walk   (the default, ~6 min)
 ///   sinmdm-train CLIP.bvh --minutes 5 --out runs/quick   (as many steps as fit in 5 minutes)
 ///   sinmdm-train --resume --out runs/walk            (continue after Ctrl-C or a crash)
 ///   sinmdm-train CLIP.bvh --config configs/paper.yaml --dry-run   (sizes only)
