@@ -13,7 +13,7 @@ use sinmdm::diffusion::Schedule;
 
 use crate::checkpoint::{self, CheckpointState};
 use crate::clip_data::ClipData;
-use crate::config::{BatchShape, TrainConfig};
+use crate::config::TrainConfig;
 use crate::data::make_batch;
 use crate::error::{TrainError, io};
 use crate::foot_contact::FootContact;
@@ -65,8 +65,6 @@ pub struct Trainer {
     optimizer: ModuleOptimizer,
     schedule: Schedule,
     clip: ClipData,
-    /// What every step's batch is made of (also recorded in `state`).
-    batch: BatchShape,
     state: CheckpointState,
     recent: VecDeque<f64>,
     log: LossLog,
@@ -165,7 +163,6 @@ impl Trainer {
             .training
             .ema_decay
             .map(|decay| WeightAverage::new(&model, decay, 0));
-        let batch = config.training.batch_shape(data.features.ncols());
         let state = CheckpointState {
             step: 0,
             learning_rate: config.training.first_rate(),
@@ -175,7 +172,7 @@ impl Trainer {
             parameters: model.num_params(),
             features,
             clip: data.facts.clone(),
-            batch: Some(batch),
+            batch: Some(config.training.batch_shape(data.features.ncols())),
             started: crate::clock::now(),
             config: config.clone(),
         };
@@ -188,7 +185,6 @@ impl Trainer {
             optimizer: new_optimizer(&config),
             schedule: schedule(&config),
             clip: data,
-            batch,
             state,
             recent: VecDeque::new(),
             log,
@@ -266,8 +262,7 @@ impl Trainer {
         let optimizer = checkpoint::load_optimizer(&dir, new_optimizer(&state.config))?;
         let log = LossLog::resume(&run.join(LOSS_LOG), state.step)?;
         let elapsed_before = state.elapsed_seconds;
-        let batch = state.config.training.batch_shape(data.features.ncols());
-        state.batch = Some(batch);
+        state.batch = Some(state.config.training.batch_shape(data.features.ncols()));
         let foot_contact = foot_contact_term(&state.config, &data);
         Ok(Trainer {
             run: run.to_path_buf(),
@@ -277,7 +272,6 @@ impl Trainer {
             optimizer,
             schedule: schedule(&state.config),
             clip: data,
-            batch,
             state,
             recent: VecDeque::new(),
             log,
@@ -322,7 +316,7 @@ impl Trainer {
         self.device.seed(sinmdm::diffusion::noise::mix(
             config.training.seed ^ step.wrapping_mul(0x9E37_79B9),
         ));
-        let shape = self.batch;
+        let shape = config.training.batch_shape(self.clip.features.ncols());
         let batch = make_batch(
             self.clip.features.view(),
             &self.schedule,
