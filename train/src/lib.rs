@@ -17,6 +17,7 @@ pub mod loss_log;
 pub mod loss_plot;
 pub mod memory;
 pub mod model;
+pub mod motion_span;
 mod shards;
 pub mod trainer;
 pub mod weight_average;

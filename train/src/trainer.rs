@@ -297,6 +297,16 @@ impl Trainer {
         &self.run
     }
 
+    /// A line for the user when the clip's motion stays correlated for much longer than the
+    /// network sees at once ([`crate::motion_span::wider_window_hint`]).
+    pub fn wider_window_hint(&self) -> Option<String> {
+        crate::motion_span::wider_window_hint(
+            self.clip.features.view(),
+            self.clip.facts.layout.fps,
+            &self.state.config.model,
+        )
+    }
+
     /// Whether all configured steps are done.
     pub fn finished(&self) -> bool {
         self.state.step >= self.state.config.training.steps

@@ -167,6 +167,19 @@ fn dry_run(args: &Args) -> Result<()> {
         config.model.receptive_field(),
         config.model.window
     );
+    let fps = data.facts.layout.fps;
+    match sinmdm_train::motion_span::decorrelation_frames(data.features.view(), fps) {
+        Some(frames) => println!(
+            "motion span     {:.2} s (the lag at which the features' autocorrelation first falls below zero)",
+            frames as f64 / fps
+        ),
+        None => println!("motion span     longer than half the clip or 10 s"),
+    }
+    if let Some(hint) =
+        sinmdm_train::motion_span::wider_window_hint(data.features.view(), fps, &config.model)
+    {
+        println!("hint            {hint}");
+    }
     let shape = config.training.batch_shape(data.features.ncols());
     let window = match shape.window {
         Some(w) if w < data.features.ncols() => format!("random windows of {w} frames"),
@@ -255,6 +268,11 @@ fn main() -> Result<()> {
     eprintln!("up axis {}", state.clip.up);
     if state.clip.in_place {
         eprintln!("in-place cycle: contacts measured against the treadmill");
+    }
+    if state.step == 0
+        && let Some(hint) = trainer.wider_window_hint()
+    {
+        eprintln!("hint: {hint}");
     }
     let bar = ProgressBar::new(state.config.training.steps);
     if !std::io::stderr().is_terminal() {
