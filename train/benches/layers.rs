@@ -1,6 +1,6 @@
 //! Forward and forward + backward time of each layer of the denoiser at the paper's size (C 256,
 //! batch 64, 200 frames), best of 4: where a training step's time goes. Run:
-//! `cargo bench -p sinmdm-train --bench layers` (`SINMDM_BENCH_SIZE=128,8` for the CPU config).
+//! `cargo bench -p sinmdm-train --bench layers` (`SINMDM_BENCH_SIZE=128,8` for the CPU config, `64,1,1024,11` for the 60 fps dog).
 
 use std::time::Instant;
 
@@ -29,15 +29,14 @@ fn main() {
     sinmdm_train::memory::keep_freed_memory();
     let device = Device::flex().autodiff();
     device.seed(1);
-    // `SINMDM_BENCH_SIZE=C,BATCH` picks another size (default the paper's 256,64).
-    let (c, batch) = std::env::var("SINMDM_BENCH_SIZE")
+    // `SINMDM_BENCH_SIZE=C,BATCH[,FRAMES[,WINDOW]]` picks another size (default the paper's
+    // 256,64,200,3; the 60 fps dog's step is 64,1,1024,11).
+    let size: Vec<usize> = std::env::var("SINMDM_BENCH_SIZE")
         .ok()
-        .and_then(|s| {
-            let (c, b) = s.split_once(',')?;
-            Some((c.trim().parse().ok()?, b.trim().parse().ok()?))
-        })
-        .unwrap_or((256, 64));
-    let frames = 200;
+        .map(|s| s.split(',').filter_map(|v| v.trim().parse().ok()).collect())
+        .unwrap_or_default();
+    let at = |i: usize, default: usize| size.get(i).copied().unwrap_or(default);
+    let (c, batch, frames, window) = (at(0, 256), at(1, 64), at(2, 200), at(3, 3));
     let x = Tensor::<3>::random([batch, frames, c], Distribution::Normal(0.0, 1.0), &device)
         .require_grad();
     let embedding = Tensor::<2>::random([batch, 4 * c], Distribution::Normal(0.0, 1.0), &device);
@@ -50,14 +49,14 @@ fn main() {
         &device,
     );
     let dropout = HashDropout::new(0.5, 1);
-    let qna = QnaBlock::new(c, 4, 3, &device);
+    let qna = QnaBlock::new(c, 4, window, &device);
     let block = ResBlock::new(c, c, 4 * c, 0.5, 1, &device);
     let key = Some(DropoutKey {
         seed: 1,
         first_item: 0,
     });
     println!(
-        "layer, [{batch}, {frames}, {c}], flex, {} threads   ms: fwd, fwd+bwd",
+        "layer, [{batch}, {frames}, {c}], QnA window {window}, flex, {} threads   ms: fwd, fwd+bwd",
         rayon::current_num_threads()
     );
     time("x * x (reference point)", || x.clone() * x.clone());
