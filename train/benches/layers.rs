@@ -1,6 +1,7 @@
 //! Forward and forward + backward time of each layer of the denoiser at the paper's size (C 256,
 //! batch 64, 200 frames), best of 4: where a training step's time goes. Run:
-//! `cargo bench -p sinmdm-train --bench layers` (`SINMDM_BENCH_SIZE=128,8` for the CPU config, `64,1,1024,11` for the 60 fps dog).
+//! `cargo bench -p sinmdm-train --bench layers` (`SINMDM_BENCH_SIZE=128,8` for the CPU config,
+//! `64,1,1024,11` for the 60 fps dog).
 
 use std::time::Instant;
 

@@ -71,14 +71,10 @@ pub fn wider_window(model: &ModelConfig, decorrelation: usize) -> Option<usize> 
     (candidate.window > model.window).then_some(candidate.window)
 }
 
-/// A line for the user when the clip's motion stays correlated longer than twice the receptive
-/// field of `model` at `fps`; `None` otherwise.
-pub fn wider_window_hint(
-    features: ArrayView2<'_, f32>,
-    fps: f64,
-    model: &ModelConfig,
-) -> Option<String> {
-    let frames = decorrelation_frames(features, fps)?;
+/// A line for the user when a clip whose features decorrelate after `frames` frames
+/// ([`decorrelation_frames`]) stays correlated longer than twice the receptive field of `model`
+/// at `fps`; `None` otherwise.
+pub fn wider_window_hint(frames: usize, fps: f64, model: &ModelConfig) -> Option<String> {
     let window = wider_window(model, frames)?;
     let wider = ModelConfig {
         window,
@@ -87,8 +83,9 @@ pub fn wider_window_hint(
     Some(format!(
         "this clip's motion stays correlated for {:.2} s and the network sees {:.2} s at once \
          (QnA window {}). Long, slow motifs like these were covered better with a wider field \
-         (the MANN dog walk at 30 fps: 80 % coverage with window 3, 94 % with 11, somewhat less varied); to try \
-         it, set model.window: {window} ({:.2} s; each step costs more) in a --config",
+         (the MANN dog walk at 30 fps: 80 % coverage with window 3, 94 % with 11, somewhat \
+         less varied); to try it, set model.window: {window} ({:.2} s; each step costs more) \
+         in a --config",
         frames as f64 / fps,
         model.receptive_field() as f64 / fps,
         model.window,
@@ -192,13 +189,13 @@ mod tests {
         let slow = sinusoids(348.0, 1000);
         let span = decorrelation_frames(slow.view(), 30.0).unwrap();
         assert!((86..=89).contains(&span), "{span}");
-        let hint = wider_window_hint(slow.view(), 30.0, &model).unwrap();
+        let hint = wider_window_hint(span, 30.0, &model).unwrap();
         assert!(
             hint.contains(&format!("{:.2} s", span as f64 / 30.0)),
             "{hint}"
         );
         assert!(hint.contains("model.window: 11"), "{hint}");
-        let fast = sinusoids(60.0, 1000);
-        assert_eq!(wider_window_hint(fast.view(), 30.0, &model), None);
+        let fast = decorrelation_frames(sinusoids(60.0, 1000).view(), 30.0).unwrap();
+        assert_eq!(wider_window_hint(fast, 30.0, &model), None);
     }
 }

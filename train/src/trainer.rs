@@ -300,11 +300,9 @@ impl Trainer {
     /// A line for the user when the clip's motion stays correlated for much longer than the
     /// network sees at once ([`crate::motion_span::wider_window_hint`]).
     pub fn wider_window_hint(&self) -> Option<String> {
-        crate::motion_span::wider_window_hint(
-            self.clip.features.view(),
-            self.clip.facts.layout.fps,
-            &self.state.config.model,
-        )
+        let fps = self.clip.facts.layout.fps;
+        let frames = crate::motion_span::decorrelation_frames(self.clip.features.view(), fps)?;
+        crate::motion_span::wider_window_hint(frames, fps, &self.state.config.model)
     }
 
     /// Whether all configured steps are done.

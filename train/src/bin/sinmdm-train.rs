@@ -12,6 +12,7 @@ use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sinmdm_train::clip_data::ClipData;
+use sinmdm_train::motion_span;
 use sinmdm_train::{QnaUnet, RunEnd, TrainConfig, Trainer};
 
 /// Fit the single-motion QnA-UNet denoiser on one BVH clip.
@@ -168,17 +169,17 @@ fn dry_run(args: &Args) -> Result<()> {
         config.model.window
     );
     let fps = data.facts.layout.fps;
-    match sinmdm_train::motion_span::decorrelation_frames(data.features.view(), fps) {
-        Some(frames) => println!(
-            "motion span     {:.2} s (the lag at which the features' autocorrelation first falls below zero)",
-            frames as f64 / fps
-        ),
+    match motion_span::decorrelation_frames(data.features.view(), fps) {
+        Some(frames) => {
+            println!(
+                "motion span     {:.2} s (the lag at which the features' autocorrelation first falls below zero)",
+                frames as f64 / fps
+            );
+            if let Some(hint) = motion_span::wider_window_hint(frames, fps, &config.model) {
+                println!("hint            {hint}");
+            }
+        }
         None => println!("motion span     longer than half the clip or 10 s"),
-    }
-    if let Some(hint) =
-        sinmdm_train::motion_span::wider_window_hint(data.features.view(), fps, &config.model)
-    {
-        println!("hint            {hint}");
     }
     let shape = config.training.batch_shape(data.features.ncols());
     let window = match shape.window {
