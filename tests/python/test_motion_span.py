@@ -70,6 +70,6 @@ def test_motion_span_and_hint_match_numpy(clip, tmp_path, sinmdm):
     while receptive_field(window) < wanted:
         window += 2
     if window > 3:
-        assert f"model.window: {window} " in out, out
+        assert f"--window {window} (" in out, out
     else:
         assert "hint" not in out, out

@@ -7,7 +7,7 @@
 //! turning and stopping, stays correlated for 2.9 s, and its samples covered it far better with a
 //! wider field (coverage 80 % at window 3, 92 % at 7, 94 % at 11, at 30 fps). The trainer does
 //! not widen the window by itself (one clip in nine measured needs it, too few to fit a rule);
-//! it tells the user, who may set `model.window` in a `--config`.
+//! it tells the user, who may train with `--window` (or set `model.window` in a `--config`).
 
 use ndarray::ArrayView2;
 
@@ -84,8 +84,8 @@ pub fn wider_window_hint(frames: usize, fps: f64, model: &ModelConfig) -> Option
         "this clip's motion stays correlated for {:.2} s and the network sees {:.2} s at once \
          (QnA window {}). Long, slow motifs like these were covered better with a wider field \
          (the MANN dog walk at 30 fps: 80 % coverage with window 3, 94 % with 11, somewhat \
-         less varied); to try it, set model.window: {window} ({:.2} s; each step costs more) \
-         in a --config",
+         less varied); to try it, train with --window {window} ({:.2} s; each step costs \
+         more)",
         frames as f64 / fps,
         model.receptive_field() as f64 / fps,
         model.window,
@@ -194,7 +194,7 @@ mod tests {
             hint.contains(&format!("{:.2} s", span as f64 / 30.0)),
             "{hint}"
         );
-        assert!(hint.contains("model.window: 11"), "{hint}");
+        assert!(hint.contains("--window 11 (1.57 s"), "{hint}");
         let fast = decorrelation_frames(sinusoids(60.0, 1000).view(), 30.0).unwrap();
         assert_eq!(wider_window_hint(fast, 30.0, &model), None);
     }

@@ -442,6 +442,38 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
         .unwrap();
     assert!(String::from_utf8_lossy(&out.stderr).contains("--fps must be"));
 
+    // --window replaces the window at any frame rate: 5 at 120 fps stays 5 (14 + 3 * 5 frames).
+    let out = Command::new(bin)
+        .arg(walk())
+        .args(["--fps", "clip", "--window", "5", "--dry-run"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("receptive field 29 frames (QnA window 5)"),
+        "{text}"
+    );
+    let out = Command::new(bin)
+        .arg(walk())
+        .args(["--window", "4", "--dry-run"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("--window 4: model.window must be odd"),
+        "{err}"
+    );
+    let out = Command::new(bin)
+        .args(["--resume", "--window", "5", "--out"])
+        .arg(scratch("no-run-to-resume"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("--window sets the QnA window of a new run"),
+        "{err}"
+    );
+
     let bad = scratch("bad.yaml");
     let text = std::fs::read_to_string(root().join("configs/tiny.yaml"))
         .unwrap()

@@ -41,6 +41,11 @@ struct Args {
     /// so this sets how much time the model sees at once (23 frames: 0.77 s at 30 fps).
     #[arg(long, value_name = "FPS|clip")]
     fps: Option<String>,
+    /// QnA window of a new run (odd), replacing the config's model.window at any frame rate: the
+    /// network then sees 14 + 3 K frames at once (23 for 3, 47 for 11). The trainer names a wider
+    /// one when the clip's motion stays correlated far longer than the network sees.
+    #[arg(long, value_name = "K")]
+    window: Option<usize>,
     /// Run folder: checkpoints, loss.csv, loss.png.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -85,7 +90,7 @@ fn default_config() -> TrainConfig {
         .expect("the shipped default configuration is valid")
 }
 
-/// The configuration of a new run: --config, else the default, with --fps applied.
+/// The configuration of a new run: --config, else the default, with --fps and --window applied.
 fn new_run_config(args: &Args) -> Result<TrainConfig> {
     let mut config = match &args.config {
         Some(path) => TrainConfig::load(path)?,
@@ -101,6 +106,13 @@ fn new_run_config(args: &Args) -> Result<TrainConfig> {
                 ),
             },
         };
+    }
+    if let Some(window) = args.window {
+        config.model.window = window;
+        config.model.window_follows_fps = false;
+        config
+            .validate()
+            .map_err(|e| anyhow::anyhow!("--window {window}: {e}"))?;
     }
     Ok(config)
 }
@@ -234,6 +246,9 @@ fn main() -> Result<()> {
     let mut trainer = if args.resume {
         if args.fps.is_some() {
             bail!("--fps sets the frame rate of a new run; a resumed run keeps its own");
+        }
+        if args.window.is_some() {
+            bail!("--window sets the QnA window of a new run; a resumed run keeps its own");
         }
         let config = args.config.as_deref().map(TrainConfig::load).transpose()?;
         Trainer::resume(out, args.clip.as_deref(), config, device)?
