@@ -54,6 +54,18 @@ pub struct StepReport {
     pub recent_loss: f64,
     /// Learning rate used by this step.
     pub learning_rate: f64,
+    /// Seconds of training so far, earlier sessions of a resumed run included.
+    pub seconds: f64,
+}
+
+impl StepReport {
+    /// Seconds the remaining steps should take at the run's mean pace so far.
+    pub fn seconds_left(&self) -> f64 {
+        if self.step == 0 {
+            return 0.0;
+        }
+        self.seconds / self.step as f64 * self.total.saturating_sub(self.step) as f64
+    }
 }
 
 /// A training run in a run folder.
@@ -389,6 +401,7 @@ impl Trainer {
             loss: value,
             recent_loss: self.state.recent_loss,
             learning_rate,
+            seconds,
         })
     }
 
@@ -478,4 +491,28 @@ pub fn seconds_per_step(
     })();
     let _ = std::fs::remove_dir_all(&folder);
     measured
+}
+
+#[cfg(test)]
+mod tests {
+    use super::StepReport;
+
+    fn report(step: u64, total: u64, seconds: f64) -> StepReport {
+        StepReport {
+            step,
+            total,
+            loss: 0.1,
+            recent_loss: 0.1,
+            learning_rate: 1e-4,
+            seconds,
+        }
+    }
+
+    #[test]
+    fn time_left_follows_the_mean_pace() {
+        // 100 steps in 60 s: 300 more take 180 s.
+        assert_eq!(report(100, 400, 60.0).seconds_left(), 180.0);
+        assert_eq!(report(400, 400, 240.0).seconds_left(), 0.0);
+        assert_eq!(report(0, 400, 0.0).seconds_left(), 0.0);
+    }
 }

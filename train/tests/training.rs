@@ -371,6 +371,8 @@ fn a_time_budget_sets_the_steps_and_records_them() {
         err.contains(&format!("so {steps} steps")) && err.contains(&format!("done: {steps} steps")),
         "{err}"
     );
+    // Progress lines in a log (no terminal) say how long the run has taken and has left.
+    assert!(err.contains(" min left"), "{err}");
     assert_eq!(losses(&run).len() as u64, steps);
     // No timing probe is left behind.
     assert!(!probe.exists());

@@ -310,8 +310,14 @@ fn main() -> Result<()> {
         ));
         if !terminal && report.step % quiet_every == 0 {
             eprintln!(
-                "step {}/{}  loss {:.4}  mean {:.4}  lr {:.3e}",
-                report.step, report.total, report.loss, report.recent_loss, report.learning_rate
+                "step {}/{}  loss {:.4}  mean {:.4}  lr {:.3e}  {:.1} min, about {:.1} min left",
+                report.step,
+                report.total,
+                report.loss,
+                report.recent_loss,
+                report.learning_rate,
+                report.seconds / 60.0,
+                report.seconds_left() / 60.0
             );
         }
     });
