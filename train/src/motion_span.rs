@@ -60,35 +60,32 @@ pub fn decorrelation_frames(features: ArrayView2<'_, f32>, fps: f64) -> Option<u
     })
 }
 
-/// The narrowest QnA window whose receptive field spans half of `decorrelation` frames, when it
-/// is wider than the window of `model` (already resolved for the clip's frame rate).
-pub fn wider_window(model: &ModelConfig, decorrelation: usize) -> Option<usize> {
+/// `model` with the narrowest QnA window whose receptive field spans half of `decorrelation`
+/// frames, when that window is wider than the window of `model` (already resolved for the
+/// clip's frame rate).
+pub fn wider_window(model: &ModelConfig, decorrelation: usize) -> Option<ModelConfig> {
     let wanted = decorrelation.div_ceil(2);
     let mut candidate = model.clone();
     while candidate.receptive_field() < wanted {
         candidate.window += 2;
     }
-    (candidate.window > model.window).then_some(candidate.window)
+    (candidate.window > model.window).then_some(candidate)
 }
 
 /// A line for the user when a clip whose features decorrelate after `frames` frames
 /// ([`decorrelation_frames`]) stays correlated longer than twice the receptive field of `model`
 /// at `fps`; `None` otherwise.
 pub fn wider_window_hint(frames: usize, fps: f64, model: &ModelConfig) -> Option<String> {
-    let window = wider_window(model, frames)?;
-    let wider = ModelConfig {
-        window,
-        ..model.clone()
-    };
+    let wider = wider_window(model, frames)?;
     Some(format!(
         "this clip's motion stays correlated for {:.2} s and the network sees {:.2} s at once \
          (QnA window {}). Long, slow motifs like these were covered better with a wider field \
          (the MANN dog walk at 30 fps: 80 % coverage with window 3, 94 % with 11, somewhat \
-         less varied); to try it, train with --window {window} ({:.2} s; each step costs \
-         more)",
+         less varied); to try it, train with --window {} ({:.2} s; each step costs more)",
         frames as f64 / fps,
         model.receptive_field() as f64 / fps,
         model.window,
+        wider.window,
         wider.receptive_field() as f64 / fps,
     ))
 }
@@ -159,15 +156,15 @@ mod tests {
     fn the_window_grows_until_its_field_spans_half_the_decorrelation() {
         let model = default_model();
         // Window 3 sees 23 frames: a span up to 46 frames asks for nothing wider.
-        assert_eq!(wider_window(&model, 42), None);
-        assert_eq!(wider_window(&model, 46), None);
+        assert!(wider_window(&model, 42).is_none());
+        assert!(wider_window(&model, 46).is_none());
         // The dog at 30 fps (2.90 s, 87 frames): half is 44 frames, window 11 sees 47, 9 sees 41.
-        assert_eq!(wider_window(&model, 87), Some(11));
+        assert_eq!(wider_window(&model, 87).map(|m| m.window), Some(11));
         // The same span at 60 fps (174 frames) with the window resolved for 60 fps (11):
         // half is 87 frames; window 25 sees 89, 23 sees 83.
         let at_60 = model.at_fps(60.0);
         assert_eq!(at_60.window, 11);
-        assert_eq!(wider_window(&at_60, 174), Some(25));
+        assert_eq!(wider_window(&at_60, 174).map(|m| m.window), Some(25));
         for (span, window) in [(87usize, 11), (174, 25)] {
             let m = ModelConfig {
                 window,
