@@ -16,7 +16,8 @@ use sinmdm::files::write_atomically;
 use sinmdm::{Feet, Generated, Request, Stream, StreamOptions, Task};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_eval::{
-    COVERAGE_WINDOW, FeetReport, ModelEvaluation, Report, evaluate_generated, evaluate_model,
+    COVERAGE_WINDOW, FeetReport, ModelEvaluation, REPLAY_TOLERANCE, ReplayReport, Report,
+    evaluate_generated, evaluate_model,
 };
 
 pub(crate) const EXAMPLES: &str = "Examples:
@@ -50,6 +51,10 @@ pub struct EvalArgs {
     /// Seed of the samples.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Root-mean-square difference per 6D component under which a sample frame counts as a
+    /// verbatim copy of a clip frame, for the replay figure.
+    #[arg(long, default_value_t = REPLAY_TOLERANCE, value_name = "RMS")]
+    replay_tolerance: f64,
     /// Threads for the network and the metrics (default: every core).
     #[arg(long)]
     threads: Option<usize>,
@@ -88,11 +93,18 @@ struct EvalFile<'a> {
     raw_motion_report: &'a Report,
     planted_report: &'a Report,
     feet: &'a FeetReport,
+    replay: &'a ReplayReport,
 }
 
 pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     if args.samples == 0 {
         bail!("--samples must be at least 1");
+    }
+    if !(args.replay_tolerance.is_finite() && args.replay_tolerance >= 0.0) {
+        bail!(
+            "--replay-tolerance must be a finite number >= 0, got {}",
+            args.replay_tolerance
+        );
     }
     if args.threads == Some(0) {
         bail!("--threads must be at least 1");
@@ -196,10 +208,21 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         raw_motion_report,
         planted_report,
         feet,
+        replay,
         sampling_seconds,
         scoring_seconds,
     } = evaluation;
     let layout = generated.layout();
+    let replay = if args.replay_tolerance == replay.tolerance {
+        replay
+    } else {
+        ReplayReport::of_features(
+            layout,
+            clip.view(),
+            generated.features.view(),
+            args.replay_tolerance,
+        )
+    };
 
     let steps_text = steps.map_or("all".to_string(), |s| s.to_string());
     println!(
@@ -239,6 +262,12 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     );
     println!();
     print!("{}", feet.markdown_table());
+    println!();
+    println!(
+        "replay: the samples' longest verbatim copies of the clip (frames within {} root-mean-square \
+         per 6D component) last {:.2} s on average, {:.2} s at most",
+        replay.tolerance, replay.mean_seconds, replay.max_seconds
+    );
 
     if let Some(path) = &args.features_json {
         write_features(path, layout, generated.features.view())?;
@@ -261,6 +290,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             raw_motion_report: &raw_motion_report,
             planted_report: &planted_report,
             feet: &feet,
+            replay: &replay,
         };
         let text = serde_json::to_string_pretty(&file)?;
         write_atomically(path, text.as_bytes())

@@ -12,6 +12,7 @@
 //! | local diversity | mean over a sample's 15-frame windows of the per-frame distance to the nearest clip window | higher |
 //! | inter diversity | Frobenius distance between consecutive samples, divided by their frames | higher |
 //! | intra diversity difference | \|mean Frobenius distance / 15 between two 15-frame windows of a sample, minus the same for the clip\| | lower |
+//! | replay (s) | mean over samples of the longest run of frames copying consecutive clip frames ([`ReplayReport`]) | lower |
 //!
 //! Two choices differ from the published scripts, both to remove noise rather than change what is
 //! measured: coverage counts every window of the clip (the scripts skip the last one), and the
@@ -31,6 +32,7 @@
 mod feet;
 mod model_eval;
 mod patched_nn;
+mod replay;
 #[cfg(test)]
 mod test_data;
 mod window_match;
@@ -47,6 +49,7 @@ pub use feet::{
 };
 pub use model_eval::{ModelEvalError, ModelEvaluation, evaluate_generated, evaluate_model};
 pub use patched_nn::patched_nearest_neighbour;
+pub use replay::{REPLAY_TOLERANCE, ReplayReport, longest_replay, rotation_rows};
 pub use window_match::DiagonalSums;
 
 /// Window of the coverage metric and shortest piece of the global diversity, in frames.

@@ -10,8 +10,8 @@ use sinmdm::{Denoiser, Generated, ModelMetadata, Request, TaskError};
 use thiserror::Error;
 
 use crate::{
-    COVERAGE_WINDOW, EvalError, FeetReport, Report, evaluate, metric_features,
-    motion_metric_features,
+    COVERAGE_WINDOW, EvalError, FeetReport, REPLAY_TOLERANCE, ReplayReport, Report, evaluate,
+    metric_features, motion_metric_features,
 };
 
 /// Why a model could not be scored.
@@ -43,6 +43,8 @@ pub struct ModelEvaluation {
     pub planted_report: Report,
     /// Their feet and smoothness figures, raw and planted, beside the clip's.
     pub feet: FeetReport,
+    /// How long the samples, as the network made them, copy the clip verbatim.
+    pub replay: ReplayReport,
     /// Seconds spent sampling.
     pub sampling_seconds: f64,
     /// Seconds spent scoring.
@@ -101,6 +103,8 @@ pub fn evaluate_generated(
         .map(|sample| metric_features(layout, sample))
         .collect();
     let report = evaluate(clip_metric.view(), &samples, threads.max(1))?;
+    let replay =
+        ReplayReport::of_features(layout, clip, generated.features.view(), REPLAY_TOLERANCE);
     let raw = (0..generated.count())
         .map(|i| generated.raw_motion(i))
         .collect::<Result<Vec<_>, _>>()?;
@@ -125,6 +129,7 @@ pub fn evaluate_generated(
         raw_motion_report,
         planted_report,
         feet,
+        replay,
         sampling_seconds,
         scoring_seconds: started.elapsed().as_secs_f64(),
     })

@@ -23,6 +23,10 @@ pub const NORM_EPSILON: f32 = 1e-5;
 /// QnA scores more than this below their sequence maximum are raised to it, so no window's
 /// softmax can sum to zero.
 pub const SCORE_FLOOR: f32 = -60.0;
+/// QnA relative-position biases more than this below their head's largest are raised to it.
+/// With the score floor, every weight of a window sum is at least `exp(-80)`, a normal f32, so
+/// the graph's sums (which take the weights unshifted) never underflow to 0.
+pub const RPE_SPREAD_FLOOR: f32 = -20.0;
 /// Width of the sinusoidal timestep features (cosines, then sines).
 pub const SINUSOID_WIDTH: usize = 256;
 /// Longest period of the timestep sinusoids.

@@ -95,3 +95,53 @@ def test_eval_scores_match_the_literal_definitions(tmp_path):
     assert np.abs(np.array(report["clip_window_coverage"]) - 100 * made_by / len(samples)).max() < 1e-12
     gap = abs(np.mean([intra(s) for s in samples]) - intra(clip))
     assert abs(report["intra_diversity_diff"] - gap) < 1e-12
+
+
+def rotations(path):
+    """Frames x every 6D rotation component of each motion in the file (f32 widened)."""
+    data = json.loads(path.read_text())
+    keep = [i for i, name in enumerate(data["columns"]) if ".rot6d[" in name]
+    return [np.asarray(sample, dtype=np.float32).astype(np.float64)[keep].T for sample in data["samples"]]
+
+
+def longest_replay(sample, clip, tolerance):
+    """The longest run of sample frames s..s+L matching clip frames k..k+L, each pair within
+    `tolerance` root-mean-square per column: every start pair tried, walked frame by frame."""
+    rms = np.sqrt(((sample[:, None, :] - clip[None, :, :]) ** 2).mean(axis=2))
+    close = rms <= tolerance
+    best = 0
+    for s in range(len(sample)):
+        for k in range(len(clip)):
+            n = 0
+            while s + n < len(sample) and k + n < len(clip) and close[s + n, k + n]:
+                n += 1
+            best = max(best, n)
+    return best
+
+
+def test_eval_replay_matches_a_naive_search(tmp_path):
+    """The replay figure against every start pair walked in numpy, at the default tolerance and
+    at a loose one under which the tiny model's samples do copy stretches of the clip."""
+    clip_json, samples_json = tmp_path / "clip.json", tmp_path / "samples.json"
+    run = lambda *a: subprocess.run([str(SINMDM), *map(str, a)], capture_output=True, text=True)  # noqa: E731
+    done = run("encode", WALK, "-m", MODEL, "-o", clip_json)
+    assert done.returncode == 0, done.stderr
+    clip = rotations(clip_json)[0]
+    longest = {}
+    for tolerance in (0.05, 0.6):
+        scores_json = tmp_path / f"scores_{tolerance}.json"
+        done = run("eval", "-m", MODEL, "--clip", WALK, "--samples", 3, "--frames", 80, "--steps", 5,
+                   "--seed", 3, "--quiet", "--json", scores_json, "--features-json", samples_json,
+                   "--replay-tolerance", tolerance)
+        assert done.returncode == 0, done.stderr
+        assert "replay:" in done.stdout
+        replay = json.loads(scores_json.read_text())["replay"]
+        samples = rotations(samples_json)
+        expected = [longest_replay(s, clip, tolerance) for s in samples]
+        assert replay["longest_frames"] == expected, tolerance
+        fps = replay["fps"]
+        assert abs(replay["mean_seconds"] - np.mean(expected) / fps) < 1e-12
+        assert abs(replay["max_seconds"] - max(expected) / fps) < 1e-12
+        longest[tolerance] = expected
+    # The loose tolerance finds copies, so the comparison above checked real runs.
+    assert max(longest[0.6]) >= 2, longest

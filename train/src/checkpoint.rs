@@ -11,6 +11,7 @@ use crate::clip_data::ClipFacts;
 use crate::config::{BatchShape, TrainConfig};
 use crate::error::{TrainError, io};
 use crate::model::QnaUnet;
+use crate::recovery::RecoveryRecord;
 
 /// Checkpoints kept on disk (older ones are removed after a new one is complete).
 pub const KEPT_CHECKPOINTS: usize = 2;
@@ -56,6 +57,9 @@ pub struct CheckpointState {
     pub batch: Option<BatchShape>,
     /// When the run started (UTC, RFC 3339).
     pub started: String,
+    /// What the trainer did about non-finite steps (clean in runs saved before it was kept).
+    #[serde(default)]
+    pub recovery: RecoveryRecord,
 }
 
 fn record(path: &Path) -> impl FnOnce(burn::store::RecordError) -> TrainError + '_ {

@@ -60,16 +60,19 @@ pub enum TrainError {
     /// The model could not be exported.
     #[error("export failed: {0}")]
     Export(String),
-    /// The loss stopped being a finite number.
+    /// Steps kept going non-finite after every recovery the trainer tries.
     #[error(
-        "the loss became {loss} at step {step}; stopped without saving. The last good checkpoint is {}",
-        last_checkpoint.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "none (no checkpoint was written yet)".into())
+        "the loss or its gradients kept going non-finite: at step {step}, after {tried}, the run had already gone back to step {to} {max} times; stopped. The last good checkpoint is {}; a smaller training.learning_rate or another training.seed may get past it",
+        last_checkpoint.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "none (no checkpoint was written yet)".into()),
+        max = crate::recovery::MAX_ROLLBACKS
     )]
-    NonFiniteLoss {
-        /// The offending loss value.
-        loss: f64,
-        /// The step it appeared at.
+    Unrecoverable {
+        /// The step that failed last.
         step: u64,
+        /// The step the run kept going back to.
+        to: u64,
+        /// What was tried (skipped steps, roll-backs, the learning rate's factor).
+        tried: String,
         /// The newest checkpoint on disk.
         last_checkpoint: Option<PathBuf>,
     },

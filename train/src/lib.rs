@@ -18,6 +18,7 @@ pub mod loss_plot;
 pub mod memory;
 pub mod model;
 pub mod motion_span;
+pub mod recovery;
 mod shards;
 pub mod trainer;
 pub mod weight_average;

@@ -76,6 +76,54 @@ pub(crate) fn sharded_gradients(
     (value, Some(grads))
 }
 
+/// Whether every gradient in `grads` (those of `model`'s parameters) is finite. A tensor's sum
+/// is NaN or infinite when any of its values is (or when the values overflow f32 together,
+/// which no update should follow either).
+pub(crate) fn gradients_are_finite(model: &QnaUnet, grads: &GradientsParams) -> bool {
+    struct Check<'a> {
+        grads: &'a GradientsParams,
+        finite: bool,
+    }
+    impl ModuleVisitor for Check<'_> {
+        fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+            if !self.finite {
+                return;
+            }
+            if let Some(grad) = self.grads.get::<D>(param.id) {
+                let sum = grad.sum().into_scalar::<f32>();
+                self.finite = sum.is_finite();
+            }
+        }
+    }
+    let mut check = Check {
+        grads,
+        finite: true,
+    };
+    model.visit(&mut check);
+    check.finite
+}
+
+/// Turns the gradient of `model`'s first parameter into NaN: a fault injected by tests of the
+/// recovery path, so they exercise the same check a real failure meets.
+pub(crate) fn poison_first_gradient(model: &QnaUnet, grads: &mut GradientsParams) {
+    struct Poison<'a> {
+        grads: &'a mut GradientsParams,
+        done: bool,
+    }
+    impl ModuleVisitor for Poison<'_> {
+        fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+            if self.done {
+                return;
+            }
+            if let Some(grad) = self.grads.remove::<D>(param.id) {
+                self.grads.register(param.id, grad.mul_scalar(f32::NAN));
+                self.done = true;
+            }
+        }
+    }
+    model.visit(&mut Poison { grads, done: false });
+}
+
 /// `(first item, items)` of each shard of a batch split `threads` ways, larger shards first.
 fn shard_ranges(batch: usize, threads: usize) -> Vec<(usize, usize)> {
     let shards = threads.clamp(1, batch.max(1));

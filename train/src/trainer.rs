@@ -1,6 +1,6 @@
 //! The training loop: batches, loss, AdamW with a decaying learning rate, checkpoints, resume.
 
-use std::collections::VecDeque;
+use std::collections::{BTreeSet, VecDeque};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -20,7 +20,8 @@ use crate::foot_contact::FootContact;
 use crate::loss::LossTerms;
 use crate::loss_log::LossLog;
 use crate::model::{QnaUnet, on_cpu};
-use crate::shards::sharded_gradients;
+use crate::recovery::{MAX_ROLLBACKS, NonFinite, RecoveryEvent, RecoveryRecord};
+use crate::shards::{gradients_are_finite, poison_first_gradient, sharded_gradients};
 use crate::weight_average::WeightAverage;
 
 /// Copy of the clip inside the run folder, so a run resumes without the original file.
@@ -56,6 +57,8 @@ pub struct StepReport {
     pub learning_rate: f64,
     /// Seconds of training so far, earlier sessions of a resumed run included.
     pub seconds: f64,
+    /// What the trainer did about a non-finite step, when this step was one.
+    pub event: Option<RecoveryEvent>,
 }
 
 impl StepReport {
@@ -85,6 +88,31 @@ pub struct Trainer {
     last_checkpoint: Option<PathBuf>,
     /// The foot-contact term of the loss, when its weight is not 0 and the clip has contacts.
     foot_contact: Option<FootContact>,
+    /// Steps (1-based) whose gradients tests turn into NaN, once each.
+    injected_faults: BTreeSet<u64>,
+}
+
+/// How one optimiser step ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepOutcome {
+    /// The model was updated; the batch's loss.
+    Updated(f64),
+    /// Nothing was changed: the loss or a gradient was not finite.
+    Skipped {
+        /// The batch's loss (finite when a gradient was the problem).
+        loss: f64,
+        /// What was not finite.
+        cause: NonFinite,
+    },
+}
+
+impl StepOutcome {
+    /// The batch's loss, whether or not the model was updated.
+    pub fn loss(&self) -> f64 {
+        match *self {
+            StepOutcome::Updated(loss) | StepOutcome::Skipped { loss, .. } => loss,
+        }
+    }
 }
 
 /// The optimiser of a configuration (AdamW, epsilon 1e-8 as in PyTorch).
@@ -96,7 +124,8 @@ pub fn new_optimizer(config: &TrainConfig) -> ModuleOptimizer {
 }
 
 /// One AdamW step on the x0-prediction MSE of `model` for the batch `(x_t, t) -> x0`. Returns
-/// the updated model and the loss; when the loss is not finite the model comes back unchanged.
+/// the updated model and the loss; when the loss or any gradient is not finite the model comes
+/// back unchanged (and the optimiser's state too), and the outcome says which.
 ///
 /// The batch is cut into as many shards as rayon has threads (at least one item each), whose
 /// forward and backward passes run in parallel on their own threads. burn-flex runs element-wise
@@ -114,17 +143,84 @@ pub fn optimisation_step(
     x0: Tensor<3>,
     learning_rate: f64,
     terms: &LossTerms,
-) -> (QnaUnet, f64) {
+) -> (QnaUnet, StepOutcome) {
+    step_with_fault(model, optimizer, (x_t, t, x0), learning_rate, terms, false)
+}
+
+/// [`optimisation_step`], with the gradients poisoned first when `inject_fault` is set.
+fn step_with_fault(
+    model: QnaUnet,
+    optimizer: &mut ModuleOptimizer,
+    (x_t, t, x0): (Tensor<3>, Tensor<1>, Tensor<3>),
+    learning_rate: f64,
+    terms: &LossTerms,
+    inject_fault: bool,
+) -> (QnaUnet, StepOutcome) {
     // A GPU runs one batch best whole.
     let shards = if on_cpu(&x_t.device()) {
         rayon::current_num_threads()
     } else {
         1
     };
-    match sharded_gradients(&model, x_t, t, x0, shards, terms) {
-        (loss, Some(grads)) => (optimizer.step(learning_rate, model, grads), loss),
-        (loss, None) => (model, loss),
+    let (loss, grads) = sharded_gradients(&model, x_t, t, x0, shards, terms);
+    let Some(mut grads) = grads else {
+        let cause = NonFinite::Loss;
+        return (model, StepOutcome::Skipped { loss, cause });
+    };
+    if inject_fault {
+        poison_first_gradient(&model, &mut grads);
     }
+    if !gradients_are_finite(&model, &grads) {
+        let cause = NonFinite::Gradient;
+        return (model, StepOutcome::Skipped { loss, cause });
+    }
+    (
+        optimizer.step(learning_rate, model, grads),
+        StepOutcome::Updated(loss),
+    )
+}
+
+/// A new network, its weight average and optimiser for `config`, drawn from the run's seed.
+fn fresh_parts(
+    config: &TrainConfig,
+    features: usize,
+    device: &Device,
+) -> (QnaUnet, Option<WeightAverage>, ModuleOptimizer) {
+    device.seed(config.training.seed);
+    let model = QnaUnet::new(features, &config.model, device);
+    let average = config
+        .training
+        .ema_decay
+        .map(|decay| WeightAverage::new(&model, decay, 0));
+    (model, average, new_optimizer(config))
+}
+
+/// The network, weight average and optimiser saved in the checkpoint `dir` of a run whose
+/// state is `state`.
+fn load_parts(
+    dir: &Path,
+    state: &CheckpointState,
+    device: &Device,
+) -> Result<(QnaUnet, Option<WeightAverage>, ModuleOptimizer), TrainError> {
+    let model = QnaUnet::new(state.features, &state.config.model, device);
+    let model = checkpoint::load_model(dir, model)?;
+    let average = match state.config.training.ema_decay {
+        None => None,
+        Some(decay) => {
+            let shape = QnaUnet::new(state.features, &state.config.model, &Device::flex());
+            let saved =
+                checkpoint::load_average(dir, shape)?.ok_or_else(|| TrainError::Checkpoint {
+                    path: dir.to_path_buf(),
+                    message: format!(
+                        "keeps no {} although the run averages its weights",
+                        checkpoint::AVERAGE_FILE
+                    ),
+                })?;
+            Some(WeightAverage::new(&saved, decay, state.step))
+        }
+    };
+    let optimizer = checkpoint::load_optimizer(dir, new_optimizer(&state.config))?;
+    Ok((model, average, optimizer))
 }
 
 /// The foot-contact term for `config` on `data`: none when its weight is 0 or the clip has no
@@ -168,13 +264,8 @@ impl Trainer {
         sinmdm::files::write_atomically(&run.join(CLIP_COPY), &clip_bytes)
             .map_err(io("write into the output folder", run))?;
         let log = LossLog::create(&run.join(LOSS_LOG))?;
-        device.seed(config.training.seed);
         let features = data.features.nrows();
-        let model = QnaUnet::new(features, &config.model, &device);
-        let average = config
-            .training
-            .ema_decay
-            .map(|decay| WeightAverage::new(&model, decay, 0));
+        let (model, average, optimizer) = fresh_parts(&config, features, &device);
         let state = CheckpointState {
             step: 0,
             learning_rate: config.training.first_rate(),
@@ -186,6 +277,7 @@ impl Trainer {
             clip: data.facts.clone(),
             batch: Some(config.training.batch_shape(data.features.ncols())),
             started: crate::clock::now(),
+            recovery: RecoveryRecord::default(),
             config: config.clone(),
         };
         let foot_contact = foot_contact_term(&config, &data);
@@ -194,7 +286,7 @@ impl Trainer {
             device,
             model: Some(model),
             average,
-            optimizer: new_optimizer(&config),
+            optimizer,
             schedule: schedule(&config),
             clip: data,
             state,
@@ -204,6 +296,7 @@ impl Trainer {
             elapsed_before: 0.0,
             last_checkpoint: None,
             foot_contact,
+            injected_faults: BTreeSet::new(),
         })
     }
 
@@ -253,25 +346,7 @@ impl Trainer {
                 ),
             });
         }
-        let model = QnaUnet::new(state.features, &state.config.model, &device);
-        let model = checkpoint::load_model(&dir, model)?;
-        let average = match state.config.training.ema_decay {
-            None => None,
-            Some(decay) => {
-                let shape = QnaUnet::new(state.features, &state.config.model, &Device::flex());
-                let saved = checkpoint::load_average(&dir, shape)?.ok_or_else(|| {
-                    TrainError::Checkpoint {
-                        path: dir.clone(),
-                        message: format!(
-                            "keeps no {} although the run averages its weights",
-                            checkpoint::AVERAGE_FILE
-                        ),
-                    }
-                })?;
-                Some(WeightAverage::new(&saved, decay, state.step))
-            }
-        };
-        let optimizer = checkpoint::load_optimizer(&dir, new_optimizer(&state.config))?;
+        let (model, average, optimizer) = load_parts(&dir, &state, &device)?;
         let log = LossLog::resume(&run.join(LOSS_LOG), state.step)?;
         let elapsed_before = state.elapsed_seconds;
         state.batch = Some(state.config.training.batch_shape(data.features.ncols()));
@@ -291,6 +366,7 @@ impl Trainer {
             elapsed_before,
             last_checkpoint: Some(dir),
             foot_contact,
+            injected_faults: BTreeSet::new(),
         })
     }
 
@@ -326,8 +402,10 @@ impl Trainer {
         self.elapsed_before + self.session_start.elapsed().as_secs_f64()
     }
 
-    /// Runs one optimiser step and returns its report. A non-finite loss is an error and
-    /// changes nothing.
+    /// Runs one optimiser step and returns its report. A step whose loss or gradients are not
+    /// finite changes nothing and is skipped, and repeated ones roll the run back
+    /// ([`crate::recovery`]); the report's `event` says so. The error is for a run that could
+    /// not be recovered, or a checkpoint that could not be read or written.
     pub fn step(&mut self) -> Result<StepReport, TrainError> {
         let config = &self.state.config;
         let step = self.state.step;
@@ -359,33 +437,27 @@ impl Trainer {
             acceleration_weight: config.training.acceleration_weight,
             acceleration_below_timestep: config.training.acceleration_below_timestep,
         };
-        let (model, value) = optimisation_step(
+        let inject_fault = self.injected_faults.remove(&(step + 1));
+        let (model, outcome) = step_with_fault(
             model,
             &mut self.optimizer,
-            noised,
-            t,
-            clean,
+            (noised, t, clean),
             learning_rate,
             &terms,
+            inject_fault,
         );
-        if !value.is_finite() {
-            self.model = Some(model);
-            return Err(TrainError::NonFiniteLoss {
-                loss: value,
-                step: step + 1,
-                last_checkpoint: self.last_checkpoint.clone(),
-            });
-        }
+        let value = match outcome {
+            StepOutcome::Updated(value) => value,
+            StepOutcome::Skipped { loss, cause } => {
+                self.model = Some(model);
+                return self.skip(loss, cause);
+            }
+        };
         if let Some(average) = &mut self.average {
             average.update(&model);
         }
         self.model = Some(model);
-        self.state.step += 1;
-        self.state.learning_rate = self
-            .state
-            .config
-            .training
-            .next_rate(self.state.step, learning_rate);
+        self.advance();
         self.state.loss = value;
         self.recent.push_back(value);
         if self.recent.len() > RECENT_STEPS {
@@ -395,14 +467,109 @@ impl Trainer {
         let seconds = self.elapsed();
         self.log
             .push(self.state.step, value, learning_rate, seconds);
-        Ok(StepReport {
+        Ok(self.report(value, learning_rate, None))
+    }
+
+    /// Counts the step done and moves the learning rate on (scaled by the roll-backs so far).
+    fn advance(&mut self) {
+        let training = &self.state.config.training;
+        let scale = self.state.recovery.rate_scale;
+        self.state.step += 1;
+        self.state.learning_rate =
+            training.next_rate(self.state.step, self.state.learning_rate / scale) * scale;
+    }
+
+    fn report(&self, loss: f64, learning_rate: f64, event: Option<RecoveryEvent>) -> StepReport {
+        StepReport {
             step: self.state.step,
             total: self.state.config.training.steps,
-            loss: value,
+            loss,
             recent_loss: self.state.recent_loss,
             learning_rate,
-            seconds,
-        })
+            seconds: self.elapsed(),
+            event,
+        }
+    }
+
+    /// A step whose update was skipped: recorded, then either passed over (its batch dropped,
+    /// no row in the loss log) or, when skips repeat, the run rolled back.
+    fn skip(&mut self, loss: f64, cause: NonFinite) -> Result<StepReport, TrainError> {
+        let learning_rate = self.state.learning_rate;
+        let at = self.state.step + 1;
+        if self.state.recovery.skip(at, cause) {
+            let event = self.roll_back(at)?;
+            return Ok(self.report(loss, learning_rate, Some(event)));
+        }
+        self.advance();
+        let event = RecoveryEvent::Skipped { step: at, cause };
+        Ok(self.report(loss, learning_rate, Some(event)))
+    }
+
+    /// Goes back to the last good checkpoint (or the start, before the first), lowers the
+    /// learning rate, and saves that point with the record at once, so a resume starts from it.
+    fn roll_back(&mut self, at: u64) -> Result<RecoveryEvent, TrainError> {
+        let checkpoint = match &self.last_checkpoint {
+            Some(dir) => Some(dir.clone()),
+            None => checkpoint::latest(&self.run)?,
+        };
+        let target = match &checkpoint {
+            Some(dir) => checkpoint::load_state(dir)?,
+            None => CheckpointState {
+                step: 0,
+                learning_rate: self.state.config.training.first_rate(),
+                loss: f64::NAN,
+                recent_loss: f64::NAN,
+                recovery: RecoveryRecord::default(),
+                ..self.state.clone()
+            },
+        };
+        let mut record = self.state.recovery.clone();
+        let tries = record
+            .events
+            .iter()
+            .filter(|e| matches!(e, RecoveryEvent::RolledBack { to, .. } if *to == target.step))
+            .count();
+        if tries >= MAX_ROLLBACKS as usize {
+            return Err(TrainError::Unrecoverable {
+                step: at,
+                to: target.step,
+                tried: record.summary(),
+                last_checkpoint: checkpoint,
+            });
+        }
+        let (model, average, optimizer) = match &checkpoint {
+            Some(dir) => load_parts(dir, &target, &self.device)?,
+            None => fresh_parts(&target.config, target.features, &self.device),
+        };
+        let scale = record.roll_back(at, target.step);
+        let elapsed = self.elapsed();
+        self.state = CheckpointState {
+            learning_rate: target.learning_rate / target.recovery.rate_scale * scale,
+            recovery: record,
+            elapsed_seconds: elapsed,
+            ..target
+        };
+        self.model = Some(model);
+        self.average = average;
+        self.optimizer = optimizer;
+        self.log = LossLog::resume(&self.run.join(LOSS_LOG), self.state.step)?;
+        self.recent.clear();
+        self.elapsed_before = elapsed;
+        self.session_start = Instant::now();
+        self.save()?;
+        Ok(*self
+            .state
+            .recovery
+            .events
+            .last()
+            .expect("the roll-back was recorded"))
+    }
+
+    /// Makes the gradients of the given steps (1-based, as in the loss log) NaN, once each: a
+    /// test's stand-in for a numerical failure, met by the same checks.
+    #[doc(hidden)]
+    pub fn inject_non_finite_gradients(&mut self, steps: impl IntoIterator<Item = u64>) {
+        self.injected_faults.extend(steps);
     }
 
     /// Writes a checkpoint of the current step and flushes the loss log.
@@ -421,7 +588,8 @@ impl Trainer {
         Ok(dir)
     }
 
-    /// Steps until the configured count, saving every `checkpoint_every` steps and at the end.
+    /// Steps until the configured count, saving every `checkpoint_every` steps (except on a
+    /// step that went non-finite) and at the end.
     /// When `stop` becomes true, saves the last completed step and returns.
     pub fn run(
         &mut self,
@@ -435,7 +603,9 @@ impl Trainer {
             }
             let report = self.step()?;
             on_step(&report);
-            if report.step % every == 0 && !self.finished() {
+            // No checkpoint on a step that went non-finite: a roll-back has saved its own, and
+            // one saved amid skips would become the target a repeat of them rolls back to.
+            if report.step % every == 0 && !self.finished() && report.event.is_none() {
                 self.save()?;
             }
         }
@@ -505,6 +675,7 @@ mod tests {
             recent_loss: 0.1,
             learning_rate: 1e-4,
             seconds,
+            event: None,
         }
     }
 

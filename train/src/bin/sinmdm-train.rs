@@ -303,6 +303,9 @@ fn main() -> Result<()> {
     let quiet_every = (state.config.training.steps / 20).max(1);
     let terminal = std::io::stderr().is_terminal();
     let end = trainer.run(&stop, |report| {
+        if let Some(event) = &report.event {
+            bar.suspend(|| eprintln!("recovery: {event}"));
+        }
         bar.set_position(report.step);
         bar.set_message(format!(
             "{:.4} (mean {:.4})",
@@ -337,6 +340,13 @@ fn main() -> Result<()> {
                 dir.display(),
                 png.display()
             );
+            if !state.recovery.is_clean() {
+                eprintln!(
+                    "non-finite steps recovered from: {} (listed under 'recovery' in {})",
+                    state.recovery.summary(),
+                    dir.join(sinmdm_train::checkpoint::STATE_FILE).display()
+                );
+            }
             if let Some(file) = &args.export {
                 sinmdm_train::export::export_checkpoint(&dir, file)?;
                 eprintln!("model {}", file.display());

@@ -7,7 +7,7 @@ use burn::tensor::{Device, Distribution, Tensor};
 use super::group_norm;
 use super::layers::{ChannelNorm, FrameConv};
 
-use sinmdm::network::SCORE_FLOOR;
+use sinmdm::network::{RPE_SPREAD_FLOOR, SCORE_FLOOR};
 
 /// `x + proj(window-softmax(q . key(GN(x))) * value(GN(x)))` with a learned relative-position bias.
 #[derive(Module, Debug)]
@@ -76,10 +76,17 @@ impl QnaBlock {
 
     /// `x` `[B, N, C]` to `[B, N, C]`.
     ///
-    /// With `e[n] = exp(s[n] - max s)` and `b_j = exp(rpe_j)`, the attention of frame `n` to
-    /// neighbour `m = n + j - (k-1)/2` inside the clip is `a_j[n] = b_j e[m] / sum_j' b_j' e[..]`.
-    /// These weights are only `[B, N, H]` each, so they are normalised first and the full-size
-    /// values are touched once per neighbour (a product and a sum), with no full-size division.
+    /// The attention of frame `n` to neighbour `m = n + j - (k-1)/2` inside the clip is a
+    /// softmax over the window of the logits `l_j[n] = max(s[m] - max s, SCORE_FLOOR) + rpe_j`
+    /// (the score floor and the position bias floor of [`position_logits`] are the
+    /// network contract's, so the exported graph computes the same function). Each frame's
+    /// logits are shifted by their own largest before the exponential, a constant per frame
+    /// that the softmax ignores (detached: it carries no gradient), so the largest weight is
+    /// exactly 1 and the sum never falls below it. Shifting by the sequence maximum alone left
+    /// the sum as small as `exp(-60)` wherever a whole window sat at the floor, and the
+    /// division's backward pass (`-a / b^2`) then overflowed: gradients of inf and NaN with a
+    /// finite loss. The weights are only `[B, N, H]` each, so they are normalised first and the
+    /// full-size values are touched once per neighbour (a product and a sum).
     pub fn forward(&self, x: Tensor<3>) -> Tensor<3> {
         let [batch, frames, channels] = x.dims();
         let heads = self.heads;
@@ -88,15 +95,28 @@ impl QnaBlock {
         let normed = self.norm.forward(x.clone());
         let scores = self.scores(normed.clone());
         let top = scores.clone().max_dim(1);
-        let weights = (scores - top).clamp_min(f64::from(SCORE_FLOOR)).exp();
-        let bias = self.rpe.val().exp();
-        // Each neighbour's unnormalised weight seen from frame n, zero outside the clip: [B, N, H].
-        let padded = weights.pad([(0, 0), (pad, pad), (0, 0)], PadMode::Constant(0.0));
-        let neighbour: Vec<Tensor<3>> = (0..self.window)
+        let floored = (scores - top).clamp_min(f64::from(SCORE_FLOOR));
+        let bias = position_logits(self.rpe.val());
+        // Each neighbour's logit seen from frame n, [B, N, H]; neighbours outside the clip get
+        // a logit whose exponential is exactly 0.
+        let padded = floored.pad(
+            [(0, 0), (pad, pad), (0, 0)],
+            PadMode::Constant(OUTSIDE_LOGIT),
+        );
+        let logits: Vec<Tensor<3>> = (0..self.window)
             .map(|j| {
                 padded.clone().narrow(1, j, frames)
-                    * bias.clone().narrow(1, j, 1).reshape([1, 1, heads])
+                    + bias.clone().narrow(1, j, 1).reshape([1, 1, heads])
             })
+            .collect();
+        let largest = logits
+            .iter()
+            .map(|l| l.clone().detach())
+            .reduce(|a, b| a.max_pair(b))
+            .expect("window >= 1");
+        let neighbour: Vec<Tensor<3>> = logits
+            .into_iter()
+            .map(|l| (l - largest.clone()).exp())
             .collect();
         let total = neighbour
             .iter()
@@ -121,6 +141,23 @@ impl QnaBlock {
         x + self.proj.forward(attended)
     }
 }
+
+/// The relative-position logits `[H, k]` as the network uses them: each raised to at most
+/// [`RPE_SPREAD_FLOOR`] below its head's largest. The floor keeps the exported graph's window
+/// sums (which take `exp(rpe)` as they are) clear of f32 underflow; trained biases spread by a
+/// few units, so it changes nothing in practice. The head's largest is a detached constant.
+pub(crate) fn position_logits(rpe: Tensor<2>) -> Tensor<2> {
+    let window = rpe.dims()[1];
+    let floor =
+        (rpe.clone().detach().max_dim(1) + f64::from(RPE_SPREAD_FLOOR)).repeat_dim(1, window);
+    rpe.max_pair(floor)
+}
+
+/// The logit of a neighbour outside the clip: far enough below any logit inside it (scores
+/// are floored at [`SCORE_FLOOR`], position biases at most [`RPE_SPREAD_FLOOR`]
+/// below their head's largest) that its exponential is 0 in f32, and finite, so nothing
+/// becomes NaN on the way.
+const OUTSIDE_LOGIT: f32 = -1.0e4;
 
 #[cfg(test)]
 mod tests {
@@ -238,5 +275,74 @@ mod tests {
                 assert!(worst < 1e-4, "window {window}, N {n}: max |diff| {worst}");
             }
         }
+    }
+
+    #[test]
+    fn gradients_stay_finite_where_whole_windows_sit_at_the_score_floor() {
+        use burn::module::ModuleVisitor;
+        use burn::optim::GradientsParams;
+        let _random = crate::device_random_lock();
+        let device = Device::flex().autodiff();
+        device.seed(5);
+        let (c, h, window, n) = (64, 4, 5, 96);
+        let mut block = perturb(QnaBlock::new(c, h, window, &device), 0.3);
+        // Key weights 300 times larger: the scores spread over hundreds, so most frames' whole
+        // windows fall more than 60 below the sequence's maximum, onto the floor.
+        let scaled: Vec<f32> = block
+            .key_weight
+            .val()
+            .into_data()
+            .iter::<f32>()
+            .map(|w| w * 300.0)
+            .collect();
+        block.key_weight =
+            Param::from_tensor(Tensor::from_data(TensorData::new(scaled, [c, c]), &device));
+        let x: Vec<f32> = (0..2 * n * c)
+            .map(|i| (i as f32 * 0.377).sin() * 3.0 + ((i / c) % 11) as f32 * 0.4)
+            .collect();
+        let input = Tensor::<3>::from_data(TensorData::new(x, [2, n, c]), &device);
+        let scores = block
+            .scores(block.norm.forward(input.clone()))
+            .into_data()
+            .try_to_vec::<f32>()
+            .unwrap();
+        let top = scores.iter().copied().fold(f32::MIN, f32::max);
+        let floored = scores.iter().filter(|&&s| s - top < SCORE_FLOOR).count();
+        assert!(
+            floored > scores.len() / 4,
+            "only {floored} of {} scores on the floor",
+            scores.len()
+        );
+        let output = block.forward(input);
+        let loss = output.powi_scalar(2).mean();
+        assert!(loss.clone().into_scalar::<f32>().is_finite());
+        let grads = GradientsParams::from_grads(loss.backward(), &block);
+        struct Finite<'a>(&'a GradientsParams, Vec<String>);
+        impl ModuleVisitor for Finite<'_> {
+            fn visit_float<const D: usize>(&mut self, param: &Param<Tensor<D>>) {
+                if let Some(g) = self.0.get::<D>(param.id) {
+                    let values = g.into_data().try_to_vec::<f32>().unwrap();
+                    if values.iter().any(|v| !v.is_finite()) {
+                        self.1.push(format!("{:?}", param.id));
+                    }
+                }
+            }
+        }
+        let mut check = Finite(&grads, Vec::new());
+        block.visit(&mut check);
+        assert!(check.1.is_empty(), "non-finite gradients: {:?}", check.1);
+    }
+
+    #[test]
+    fn position_biases_are_floored_below_their_heads_largest() {
+        let rpe = Tensor::<2>::from_data(
+            TensorData::new(vec![0.5f32, -30.0, 1.0, -2.0, -2.5, -23.0], [2, 3]),
+            &Device::flex(),
+        );
+        let got = position_logits(rpe)
+            .into_data()
+            .try_to_vec::<f32>()
+            .unwrap();
+        assert_eq!(got, vec![0.5, -19.0, 1.0, -2.0, -2.5, -22.0]);
     }
 }
