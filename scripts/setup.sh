@@ -48,6 +48,19 @@ if [ -z "$lib" ]; then
 fi
 echo "setup: onnxruntime library at $lib"
 
+# The independent glTF readers the tests run under node (the Khronos validator, three.js),
+# pinned by tests/node/package-lock.json.
+if command -v npm >/dev/null; then
+  node_stamp=tests/node/node_modules/.sinmdm-lock
+  if ! cmp -s tests/node/package-lock.json "$node_stamp"; then
+    echo "setup: installing the node packages of tests/node (gltf-validator, three)"
+    npm ci --prefix tests/node --no-audit --no-fund --loglevel=error
+    cp tests/node/package-lock.json "$node_stamp"
+  fi
+else
+  echo "setup: node and npm are needed for the glTF tests (as root: apt-get install nodejs npm)" >&2
+fi
+
 echo "setup: building (release)"
 cargo build --release --workspace --quiet
 echo "setup: done"

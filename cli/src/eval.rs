@@ -124,7 +124,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             threads: args.threads,
         },
     )?;
-    let clip = reference_features(&model, &args.clip, args.up.up)?;
+    let clip = reference_features(&model, &args.clip, &args.up)?;
     let clip_frames = clip.len_of(Axis(1));
     let frames = args.frames.unwrap_or(2 * clip_frames);
     if frames < COVERAGE_WINDOW {

@@ -156,7 +156,7 @@ pub(crate) fn info(args: &InfoArgs) -> Result<()> {
 
 pub(crate) fn encode(args: &EncodeArgs) -> Result<()> {
     let model = Model::open(&args.model, &ModelOptions { threads: Some(1) })?;
-    let features = reference_features(&model, &args.clip, args.up.up)?;
+    let features = reference_features(&model, &args.clip, &args.up)?;
     write_features(
         &args.output,
         &model.metadata().layout,

@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 
-use sinmdm::bvh::{read_bvh, write_bvh};
+use sinmdm::bvh::write_bvh;
+
+use crate::clip_files::read_motion_file;
 use sinmdm::files::write_atomically;
 use sinmdm::motion::up::{UP, file_axis_name};
 use sinmdm::motion::{
@@ -62,7 +64,18 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     {
         bail!("--fps must be a positive number, got {fps}");
     }
-    let clip = read_bvh(&args.clip)?;
+    let clip = read_motion_file(&args.clip, args.up.clip_anim.as_deref())?;
+    if crate::clip_files::is_gltf(&args.clip) {
+        let animations = sinmdm_formats::gltf::list_animations(&args.clip)?;
+        println!("animations {}", animations.len());
+        for a in &animations {
+            println!(
+                "  {} {:.2} s",
+                crate::clip_files::describe_animation(a),
+                a.seconds
+            );
+        }
+    }
     let options = EncodeOptions {
         fps: args.fps,
         contacts: ContactConfig {

@@ -1,6 +1,8 @@
 //! The `sinmdm` command line: argument parsing and printing; the work is done by the libraries
 //! (`sinmdm`, `sinmdm-render`, `sinmdm-eval`).
 
+mod clip_files;
+mod convert;
 mod eval;
 mod info;
 mod inspect;
@@ -24,7 +26,7 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Describe a BVH clip as the model sees it, and optionally check the representation by an
+    /// Describe a clip (BVH, glTF) as the model sees it, and optionally check the representation by an
     /// encode/decode round trip.
     #[command(after_help = inspect::EXAMPLES)]
     Inspect(inspect::InspectArgs),
@@ -46,6 +48,9 @@ pub enum Command {
     /// Draw BVH clips as stick figures: an animated GIF, or a PNG contact sheet.
     #[command(after_help = render::EXAMPLES)]
     Render(render::RenderArgs),
+    /// Convert a clip between motion formats (BVH, glTF .glb/.gltf).
+    #[command(after_help = convert::EXAMPLES)]
+    Convert(convert::ConvertArgs),
     /// Rewrite a clip with another up axis (Z-up to Y-up, say) and/or turned about its up axis.
     #[command(after_help = reorient::EXAMPLES)]
     Reorient(reorient::ReorientArgs),
@@ -77,6 +82,7 @@ fn main() -> std::process::ExitCode {
         Command::Info(args) => info::info(&args),
         Command::Render(args) => render::run(&args),
         Command::Reorient(args) => reorient::run(&args),
+        Command::Convert(args) => convert::run(&args),
         Command::Encode(args) => info::encode(&args),
     };
     match result {

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 
-use sinmdm::bvh::read_bvh;
+use crate::clip_files::read_motion_file;
 use sinmdm::files::write_atomically;
 use sinmdm::motion::{Confidence, ContactConfig, detect_up};
 use sinmdm_render::{Camera, Figure, RenderOptions, contact_sheet, gif_bytes};
@@ -82,7 +82,7 @@ pub fn write_picture(
 pub(crate) fn run(args: &RenderArgs) -> Result<()> {
     let mut figures = Vec::new();
     for path in &args.clips {
-        let clip = read_bvh(path)?;
+        let clip = read_motion_file(path, args.up.clip_anim.as_deref())?;
         let label = path
             .file_stem()
             .map_or(String::new(), |s| s.to_string_lossy().into_owned());

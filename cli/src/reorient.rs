@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use anyhow::{Result, bail};
 use clap::Args;
 
-use sinmdm::bvh::{read_bvh, write_bvh};
+use sinmdm::bvh::write_bvh;
+
+use crate::clip_files::read_motion_file;
 use sinmdm::motion::math;
 use sinmdm::motion::up::{UP, UpAxis, detect_up, reorient, reorient_problem};
 
@@ -17,8 +19,11 @@ pub(crate) const EXAMPLES: &str = "Examples:
 /// Arguments of `sinmdm reorient`.
 #[derive(Debug, Args)]
 pub struct ReorientArgs {
-    /// The BVH clip.
+    /// The clip (.bvh, .glb, .gltf).
     pub clip: PathBuf,
+    /// The animation of a glTF clip to read, by name or index (default: the first).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub clip_anim: Option<String>,
     /// The BVH file to write (same joints, offsets and channel lists; the top joint's OFFSET,
     /// position and rotation turned).
     #[arg(short, long, value_name = "OUT.bvh")]
@@ -39,7 +44,7 @@ pub(crate) fn run(args: &ReorientArgs) -> Result<()> {
     if !args.turn.is_finite() {
         bail!("--turn must be a number of degrees, got {}", args.turn);
     }
-    let clip = read_bvh(&args.clip)?;
+    let clip = read_motion_file(&args.clip, args.clip_anim.as_deref())?;
     if let Some(problem) = reorient_problem(&clip.skeleton) {
         bail!("{}: {problem}", args.clip.display());
     }

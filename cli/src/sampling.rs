@@ -8,9 +8,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use ndarray::Array2;
 
-use sinmdm::bvh::{read_bvh, to_bvh_string};
 use sinmdm::features_file::write_features;
-use sinmdm::files::write_atomically;
 use sinmdm::motion::encode_for_model;
 use sinmdm::motion::up::UpAxis;
 use sinmdm::tasks::MAX_COUNT;
@@ -18,7 +16,9 @@ use sinmdm::{Feet, Generated, Method, Plan, Request, Span, Task};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_render::{Camera, Figure};
 
+use crate::clip_files::{is_gltf, metres_per_unit, read_motion_file, write_motion_file};
 use crate::render::write_picture;
+use sinmdm_formats::ClipFormat;
 
 /// Default respaced sampling steps of the command line: the library's `sinmdm::DEFAULT_STEPS`
 /// (clap needs it as text; a test checks they agree).
@@ -30,9 +30,15 @@ pub struct SamplingArgs {
     /// The trained model (.onnx written by sinmdm-export).
     #[arg(short, long, value_name = "MODEL.onnx")]
     pub model: PathBuf,
-    /// Output BVH file. With --count above 1, samples go to NAME_000.bvh, NAME_001.bvh, ...
-    #[arg(short, long, value_name = "OUT.bvh")]
+    /// Output file: BVH (with --count above 1, samples go to NAME_000.bvh, NAME_001.bvh, ...),
+    /// or glTF (.glb, .gltf: one file with every sample as an animation, in metres and +Y up).
+    /// FBX is not written: write .glb, which Blender, Godot, Unity (glTFast) and three.js open.
+    #[arg(short, long, value_name = "OUT.bvh|OUT.glb")]
     pub output: PathBuf,
+    /// Metres per unit of the model's clip, for glTF output (default: from the skeleton's
+    /// height: metres, centimetres, or CMU units when unsure, said).
+    #[arg(long, value_name = "METRES")]
+    pub unit_scale: Option<f64>,
     /// Samples to make in one batched run (a crowd).
     #[arg(long, default_value_t = 1)]
     pub count: usize,
@@ -144,9 +150,9 @@ impl SamplingArgs {
         )?)
     }
 
-    /// The BVH file of sample `index` of `count`.
+    /// The file of sample `index` of `count` (a glTF file holds them all).
     pub fn output_path(&self, index: usize, count: usize) -> PathBuf {
-        if count == 1 {
+        if count == 1 || is_gltf(&self.output) {
             return self.output.clone();
         }
         let stem = self
@@ -216,14 +222,17 @@ pub struct ClipUpArg {
     /// reference or content clip, the model's own when the motion does not say clearly).
     #[arg(long, value_name = "AXIS")]
     pub up: Option<UpAxis>,
+    /// The animation of a glTF clip to read, by name or index (default: the first).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub clip_anim: Option<String>,
 }
 
-/// Reads a BVH clip of the model's skeleton as raw features in the model's layout
+/// Reads a clip (BVH or glTF) of the model's skeleton as raw features in the model's layout
 /// ([`encode_for_model`]), saying so when the clip was turned into the model's up convention.
-pub fn reference_features(model: &Model, clip: &Path, up: Option<UpAxis>) -> Result<Array2<f32>> {
-    let channels = read_bvh(clip)?;
+pub fn reference_features(model: &Model, clip: &Path, read: &ClipUpArg) -> Result<Array2<f32>> {
+    let channels = read_motion_file(clip, read.clip_anim.as_deref())?;
     let layout = &model.metadata().layout;
-    let encoded = encode_for_model(&channels, layout, up).with_context(|| {
+    let encoded = encode_for_model(&channels, layout, read.up).with_context(|| {
         format!(
             "{}: cannot use it with model {}",
             clip.display(),
@@ -299,19 +308,44 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
     let mut outputs: Vec<PathBuf> = (0..plan.count())
         .map(|i| args.output_path(i, plan.count()))
         .collect();
+    outputs.dedup();
+    let metres = if is_gltf(&args.output) {
+        metres_per_unit(model.metadata().layout.skeleton_height, args.unit_scale)?
+    } else {
+        ClipFormat::of(&args.output)?;
+        anyhow::ensure!(
+            args.unit_scale.is_none(),
+            "--unit-scale is for glTF output; BVH keeps the clip's units"
+        );
+        1.0
+    };
     outputs.extend(args.features_json.iter().cloned());
     outputs.extend(args.render.iter().cloned());
     check_writable(&outputs)?;
 
     let generated = run_with_progress(model, &plan, args.quiet)?;
-    for i in 0..generated.count() {
-        let path = args.output_path(i, generated.count());
-        let motion = generated
-            .motion(i)
-            .with_context(|| format!("sample {i} could not be decoded"))?;
-        write_atomically(&path, to_bvh_string(&motion.to_channels()).as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        eprintln!("wrote {}", path.display());
+    let motions = (0..generated.count())
+        .map(|i| {
+            generated
+                .motion(i)
+                .with_context(|| format!("sample {i} could not be decoded"))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let layout = generated.layout();
+    if is_gltf(&args.output) {
+        write_motion_file(&args.output, &motions, layout.up, metres)?;
+        eprintln!(
+            "wrote {} ({} animation{})",
+            args.output.display(),
+            motions.len(),
+            if motions.len() == 1 { "" } else { "s" }
+        );
+    } else {
+        for (i, motion) in motions.iter().enumerate() {
+            let path = args.output_path(i, motions.len());
+            write_motion_file(&path, std::slice::from_ref(motion), layout.up, 1.0)?;
+            eprintln!("wrote {}", path.display());
+        }
     }
     if let Some(path) = &args.features_json {
         write_features(path, generated.layout(), generated.features.view())?;

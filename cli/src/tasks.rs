@@ -153,7 +153,7 @@ pub(crate) fn generate(args: &GenerateArgs) -> Result<()> {
 
 pub(crate) fn inbetween(args: &InbetweenArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
-    let reference = reference_features(&model, &args.reference, args.up.up)?;
+    let reference = reference_features(&model, &args.reference, &args.up)?;
     let fps = model.metadata().layout.fps;
     let keep = args
         .keep
@@ -171,7 +171,7 @@ pub(crate) fn inbetween(args: &InbetweenArgs) -> Result<()> {
 
 pub(crate) fn expand(args: &ExpandArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
-    let reference = reference_features(&model, &args.reference, args.up.up)?;
+    let reference = reference_features(&model, &args.reference, &args.up)?;
     let fps = model.metadata().layout.fps;
     let task = Task::Expand {
         reference,
@@ -185,7 +185,7 @@ pub(crate) fn expand(args: &ExpandArgs) -> Result<()> {
 
 pub(crate) fn compose(args: &ComposeArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
-    let reference = reference_features(&model, &args.reference, args.up.up)?;
+    let reference = reference_features(&model, &args.reference, &args.up)?;
     let layout = &model.metadata().layout;
     let fps = layout.fps;
     let mut joints = joints_by_name(layout, &args.joints)?;
@@ -210,7 +210,7 @@ pub(crate) fn compose(args: &ComposeArgs) -> Result<()> {
 
 pub(crate) fn harmonize(args: &HarmonizeArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
-    let content = reference_features(&model, &args.content, args.up.up)?;
+    let content = reference_features(&model, &args.content, &args.up)?;
     let task = Task::Harmonize {
         content,
         factor: args.factor,

@@ -1,0 +1,122 @@
+//! Motion files in and out by extension: `.bvh`, `.glb` and `.gltf` (through `sinmdm-formats`).
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use sinmdm::bvh::to_bvh_string;
+use sinmdm::files::write_atomically;
+use sinmdm::motion::{ChannelClip, LocalMotion, UpAxis};
+use sinmdm_formats::{
+    AnimationChoice, ClipFormat, GltfReadOptions, GltfWriteOptions, UnitGuess, read_clip,
+};
+
+/// Reads a clip from a `.bvh`, `.glb` or `.gltf` file; `animation` picks one of a glTF file's
+/// animations by name or index (default: the first), and which one was read is said when the
+/// file holds several.
+pub fn read_motion_file(path: &Path, animation: Option<&str>) -> Result<ChannelClip> {
+    let options = GltfReadOptions {
+        animation: animation.map(AnimationChoice::parse),
+        fps: None,
+    };
+    if animation.is_some() && ClipFormat::of(path)? == ClipFormat::Bvh {
+        anyhow::bail!(
+            "{}: --clip-anim picks an animation of a glTF file; a BVH file holds one",
+            path.display()
+        );
+    }
+    let (clip, source) = read_clip(path, &options)?;
+    if let Some(read) = &source.animation {
+        if source.animations.len() > 1 {
+            eprintln!(
+                "{}: read animation {} ({:.2} s), one of {}; --clip-anim NAME|INDEX picks another",
+                path.display(),
+                describe_animation(read),
+                read.seconds,
+                source.animations.len()
+            );
+        }
+    }
+    Ok(clip)
+}
+
+/// `'Walk' (#0)` or `#0`.
+pub fn describe_animation(info: &sinmdm_formats::AnimationInfo) -> String {
+    match &info.name {
+        Some(name) => format!("'{name}' (#{})", info.index),
+        None => format!("#{}", info.index),
+    }
+}
+
+/// Whether `path` names a glTF file, which holds every sample of a run as one animation each.
+pub fn is_gltf(path: &Path) -> bool {
+    matches!(ClipFormat::of(path), Ok(ClipFormat::Gltf))
+}
+
+/// Metres per file unit for a glTF output: `explicit`, or the guess from the skeleton's height
+/// in file units (said when it is only a guess).
+pub fn metres_per_unit(height: f64, explicit: Option<f64>) -> Result<f64> {
+    if let Some(scale) = explicit {
+        anyhow::ensure!(
+            scale.is_finite() && scale > 0.0,
+            "--unit-scale must be a positive number of metres per file unit, got {scale}"
+        );
+        return Ok(scale);
+    }
+    let guess = UnitGuess::from_height(height);
+    if !guess.is_sure() {
+        eprintln!(
+            "note: the figure is {height:.3} file units tall; units {}, so one unit = {:.4} m in the glTF file (--unit-scale METRES overrides)",
+            guess.describe(),
+            guess.metres_per_unit()
+        );
+    }
+    Ok(guess.metres_per_unit())
+}
+
+/// Writes motions to `path`: glTF (`.glb`/`.gltf`) takes all of them, one animation each named
+/// `sample_000`, ... (or `name` when there is one motion); BVH takes one. `up` is the motions'
+/// up axis, `metres` metres per unit.
+pub fn write_motion_file(
+    path: &Path,
+    motions: &[LocalMotion],
+    up: UpAxis,
+    metres: f64,
+) -> Result<()> {
+    write_named_motions(path, motions, None, up, metres)
+}
+
+/// [`write_motion_file`], naming a single motion's glTF animation `name`.
+pub fn write_named_motions(
+    path: &Path,
+    motions: &[LocalMotion],
+    name: Option<&str>,
+    up: UpAxis,
+    metres: f64,
+) -> Result<()> {
+    if is_gltf(path) {
+        let named: Vec<(String, &LocalMotion)> = motions
+            .iter()
+            .enumerate()
+            .map(|(i, m)| match name {
+                Some(name) if motions.len() == 1 => (name.to_string(), m),
+                _ => (format!("sample_{i:03}"), m),
+            })
+            .collect();
+        let options = GltfWriteOptions {
+            up,
+            metres_per_unit: metres,
+        };
+        sinmdm_formats::gltf::write_gltf(path, &named, &options)?;
+        return Ok(());
+    }
+    ClipFormat::of(path)?;
+    let [motion] = motions else {
+        anyhow::bail!(
+            "{}: a BVH file holds one motion, {} were given",
+            path.display(),
+            motions.len()
+        );
+    };
+    write_atomically(path, to_bvh_string(&motion.to_channels()).as_bytes())
+        .with_context(|| format!("cannot write {}", path.display()))
+}

@@ -1,0 +1,73 @@
+//! `sinmdm convert`: a clip from one motion format to another (BVH, glTF), so a clip can go
+//! into an engine, or a glTF clip into a BVH tool, without a DCC round trip.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use sinmdm::motion::up::{choose_up, to_canonical};
+use sinmdm::motion::{UpAxis, global_poses, skeleton_height};
+
+use crate::clip_files::{is_gltf, metres_per_unit, read_motion_file, write_named_motions};
+
+pub(crate) const EXAMPLES: &str = "Examples:
+  sinmdm convert tests/data/bvh/human_walk_cmu_131_01.bvh -o walk.glb   # for an engine
+  sinmdm convert character.glb --clip-anim Walk -o walk.bvh             # one animation as BVH
+  sinmdm convert walk.bvh -o walk.glb --unit-scale 0.01                 # the file is in cm
+
+glTF is written in metres with +Y up (the clip's up axis is read from the motion, --up
+overrides; its unit from the skeleton's height, --unit-scale overrides); BVH keeps the clip's
+own frame and units. FBX is not written.";
+
+/// Arguments of `sinmdm convert`.
+#[derive(Debug, Args)]
+pub struct ConvertArgs {
+    /// The clip (.bvh, .glb, .gltf).
+    pub clip: PathBuf,
+    /// The file to write (.bvh, .glb, .gltf).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub read: crate::sampling::ClipUpArg,
+    /// Metres per file unit, for glTF output (default: from the skeleton's height).
+    #[arg(long, value_name = "METRES")]
+    pub unit_scale: Option<f64>,
+}
+
+pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
+    let clip = read_motion_file(&args.clip, args.read.clip_anim.as_deref())?;
+    let motion = clip.to_local();
+    let (up, metres) = if is_gltf(&args.output) {
+        let (up, detection) = choose_up(&motion, args.read.up);
+        if let Some(found) = detection {
+            eprintln!("{}: up axis {}", args.clip.display(), found.describe());
+        }
+        let height = skeleton_height(&global_poses(&to_canonical(&motion, up)));
+        (up, metres_per_unit(height, args.unit_scale)?)
+    } else {
+        anyhow::ensure!(
+            args.unit_scale.is_none(),
+            "--unit-scale is for glTF output; BVH keeps the clip's units"
+        );
+        (UpAxis::PosY, 1.0)
+    };
+    let name = args
+        .clip
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned());
+    write_named_motions(
+        &args.output,
+        std::slice::from_ref(&motion),
+        name.as_deref(),
+        up,
+        metres,
+    )?;
+    eprintln!(
+        "wrote {} ({} joints, {} frames at {} fps)",
+        args.output.display(),
+        motion.skeleton.len(),
+        motion.frame_count(),
+        motion.fps
+    );
+    Ok(())
+}

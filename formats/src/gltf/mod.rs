@@ -1,0 +1,16 @@
+//! glTF 2.0 (`.glb` and `.gltf`): skinned skeletons with animations, read as clips and written
+//! from motions.
+
+mod accessor;
+pub mod container;
+mod read;
+mod write;
+
+pub use read::{
+    AnimationChoice, AnimationInfo, GltfClip, GltfReadOptions, list_animations, read_gltf,
+};
+pub use write::{GltfWriteOptions, gltf_document, write_gltf};
+
+/// The key under a node's `extras` where this crate keeps what glTF has no place for: the
+/// joint's BVH channel list and its End Site, so BVH -> glTF -> BVH gives the same skeleton.
+pub const EXTRAS_KEY: &str = "sinmdm";

@@ -1,0 +1,305 @@
+//! Motion to glTF 2.0: one node per joint with its rest transform, a skin over every joint (so
+//! importers build bones, not empties), and one animation per motion, in metres and +Y up.
+
+use std::path::Path;
+
+use serde_json::{Value, json};
+use sinmdm::motion::math::{self, Mat3, Vec3};
+use sinmdm::motion::{LocalMotion, Skeleton, UpAxis, up};
+
+use super::EXTRAS_KEY;
+use super::container::{base64_encode, glb_bytes};
+use crate::error::FormatError;
+
+/// How motions are placed into glTF's frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GltfWriteOptions {
+    /// The up axis of the motions' own frame (glTF's is +Y; the motion is turned into it).
+    pub up: UpAxis,
+    /// Metres per unit of the motions' translations (glTF is in metres).
+    pub metres_per_unit: f64,
+}
+
+/// glTF's component type for 32-bit floats.
+const FLOAT: u32 = 5126;
+
+/// The binary buffer under construction, with one buffer view and accessor per array.
+#[derive(Default)]
+struct Binary {
+    bytes: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Binary {
+    /// Appends `values` as an accessor of `kind` (`SCALAR`, `VEC3`, `VEC4`, `MAT4`) with
+    /// `width` floats per element, with its min and max when `bounds` is set; returns its index.
+    fn accessor(&mut self, values: &[f32], kind: &str, width: usize, bounds: bool) -> usize {
+        while self.bytes.len() % 4 != 0 {
+            self.bytes.push(0);
+        }
+        let offset = self.bytes.len();
+        for v in values {
+            self.bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        self.views.push(json!({
+            "buffer": 0,
+            "byteOffset": offset,
+            "byteLength": values.len() * 4,
+        }));
+        let mut accessor = json!({
+            "bufferView": self.views.len() - 1,
+            "componentType": FLOAT,
+            "count": values.len() / width,
+            "type": kind,
+        });
+        if bounds {
+            let mut min = vec![f32::INFINITY; width];
+            let mut max = vec![f32::NEG_INFINITY; width];
+            for element in values.chunks(width) {
+                for (k, &v) in element.iter().enumerate() {
+                    min[k] = min[k].min(v);
+                    max[k] = max[k].max(v);
+                }
+            }
+            accessor["min"] = json!(min);
+            accessor["max"] = json!(max);
+        }
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+}
+
+/// A rotation as glTF's unit quaternion `[x, y, z, w]`, on the same side as `previous` (so
+/// interpolating consecutive keys takes the short way).
+fn quaternion_xyzw(m: &Mat3, previous: Option<[f64; 4]>) -> [f64; 4] {
+    let [w, x, y, z] = math::quat_wxyz_from_mat(m);
+    let q = [x, y, z, w];
+    match previous {
+        Some(p) if p.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>() < 0.0 => {
+            [-q[0], -q[1], -q[2], -q[3]]
+        }
+        _ => q,
+    }
+}
+
+/// The quaternion rounded to f32 and renormalised there, as validators measure unit length.
+fn unit_f32(q: [f64; 4]) -> [f32; 4] {
+    let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let q = q.map(|v| (v / n) as f32);
+    let n32 = q.iter().map(|v| v * v).sum::<f32>().sqrt();
+    q.map(|v| v / n32)
+}
+
+/// The rest transform of each joint in glTF's frame: the offset in metres, and for each top
+/// joint the turn from the file's frame into +Y up.
+fn rest_transforms(skeleton: &Skeleton, options: &GltfWriteOptions) -> Vec<(Mat3, Vec3)> {
+    let turn = options.up.canonical_from_file();
+    skeleton
+        .joints
+        .iter()
+        .map(|joint| {
+            let offset = math::scale(joint.offset, options.metres_per_unit);
+            match joint.parent {
+                None => (turn, math::mat_vec(&turn, offset)),
+                Some(_) => (math::IDENTITY, offset),
+            }
+        })
+        .collect()
+}
+
+/// The column-major inverse of each joint's global rest transform.
+fn inverse_bind_matrices(skeleton: &Skeleton, rest: &[(Mat3, Vec3)]) -> Vec<f32> {
+    let mut global: Vec<(Mat3, Vec3)> = Vec::with_capacity(rest.len());
+    let mut out = Vec::with_capacity(rest.len() * 16);
+    for (joint, (r, t)) in skeleton.joints.iter().zip(rest) {
+        let g = match joint.parent {
+            None => (*r, *t),
+            Some(p) => {
+                let (pr, pt) = global[p];
+                (math::mat_mul(&pr, r), math::add(pt, math::mat_vec(&pr, *t)))
+            }
+        };
+        let inverse_rotation = math::transpose(&g.0);
+        let inverse_translation = math::scale(math::mat_vec(&inverse_rotation, g.1), -1.0);
+        for column in 0..4 {
+            for row in 0..4 {
+                let v = match (row, column) {
+                    (3, 3) => 1.0,
+                    (3, _) => 0.0,
+                    (_, 3) => inverse_translation[row],
+                    _ => inverse_rotation[row][column],
+                };
+                out.push(v as f32);
+            }
+        }
+        global.push(g);
+    }
+    out
+}
+
+/// The glTF document and binary buffer of `motions` (name and motion), which must share one
+/// skeleton: the nodes, the skin, and one animation per motion.
+pub fn gltf_document(
+    motions: &[(String, &LocalMotion)],
+    options: &GltfWriteOptions,
+) -> Result<(Value, Vec<u8>), String> {
+    let Some((_, first)) = motions.first() else {
+        return Err("no motion to write".into());
+    };
+    let skeleton = &first.skeleton;
+    if skeleton.is_empty() {
+        return Err("the skeleton has no joints".into());
+    }
+    if let Some((name, _)) = motions.iter().find(|(_, m)| m.skeleton != *skeleton) {
+        return Err(format!(
+            "motion '{name}' has another skeleton than '{}'; one file holds one skeleton",
+            motions[0].0
+        ));
+    }
+    if !(options.metres_per_unit.is_finite() && options.metres_per_unit > 0.0) {
+        return Err(format!(
+            "the unit scale must be a positive number, got {}",
+            options.metres_per_unit
+        ));
+    }
+    let animated: Vec<(bool, bool)> = skeleton
+        .joints
+        .iter()
+        .map(|j| (j.rotates(), !j.position_axes().is_empty()))
+        .collect();
+    if animated.iter().all(|&(r, t)| !r && !t) {
+        return Err("no joint of the skeleton has a channel to animate".into());
+    }
+    let mut binary = Binary::default();
+    let rest = rest_transforms(skeleton, options);
+    let nodes: Vec<Value> = skeleton
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(j, joint)| {
+            let (r, t) = rest[j];
+            let mut node = json!({
+                "name": joint.name,
+                "translation": t.map(|v| v as f32),
+            });
+            if joint.parent.is_none() {
+                node["rotation"] = json!(unit_f32(quaternion_xyzw(&r, None)));
+            }
+            let children = skeleton.children(j);
+            if !children.is_empty() {
+                node["children"] = json!(children);
+            }
+            let channels: Vec<String> = joint.channels.iter().map(|c| c.to_string()).collect();
+            let mut extras = json!({ "channels": channels });
+            if let Some(end) = joint.end_site {
+                extras["end_site"] = json!(math::scale(end, options.metres_per_unit));
+            }
+            node["extras"] = json!({ EXTRAS_KEY: extras });
+            node
+        })
+        .collect();
+    let roots: Vec<usize> = (0..skeleton.len())
+        .filter(|&j| skeleton.joints[j].parent.is_none())
+        .collect();
+    let ibm = binary.accessor(&inverse_bind_matrices(skeleton, &rest), "MAT4", 16, false);
+    let joints = skeleton.len();
+    let mut animations = Vec::with_capacity(motions.len());
+    for (name, motion) in motions {
+        let frames = motion.frame_count();
+        if frames == 0 {
+            return Err(format!("motion '{name}' has no frames"));
+        }
+        if !(motion.fps.is_finite() && motion.fps > 0.0) {
+            return Err(format!(
+                "motion '{name}' has a frame rate of {}",
+                motion.fps
+            ));
+        }
+        let canonical = up::to_canonical(motion, options.up);
+        let times: Vec<f32> = (0..frames)
+            .map(|f| (f as f64 / motion.fps) as f32)
+            .collect();
+        let input = binary.accessor(&times, "SCALAR", 1, true);
+        let mut samplers = Vec::new();
+        let mut channels = Vec::new();
+        for (j, &(rotates, moves)) in animated.iter().enumerate() {
+            if rotates {
+                let mut previous = None;
+                let mut values = Vec::with_capacity(frames * 4);
+                for f in 0..frames {
+                    let q = quaternion_xyzw(&canonical.rotations[f * joints + j], previous);
+                    previous = Some(q);
+                    values.extend(unit_f32(q));
+                }
+                let output = binary.accessor(&values, "VEC4", 4, false);
+                samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
+                channels.push(json!({
+                    "sampler": samplers.len() - 1,
+                    "target": {"node": j, "path": "rotation"},
+                }));
+            }
+            if moves {
+                let values: Vec<f32> = (0..frames)
+                    .flat_map(|f| {
+                        math::scale(
+                            canonical.translations[f * joints + j],
+                            options.metres_per_unit,
+                        )
+                        .map(|v| v as f32)
+                    })
+                    .collect();
+                let output = binary.accessor(&values, "VEC3", 3, false);
+                samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
+                channels.push(json!({
+                    "sampler": samplers.len() - 1,
+                    "target": {"node": j, "path": "translation"},
+                }));
+            }
+        }
+        animations.push(json!({"name": name, "samplers": samplers, "channels": channels}));
+    }
+    let document = json!({
+        "asset": {"version": "2.0", "generator": concat!("sinmdm-rs ", env!("CARGO_PKG_VERSION"))},
+        "scene": 0,
+        "scenes": [{"nodes": roots}],
+        "nodes": nodes,
+        "skins": [{"joints": (0..joints).collect::<Vec<_>>(), "inverseBindMatrices": ibm, "skeleton": roots[0]}],
+        "animations": animations,
+        "accessors": binary.accessors,
+        "bufferViews": binary.views,
+        "buffers": [{"byteLength": binary.bytes.len()}],
+    });
+    Ok((document, binary.bytes))
+}
+
+/// Writes `motions` (name and motion, one skeleton) to `path`: a `.glb`, or a `.gltf` with its
+/// buffer embedded as base64. The file appears complete or not at all.
+pub fn write_gltf(
+    path: &Path,
+    motions: &[(String, &LocalMotion)],
+    options: &GltfWriteOptions,
+) -> Result<(), FormatError> {
+    let (mut document, bin) =
+        gltf_document(motions, options).map_err(|message| FormatError::Write {
+            path: path.to_path_buf(),
+            message,
+        })?;
+    let binary_file = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    let bytes = if binary_file {
+        glb_bytes(&document, &bin)
+    } else {
+        document["buffers"][0]["uri"] = json!(format!(
+            "data:application/octet-stream;base64,{}",
+            base64_encode(&bin)
+        ));
+        serde_json::to_vec_pretty(&document).expect("a JSON value serialises")
+    };
+    sinmdm::files::write_atomically(path, &bytes).map_err(|source| FormatError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}

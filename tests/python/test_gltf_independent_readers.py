@@ -1,0 +1,125 @@
+"""The glTF files sinmdm writes, read by readers that are not ours: the Khronos glTF validator
+reports no error and no warning, and three.js (GLTFLoader + AnimationMixer under node) puts every
+bone where bvhio's forward kinematics of the same motion as BVH puts the joint."""
+
+import json
+import pathlib
+import re
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import ROOT, SINMDM, bvhio_joint_positions
+
+NODE_DIR = ROOT / "tests" / "node"
+WALK = ROOT / "tests" / "data" / "bvh" / "human_walk_cmu_131_01.bvh"
+FOX = ROOT / "tests" / "data" / "bvh" / "fox_survey_khronos.bvh"
+ZOMBIE = ROOT.parent / "shared" / "data" / "bvh" / "human_zombie_walk_fair.bvh"
+MODEL = ROOT / "onnx-models" / "human_walk_cmu.onnx"
+
+# The file frame to glTF's (+Y up) for a +Z-up file: (x, y, z) -> (x, z, -y).
+Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+
+
+@pytest.fixture(scope="module", autouse=True)
+def node_packages():
+    if shutil.which("node") is None or not (NODE_DIR / "node_modules" / "three").is_dir():
+        pytest.fail("node and tests/node/node_modules are needed: run scripts/setup.sh")
+
+
+def run(*args):
+    done = subprocess.run([str(SINMDM), *map(str, args)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return done
+
+
+def node(script, *args):
+    done = subprocess.run(["node", str(NODE_DIR / script), *map(str, args)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+def three_name(name):
+    """three.js's PropertyBinding.sanitizeNodeName: whitespace to '_', '[].:/' removed."""
+    return re.sub(r"[\[\]\.:/]", "", re.sub(r"\s", "_", name))
+
+
+def frame_times(count, fps, picks):
+    """Seconds of frames `picks` (negative from the end); the last frame just before the clip's
+    end, where three.js would wrap to frame 0."""
+    frames = [p % count for p in picks]
+    return frames, [min(f / fps, (count - 1) / fps - 1e-6) for f in frames]
+
+
+def bvh_fps(path):
+    """The file's frame rate, snapped to a whole rate when its Frame Time is one rounded
+    (0.0083333 s is 120 fps), as the glTF writer's key times are."""
+    text = pathlib.Path(path).read_text()
+    fps = 1.0 / float(re.search(r"Frame Time:\s*([0-9.eE+-]+)", text).group(1))
+    return float(round(fps)) if abs(fps - round(fps)) < 1e-3 * fps else fps
+
+
+def compare(three, animation, bvh_positions, bvh_names, frames, turn, scale, height):
+    """Largest distance, relative to the height, between three.js's bones and bvhio's joints."""
+    index = {three_name(n): i for i, n in enumerate(bvh_names)}
+    worst = 0.0
+    matched = 0
+    for bone, name in enumerate(three["bones"]):
+        i = index[name]
+        matched += 1
+        for k, frame in enumerate(frames):
+            expected = scale * (turn @ bvh_positions[frame, i])
+            got = np.asarray(three["positions"][animation][k][bone])
+            worst = max(worst, float(np.linalg.norm(expected - got)))
+    assert matched == len(three["bones"])
+    return worst / (height * scale)
+
+
+def test_the_validator_finds_no_error_or_warning(tmp_path):
+    walk, fox, crowd = tmp_path / "walk.glb", tmp_path / "fox.gltf", tmp_path / "crowd.glb"
+    run("convert", WALK, "-o", walk)
+    run("convert", FOX, "-o", fox)
+    run("generate", "-m", MODEL, "-o", crowd, "--count", 3, "--seconds", 3, "--quiet")
+    report = node("validate.mjs", walk, fox, crowd)
+    for file, result in report.items():
+        assert result["errors"] == 0 and result["warnings"] == 0, (file, result["messages"])
+        # Only the skin unused by any mesh is reported, as information.
+        assert set(result["infoCodes"]) <= {"UNUSED_OBJECT"}, (file, result["infoCodes"])
+    assert report[str(crowd)]["animations"] == 3
+
+
+@pytest.mark.parametrize("clip,turn,scale", [(WALK, np.eye(3), 0.05), (ZOMBIE, Z_UP_TO_Y_UP, 0.01)],
+                         ids=["walk, Y-up", "zombie, Z-up"])
+def test_three_puts_every_bone_where_bvhio_puts_the_joint(tmp_path, clip, turn, scale):
+    if not clip.exists():
+        pytest.skip(f"{clip} is not beside the checkout")
+    glb = tmp_path / "clip.glb"
+    run("convert", clip, "-o", glb, "--unit-scale", scale)
+    positions, names = bvhio_joint_positions(clip)
+    height = float(np.ptp((positions @ turn.T)[..., 1], axis=1).mean())
+    frames, times = frame_times(len(positions), bvh_fps(clip), [0, 1, 37, len(positions) // 2, -2, -1])
+    three = node("three_positions.mjs", glb, ",".join(map(str, times)))
+    assert len(three["animations"]) == 1
+    assert len(three["bones"]) == len(re.findall(r"\b(ROOT|JOINT)\b", clip.read_text()))
+    worst = compare(three, 0, positions, names, frames, turn, scale, height)
+    assert worst <= 1e-5, f"worst {worst:.2e} of the height"
+
+
+def test_a_generated_crowd_as_glb_matches_the_same_crowd_as_bvh(tmp_path):
+    """The same model, seed and arguments written as one GLB and as three BVH files: three.js
+    plays animation i where bvhio puts sample i."""
+    glb, bvh = tmp_path / "crowd.glb", tmp_path / "crowd.bvh"
+    args = ["-m", MODEL, "--count", 3, "--seed", 4, "--seconds", 4, "--quiet"]
+    run("generate", *args, "-o", glb, "--unit-scale", 0.05)
+    run("generate", *args, "-o", bvh)
+    samples = [bvhio_joint_positions(tmp_path / f"crowd_{i:03}.bvh") for i in range(3)]
+    count = len(samples[0][0])
+    frames, times = frame_times(count, 30.0, [0, 5, count // 3, -1])
+    three = node("three_positions.mjs", glb, ",".join(map(str, times)))
+    assert [a["name"] for a in three["animations"]] == ["sample_000", "sample_001", "sample_002"]
+    for i, (positions, names) in enumerate(samples):
+        height = float(np.ptp(positions[..., 1], axis=1).mean())
+        worst = compare(three, i, positions, names, frames, np.eye(3), 0.05, height)
+        assert worst <= 1e-5, f"sample {i}: worst {worst:.2e} of the height"
