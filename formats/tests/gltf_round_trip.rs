@@ -135,7 +135,7 @@ fn bvh_to_gltf_and_back_keeps_every_joint_where_it_was() {
 
 #[test]
 fn a_crowd_is_one_file_with_one_animation_each() {
-    let walk = read_bvh(&root().join("tests/data/bvh/human_walk_cmu_131_01.bvh"))
+    let walk = read_bvh(root().join("tests/data/bvh/human_walk_cmu_131_01.bvh"))
         .unwrap()
         .to_local();
     // Three "samples": the walk, its first half, and the walk mirrored in time.

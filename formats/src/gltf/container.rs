@@ -31,11 +31,11 @@ pub struct Asset {
 /// A GLB file of `json` (serialised compactly) and one binary chunk `bin`.
 pub fn glb_bytes(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
     let mut json_bytes = serde_json::to_vec(json).expect("a JSON value serialises");
-    while json_bytes.len() % 4 != 0 {
+    while !json_bytes.len().is_multiple_of(4) {
         json_bytes.push(b' ');
     }
     let mut bin_bytes = bin.to_vec();
-    while bin_bytes.len() % 4 != 0 {
+    while !bin_bytes.len().is_multiple_of(4) {
         bin_bytes.push(0);
     }
     let total = 12 + 8 + json_bytes.len() + 8 + bin_bytes.len();
@@ -194,12 +194,13 @@ fn percent_decode(uri: &str) -> String {
     let mut out = Vec::with_capacity(bytes.len());
     let mut i = 0;
     while i < bytes.len() {
-        if bytes[i] == b'%' && i + 2 < bytes.len() {
-            if let Ok(v) = u8::from_str_radix(&uri[i + 1..i + 3], 16) {
-                out.push(v);
-                i += 3;
-                continue;
-            }
+        if bytes[i] == b'%'
+            && i + 2 < bytes.len()
+            && let Ok(v) = u8::from_str_radix(&uri[i + 1..i + 3], 16)
+        {
+            out.push(v);
+            i += 3;
+            continue;
         }
         out.push(bytes[i]);
         i += 1;

@@ -3,7 +3,10 @@
 
 mod accessor;
 pub mod container;
+mod nodes;
 mod read;
+mod skin;
+mod tracks;
 mod write;
 
 pub use read::{

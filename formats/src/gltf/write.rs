@@ -35,7 +35,7 @@ impl Binary {
     /// Appends `values` as an accessor of `kind` (`SCALAR`, `VEC3`, `VEC4`, `MAT4`) with
     /// `width` floats per element, with its min and max when `bounds` is set; returns its index.
     fn accessor(&mut self, values: &[f32], kind: &str, width: usize, bounds: bool) -> usize {
-        while self.bytes.len() % 4 != 0 {
+        while !self.bytes.len().is_multiple_of(4) {
             self.bytes.push(0);
         }
         let offset = self.bytes.len();
@@ -122,17 +122,13 @@ fn inverse_bind_matrices(skeleton: &Skeleton, rest: &[(Mat3, Vec3)]) -> Vec<f32>
         };
         let inverse_rotation = math::transpose(&g.0);
         let inverse_translation = math::scale(math::mat_vec(&inverse_rotation, g.1), -1.0);
-        for column in 0..4 {
-            for row in 0..4 {
-                let v = match (row, column) {
-                    (3, 3) => 1.0,
-                    (3, _) => 0.0,
-                    (_, 3) => inverse_translation[row],
-                    _ => inverse_rotation[row][column],
-                };
-                out.push(v as f32);
-            }
+        // Column-major: the rotation's columns, then the translation, each with its fourth row.
+        for column in 0..3 {
+            out.extend(inverse_rotation.iter().map(|row| row[column] as f32));
+            out.push(0.0);
         }
+        out.extend(inverse_translation.map(|v| v as f32));
+        out.push(1.0);
         global.push(g);
     }
     out
