@@ -114,6 +114,15 @@ pub fn describe(path: &std::path::Path, m: &ModelMetadata) -> String {
         "trained on   {} ({} frames, sha256 {})",
         t.clip, t.clip_frames, t.clip_sha256
     );
+    if let Some(source) = &t.clip_source {
+        let _ = writeln!(
+            s,
+            "clip source  {}, animation {} (one of {})",
+            source.format,
+            source.animation.as_deref().unwrap_or("?"),
+            source.animations
+        );
+    }
     let _ = writeln!(
         s,
         "training     {} steps in {:.0} s, final loss {:.4e} (mean of last 100: {:.4e}), started {}",

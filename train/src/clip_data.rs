@@ -6,7 +6,9 @@ use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use sinmdm::model_file::ClipSourceFacts;
 use sinmdm::motion::{ContactConfig, EncodeOptions, FeatureLayout, Normalizer, encode};
+use sinmdm_formats::{AnimationChoice, ClipFormat, GltfReadOptions, read_clip};
 
 use crate::config::{DataConfig, ModelConfig};
 use crate::error::TrainError;
@@ -31,6 +33,9 @@ pub struct ClipFacts {
     /// The clip is an in-place cycle (contacts measured against its treadmill).
     #[serde(default)]
     pub in_place: bool,
+    /// What the file was, when not BVH: its format and the animation read.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<ClipSourceFacts>,
 }
 
 /// A clip ready for training: its facts and normalised features `[F, N]`.
@@ -51,7 +56,8 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 }
 
 impl ClipData {
-    /// Reads, encodes and normalises `path`; rejects a clip shorter than the receptive field.
+    /// Reads (BVH, or glTF with `data.animation` choosing the animation), encodes and normalises
+    /// `path`; rejects a clip shorter than the receptive field.
     pub fn load(
         path: &Path,
         data: &DataConfig,
@@ -62,8 +68,35 @@ impl ClipData {
             path: path.to_path_buf(),
             source,
         })?;
-        let text = String::from_utf8_lossy(&bytes);
-        let clip = sinmdm::bvh::parse_bvh(&text, &path.display().to_string())?;
+        let read_options = GltfReadOptions {
+            animation: data.animation.as_deref().map(AnimationChoice::parse),
+            fps: None,
+        };
+        let (clip, source) = match ClipFormat::of(path)? {
+            ClipFormat::Bvh => {
+                if data.animation.is_some() {
+                    return Err(TrainError::Config {
+                        path: path.to_path_buf(),
+                        message: "data.animation (--clip-anim) picks an animation of a glTF clip; a BVH file holds one".into(),
+                    });
+                }
+                let text = String::from_utf8_lossy(&bytes);
+                (
+                    sinmdm::bvh::parse_bvh(&text, &path.display().to_string())?,
+                    None,
+                )
+            }
+            ClipFormat::Gltf => {
+                let (clip, source) = read_clip(path, &read_options)?;
+                let read = source.animation.expect("a glTF clip names its animation");
+                let facts = ClipSourceFacts {
+                    format: "gltf".into(),
+                    animation: Some(read.name.unwrap_or_else(|| format!("#{}", read.index))),
+                    animations: source.animations.len(),
+                };
+                (clip, Some(facts))
+            }
+        };
         let options = EncodeOptions {
             fps: data.fps,
             contacts: ContactConfig {
@@ -106,6 +139,7 @@ impl ClipData {
                 frames,
                 layout: encoded.layout,
                 normalizer,
+                source,
             },
             features,
         })

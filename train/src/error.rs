@@ -26,6 +26,9 @@ pub enum TrainError {
     /// The clip could not be read.
     #[error(transparent)]
     Bvh(#[from] sinmdm::bvh::BvhError),
+    /// A clip in another format could not be read.
+    #[error(transparent)]
+    Format(#[from] sinmdm_formats::FormatError),
     /// The clip could not be turned into features.
     #[error("{}: {source}", path.display())]
     Motion {

@@ -59,6 +59,7 @@ pub fn metadata_of(state: &CheckpointState) -> ModelMetadata {
             seconds: state.elapsed_seconds,
             started: state.started.clone(),
             exported: crate::clock::now(),
+            clip_source: state.clip.source.clone(),
         },
     }
 }

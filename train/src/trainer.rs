@@ -24,8 +24,30 @@ use crate::recovery::{MAX_ROLLBACKS, NonFinite, RecoveryEvent, RecoveryRecord};
 use crate::shards::{gradients_are_finite, poison_first_gradient, sharded_gradients};
 use crate::weight_average::WeightAverage;
 
-/// Copy of the clip inside the run folder, so a run resumes without the original file.
-pub const CLIP_COPY: &str = "clip.bvh";
+/// Copy of the clip inside the run folder, so a run resumes without the original file: this
+/// name with the clip's own extension (`clip.bvh`, `clip.glb`, `clip.gltf`).
+pub const CLIP_COPY: &str = "clip";
+/// The extensions a clip copy may have.
+const CLIP_EXTENSIONS: [&str; 3] = ["bvh", "glb", "gltf"];
+
+/// The clip copy in run folder `run` for a clip at `clip` (its extension kept, lower-case).
+fn clip_copy(run: &Path, clip: &Path) -> PathBuf {
+    let extension = clip
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .filter(|e| CLIP_EXTENSIONS.contains(&e.as_str()))
+        .unwrap_or_else(|| "bvh".into());
+    run.join(format!("{CLIP_COPY}.{extension}"))
+}
+
+/// The clip copy a run folder holds, if any.
+pub fn saved_clip(run: &Path) -> Option<PathBuf> {
+    CLIP_EXTENSIONS
+        .iter()
+        .map(|e| run.join(format!("{CLIP_COPY}.{e}")))
+        .find(|p| p.is_file())
+}
 /// Copy of the configuration inside the run folder.
 pub const CONFIG_COPY: &str = "config.yaml";
 /// The loss log inside the run folder.
@@ -261,7 +283,7 @@ impl Trainer {
         sinmdm::files::write_atomically(&run.join(CONFIG_COPY), yaml.as_bytes())
             .map_err(io("write into the output folder", run))?;
         let clip_bytes = std::fs::read(clip).map_err(io("read the clip", clip))?;
-        sinmdm::files::write_atomically(&run.join(CLIP_COPY), &clip_bytes)
+        sinmdm::files::write_atomically(&clip_copy(run, clip), &clip_bytes)
             .map_err(io("write into the output folder", run))?;
         let log = LossLog::create(&run.join(LOSS_LOG))?;
         let features = data.features.nrows();
@@ -324,7 +346,12 @@ impl Trainer {
         }
         let clip_path = match clip {
             Some(p) => p.to_path_buf(),
-            None => run.join(CLIP_COPY),
+            None => saved_clip(run).ok_or_else(|| TrainError::Checkpoint {
+                path: run.to_path_buf(),
+                message: format!(
+                    "holds no copy of its clip ({CLIP_COPY}.bvh, .glb or .gltf); pass the clip"
+                ),
+            })?,
         };
         let data = ClipData::load(&clip_path, &state.config.data, &state.config.model)?;
         if data.facts.sha256 != state.clip.sha256 {

@@ -183,12 +183,15 @@ fn sample_frames(
     let mut translations = Vec::with_capacity(frames * joints);
     for f in 0..frames {
         let t = first + f as f64 / fps;
+        // A key this close to the frame's time is the frame's key (a thousandth of a frame, or
+        // a few f32 ulps of t for long clips).
+        let snap = 1e-3 / fps + 4.0 * f64::from(f32::EPSILON) * t.abs();
         for (j, &n) in order.iter().enumerate() {
             let mut translation = rest[n].translation;
             let mut rotation = rest[n].rotation;
             let mut scale = rest[n].scale;
             for track in tracks.iter().filter(|track| track.joint == j) {
-                let v = track.sample(t);
+                let v = track.sample(t, snap);
                 match track.property {
                     Property::Translation => translation = [v[0], v[1], v[2]],
                     Property::Rotation => rotation = rotation_of(v),

@@ -48,8 +48,10 @@ impl Property {
 
 impl Track {
     /// The property's value at time `t`: a translation or scale `[x, y, z, _]`, or a rotation
-    /// `[x, y, z, w]` (unit).
-    pub(super) fn sample(&self, t: f64) -> [f64; 4] {
+    /// `[x, y, z, w]` (unit). A key within `snap` seconds of `t` is taken as it is: key times
+    /// are f32, so the key of frame `f` may sit an ulp away from `f / fps`, and interpolating
+    /// across that ulp would blend in a sliver of the neighbouring frame.
+    pub(super) fn sample(&self, t: f64, snap: f64) -> [f64; 4] {
         let width = self.property.width();
         let keys = self.times.len();
         let value = |key: usize| -> [f64; 4] {
@@ -63,7 +65,14 @@ impl Track {
             }
             out
         };
-        let result = if t <= f64::from(self.times[0]) {
+        let nearest = self.times.partition_point(|&key| f64::from(key) <= t);
+        let close = [nearest.checked_sub(1), (nearest < keys).then_some(nearest)]
+            .into_iter()
+            .flatten()
+            .find(|&k| (f64::from(self.times[k]) - t).abs() <= snap);
+        let result = if let Some(k) = close {
+            value(k)
+        } else if t <= f64::from(self.times[0]) {
             value(0)
         } else if t >= f64::from(self.times[keys - 1]) {
             value(keys - 1)

@@ -100,6 +100,20 @@ pub struct TrainingFacts {
     pub started: String,
     /// When the file was written (UTC, RFC 3339).
     pub exported: String,
+    /// What the clip file was, when it was not a BVH file (absent: BVH, or an older file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clip_source: Option<ClipSourceFacts>,
+}
+
+/// Where a clip read from a format other than BVH came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ClipSourceFacts {
+    /// The file format (`gltf`).
+    pub format: String,
+    /// The animation read, by name (or `#index` when it has none).
+    pub animation: Option<String>,
+    /// How many animations the file held.
+    pub animations: usize,
 }
 
 impl NetworkFacts {

@@ -15,18 +15,23 @@ use sinmdm_train::clip_data::ClipData;
 use sinmdm_train::motion_span;
 use sinmdm_train::{QnaUnet, RunEnd, TrainConfig, Trainer};
 
-/// Fit the single-motion QnA-UNet denoiser on one BVH clip.
+/// Fit the single-motion QnA-UNet denoiser on one clip (BVH, or glTF: .glb/.gltf).
 ///
 /// Examples:
 ///   sinmdm-train tests/data/bvh/human_walk_cmu_131_01.bvh --out runs/walk   (the default, ~6 min)
 ///   sinmdm-train CLIP.bvh --minutes 5 --out runs/quick   (as many steps as fit in 5 minutes)
 ///   sinmdm-train --resume --out runs/walk            (continue after Ctrl-C or a crash)
 ///   sinmdm-train CLIP.bvh --config configs/paper.yaml --dry-run   (sizes only)
+///   sinmdm-train character.glb --clip-anim Walk --out runs/walk   (one animation of a glTF file)
 #[derive(Parser, Debug)]
 #[command(name = "sinmdm-train", version, verbatim_doc_comment)]
 struct Args {
-    /// The BVH clip to learn (optional with --resume: the run keeps a copy).
+    /// The clip to learn: .bvh, .glb or .gltf (optional with --resume: the run keeps a copy).
     clip: Option<PathBuf>,
+    /// The animation of a glTF clip a new run learns, by name or index (default: the first),
+    /// replacing the config's data.animation.
+    #[arg(long, value_name = "NAME|INDEX")]
+    clip_anim: Option<String>,
     /// Training configuration (YAML). Without it a new run uses the default (configs/default.yaml,
     /// built in) and a resumed run its own.
     #[arg(long)]
@@ -107,6 +112,9 @@ fn new_run_config(args: &Args) -> Result<TrainConfig> {
             },
         };
     }
+    if let Some(animation) = &args.clip_anim {
+        config.data.animation = Some(animation.clone());
+    }
     if let Some(window) = args.window {
         config.model.window = window;
         config.model.window_follows_fps = false;
@@ -168,6 +176,14 @@ fn dry_run(args: &Args) -> Result<()> {
         data.facts.frames,
         data.facts.layout.fps
     );
+    if let Some(source) = &data.facts.source {
+        println!(
+            "source          {} animation {} (one of {})",
+            source.format,
+            source.animation.as_deref().unwrap_or("?"),
+            source.animations
+        );
+    }
     println!("up axis         {}", data.facts.up);
     if data.facts.in_place {
         println!("cycle           in place: contacts measured against the treadmill");
@@ -249,6 +265,9 @@ fn main() -> Result<()> {
         }
         if args.window.is_some() {
             bail!("--window sets the QnA window of a new run; a resumed run keeps its own");
+        }
+        if args.clip_anim.is_some() {
+            bail!("--clip-anim picks the animation of a new run; a resumed run keeps its own");
         }
         let config = args.config.as_deref().map(TrainConfig::load).transpose()?;
         Trainer::resume(out, args.clip.as_deref(), config, device)?
