@@ -24,7 +24,7 @@ use super::accessor::{field_usize, read_floats};
 use super::container::{Asset, read_asset};
 use super::nodes::{Similarity, Trs, node_name, node_trs, parents, rotation_of, unit_scale};
 use super::skin::{SkinJoints, build_joints, drop_static_leaves, skin_joints, unique_names};
-use super::tracks::{Property, Track, frame_rate, read_tracks};
+use super::tracks::{MAX_JOINT_FRAMES, Property, Track, frame_rate, read_tracks};
 use crate::error::{FormatError, Part};
 
 /// Which animation of a file is the clip.
@@ -241,6 +241,16 @@ pub fn read_gltf(path: &Path, options: &GltfReadOptions) -> Result<GltfClip, For
     let tracks = read_tracks(path, &asset, chosen, |n| skin.joint_of(n))?;
     let timing = frame_rate(path, part, &tracks, options.fps)?;
     let (_, fps, frames) = timing;
+    if frames.saturating_mul(skin.order.len()) > MAX_JOINT_FRAMES {
+        return Err(FormatError::bad(
+            path,
+            Part::Skeleton,
+            format!(
+                "{} joints x {frames} frames are more transforms than the {MAX_JOINT_FRAMES} a clip may have",
+                skin.order.len()
+            ),
+        ));
+    }
     let (rotations, translations) = sample_frames(path, nodes, &rest, &skin, &tracks, timing)?;
     let names = unique_names(nodes, &skin.order);
     let joints = build_joints(

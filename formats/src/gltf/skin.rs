@@ -172,7 +172,18 @@ pub(super) fn unique_names(nodes: &[Value], order: &[usize]) -> Vec<String> {
     names
 }
 
-/// The channels this crate's writer recorded for node `n`, and its End Site.
+/// Whether `channels` is a list a BVH joint can have: each rotation axis and each position
+/// axis at most once.
+fn well_formed(channels: &[Channel]) -> bool {
+    let mut seen = Vec::with_capacity(channels.len());
+    channels.iter().all(|c| {
+        let new = !seen.contains(c);
+        seen.push(*c);
+        new
+    })
+}
+
+/// The channels this crate's writer recorded for node `n` (when well formed), and its End Site.
 fn recorded(node: &Value, unit: f64) -> (Option<Vec<Channel>>, Option<Vec3>) {
     let extras = node.get("extras").and_then(|e| e.get(EXTRAS_KEY));
     let channels = extras
@@ -182,7 +193,8 @@ fn recorded(node: &Value, unit: f64) -> (Option<Vec<Channel>>, Option<Vec3>) {
             list.iter()
                 .map(|c| c.as_str().and_then(Channel::parse))
                 .collect::<Option<Vec<_>>>()
-        });
+        })
+        .filter(|channels| well_formed(channels));
     let end = numbers::<3>(extras.and_then(|e| e.get("end_site"))).map(|e| math::scale(e, unit));
     (channels, end)
 }

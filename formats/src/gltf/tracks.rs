@@ -12,6 +12,13 @@ use super::container::Asset;
 use super::nodes::node_name;
 use crate::error::{FormatError, Part};
 
+/// The most frames a clip read from glTF may have: 14 minutes at 120 fps, far beyond a
+/// training clip, and a bound on what a malformed file (keys a million seconds apart, say) can
+/// make the reader allocate.
+pub const MAX_CLIP_FRAMES: usize = 100_000;
+/// The most joint transforms (frames x joints) a clip read from glTF may have: about 1 GB.
+pub const MAX_JOINT_FRAMES: usize = 10_000_000;
+
 /// How a sampler interpolates.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum Interpolation {
@@ -292,7 +299,15 @@ pub(super) fn frame_rate(
     if !(fps.is_finite() && fps > 0.0) {
         return Err(bad(animation_part, format!("gives a frame rate of {fps}")));
     }
-    let frames = ((last - first) * fps).round() as usize + 1;
-
-    Ok((first, fps, frames))
+    let span = ((last - first) * fps).round();
+    if span >= MAX_CLIP_FRAMES as f64 {
+        return Err(bad(
+            animation_part,
+            format!(
+                "lasts {:.1} s, {span} frames at {fps} fps, more than the {MAX_CLIP_FRAMES} a clip may have; is the frame rate right (--fps)?",
+                last - first
+            ),
+        ));
+    }
+    Ok((first, fps, span as usize + 1))
 }

@@ -1,0 +1,293 @@
+//! Bad glTF files get an error naming the file and the part at fault, never a panic: each kind
+//! of problem on its own, then 2 000 random mutations of real files (JSON fields and buffer
+//! bytes).
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+
+use serde_json::{Value, json};
+use sinmdm::bvh::read_bvh;
+use sinmdm::motion::UpAxis;
+use sinmdm_formats::gltf::container::{Asset, glb_bytes, parse_glb};
+use sinmdm_formats::gltf::{GltfReadOptions, GltfWriteOptions, gltf_document, read_gltf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sinmdm-bad-gltf-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// The fox, cut to its first 12 frames, as a glTF document and its binary buffer.
+fn fox() -> (Value, Vec<u8>) {
+    let mut motion = read_bvh(root().join("tests/data/bvh/fox_survey_khronos.bvh"))
+        .unwrap()
+        .to_local();
+    let keep = 12 * motion.skeleton.len();
+    motion.rotations.truncate(keep);
+    motion.translations.truncate(keep);
+    let options = GltfWriteOptions {
+        up: UpAxis::PosY,
+        metres_per_unit: 0.01,
+    };
+    gltf_document(&[("Survey".into(), &motion)], &options).unwrap()
+}
+
+/// Reads `json` + `bin` as a GLB file; the error's text, or `None` when it reads.
+fn read(json: &Value, bin: &[u8], name: &str) -> Option<String> {
+    let path = scratch(name);
+    std::fs::write(&path, glb_bytes(json, bin)).unwrap();
+    let result = read_gltf(&path, &GltfReadOptions::default());
+    std::fs::remove_file(&path).unwrap();
+    result.err().map(|e| e.to_string())
+}
+
+fn error(json: &Value, bin: &[u8], name: &str) -> String {
+    read(json, bin, name).unwrap_or_else(|| panic!("{name} was read"))
+}
+
+#[test]
+fn the_unmodified_file_reads() {
+    let (json, bin) = fox();
+    assert_eq!(read(&json, &bin, "fine.glb"), None);
+}
+
+#[test]
+fn each_problem_is_named_with_the_file_and_the_part() {
+    let (json, bin) = fox();
+    let mut no_skin = json.clone();
+    no_skin.as_object_mut().unwrap().remove("skins");
+    let message = error(&no_skin, &bin, "no_skin.glb");
+    assert!(
+        message.contains("no_skin.glb") && message.contains("has no skin"),
+        "{message}"
+    );
+
+    let mut no_animation = json.clone();
+    no_animation.as_object_mut().unwrap().remove("animations");
+    let message = error(&no_animation, &bin, "no_animation.glb");
+    assert!(message.contains("has no animation"), "{message}");
+
+    let mut moves_nothing = json.clone();
+    for channel in moves_nothing["animations"][0]["channels"]
+        .as_array_mut()
+        .unwrap()
+    {
+        channel["target"]["node"] = json!(9999);
+    }
+    let message = error(&moves_nothing, &bin, "still.glb");
+    assert!(
+        message.contains("animation 0 ('Survey')") && message.contains("moves no joint"),
+        "{message}"
+    );
+
+    // A sampler whose output has fewer values than its input has keys.
+    let mut short = json.clone();
+    let output = short["animations"][0]["samplers"][0]["output"]
+        .as_u64()
+        .unwrap() as usize;
+    short["accessors"][output]["count"] = json!(5);
+    let message = error(&short, &bin, "short.glb");
+    assert!(
+        message.contains("animation 0, sampler 0") && message.contains("12 keys but 5"),
+        "{message}"
+    );
+
+    // A buffer cut short: the accessors run past its end.
+    let message = error(&json, &bin[..bin.len() / 2], "cut.glb");
+    assert!(
+        message.contains("buffer 0") && message.contains("truncated"),
+        "{message}"
+    );
+
+    // NaN in the key times (a float written over the first key).
+    let input = json["animations"][0]["samplers"][0]["input"]
+        .as_u64()
+        .unwrap() as usize;
+    let view = json["accessors"][input]["bufferView"].as_u64().unwrap() as usize;
+    let at = json["bufferViews"][view]["byteOffset"]
+        .as_u64()
+        .unwrap_or(0) as usize;
+    let mut nan = bin.clone();
+    nan[at..at + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    let message = error(&json, &nan, "nan.glb");
+    assert!(
+        message.contains(&format!("accessor {input}")) && message.contains("NaN"),
+        "{message}"
+    );
+
+    // Key times that go backwards, a scaled joint, two roots.
+    let mut backwards = bin.clone();
+    backwards[at + 4..at + 8].copy_from_slice(&(-1.0f32).to_le_bytes());
+    let message = error(&json, &backwards, "backwards.glb");
+    assert!(message.contains("do not increase"), "{message}");
+    let mut scaled = json.clone();
+    scaled["nodes"][3]["scale"] = json!([2.0, 2.0, 2.0]);
+    let message = error(&scaled, &bin, "scaled.glb");
+    assert!(
+        message.contains("node 3") && message.contains("unit scale"),
+        "{message}"
+    );
+    let mut two_roots = json.clone();
+    let children = two_roots["nodes"][0]["children"]
+        .as_array()
+        .unwrap()
+        .clone();
+    two_roots["nodes"][0]["children"] = json!([children[0]]);
+    let message = error(&two_roots, &bin, "two_roots.glb");
+    assert!(message.contains("root joints"), "{message}");
+
+    // Not a motion file at all.
+    let path = scratch("text.glb");
+    std::fs::write(&path, b"glTF and nothing else").unwrap();
+    let message = read_gltf(&path, &GltfReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("text.glb") && message.contains("GLB"),
+        "{message}"
+    );
+    std::fs::remove_file(path).unwrap();
+}
+
+/// A small deterministic generator (SplitMix64).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+/// Every path to a value inside `value`.
+fn paths(value: &Value, at: Vec<Value>, out: &mut Vec<Vec<Value>>) {
+    out.push(at.clone());
+    match value {
+        Value::Object(map) => {
+            for (k, v) in map {
+                let mut next = at.clone();
+                next.push(json!(k));
+                paths(v, next, out);
+            }
+        }
+        Value::Array(items) => {
+            for (i, v) in items.iter().enumerate() {
+                let mut next = at.clone();
+                next.push(json!(i));
+                paths(v, next, out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// The value at `path`, if an earlier mutation left it there.
+fn at<'a>(value: &'a mut Value, path: &[Value]) -> Option<&'a mut Value> {
+    path.iter().try_fold(value, |v, key| match key {
+        Value::String(k) => v.get_mut(k.as_str()),
+        Value::Number(i) => v.get_mut(i.as_u64()? as usize),
+        _ => None,
+    })
+}
+
+/// A hostile replacement for a JSON value.
+fn hostile(rng: &mut Rng, old: &Value) -> Value {
+    let numbers = [
+        json!(-1),
+        json!(0),
+        json!(1),
+        json!(3),
+        json!(1e30),
+        json!(-1e30),
+        json!(4_294_967_295u64),
+        json!(18_446_744_073_709_551_615u64),
+        json!(0.5),
+        json!(1e-30),
+    ];
+    match rng.below(6) {
+        0 => numbers[rng.below(numbers.len())].clone(),
+        1 => Value::Null,
+        2 => json!("CUBICSPLINE"),
+        3 => json!([]),
+        4 => json!({}),
+        _ => match old {
+            Value::Number(n) => json!(n.as_f64().unwrap_or(0.0) + (rng.below(5) as f64 - 2.0)),
+            Value::Array(a) if !a.is_empty() => json!(a[..rng.below(a.len())].to_vec()),
+            _ => json!(true),
+        },
+    }
+}
+
+#[test]
+fn two_thousand_mutated_files_give_errors_never_a_panic() {
+    let (json, bin) = fox();
+    let mut all = Vec::new();
+    paths(&json, Vec::new(), &mut all);
+    let mut rng = Rng(0x5eed);
+    let mut outcomes = [0usize; 2];
+    for case in 0..2000 {
+        let (mut mutated, mut bytes) = (json.clone(), bin.clone());
+        for _ in 0..1 + rng.below(3) {
+            match rng.below(4) {
+                0 | 1 => {
+                    let path = &all[1 + rng.below(all.len() - 1)];
+                    if let Some(target) = at(&mut mutated, path) {
+                        *target = hostile(&mut rng, target);
+                    }
+                }
+                2 => {
+                    let i = rng.below(bytes.len());
+                    bytes[i] = rng.next() as u8;
+                }
+                _ => {
+                    let i = rng.below(bytes.len());
+                    let v = [f32::NAN, f32::INFINITY, -1.0, 1e30, 0.0][rng.below(5)];
+                    let end = (i + 4).min(bytes.len());
+                    bytes[i..end].copy_from_slice(&v.to_le_bytes()[..end - i]);
+                }
+            }
+        }
+        let mut glb = glb_bytes(&mutated, &bytes);
+        if rng.below(10) == 0 {
+            glb.truncate(rng.below(glb.len()));
+        }
+        let path = scratch(&format!("case{case}.glb"));
+        std::fs::write(&path, &glb).unwrap();
+        let result = catch_unwind(AssertUnwindSafe(|| {
+            read_gltf(&path, &GltfReadOptions::default())
+        }));
+        std::fs::remove_file(&path).unwrap();
+        match result {
+            Err(_) => panic!("case {case} panicked: {mutated}"),
+            Ok(Ok(read)) => {
+                outcomes[0] += 1;
+                assert!(read.clip.frame_count() > 0);
+            }
+            Ok(Err(e)) => {
+                outcomes[1] += 1;
+                assert!(e.to_string().contains(&format!("case{case}.glb")), "{e}");
+            }
+        }
+    }
+    // Both outcomes occur: the mutations are neither all harmless nor all fatal.
+    assert!(outcomes[0] > 100 && outcomes[1] > 100, "{outcomes:?}");
+    // The container parser on its own, with every truncation of a small file.
+    let small = glb_bytes(&json!({"asset": {"version": "2.0"}}), &[1, 2, 3]);
+    for end in 0..small.len() {
+        let _: Result<Asset, _> = parse_glb(Path::new("t.glb"), &small[..end]);
+    }
+}
