@@ -25,16 +25,16 @@ pub fn read_motion_file(path: &Path, animation: Option<&str>) -> Result<ChannelC
         );
     }
     let (clip, source) = read_clip(path, &options)?;
-    if let Some(read) = &source.animation {
-        if source.animations.len() > 1 {
-            eprintln!(
-                "{}: read animation {} ({:.2} s), one of {}; --clip-anim NAME|INDEX picks another",
-                path.display(),
-                describe_animation(read),
-                read.seconds,
-                source.animations.len()
-            );
-        }
+    if let Some(read) = &source.animation
+        && source.animations.len() > 1
+    {
+        eprintln!(
+            "{}: read animation {} ({:.2} s), one of {}; --clip-anim NAME|INDEX picks another",
+            path.display(),
+            describe_animation(read),
+            read.seconds,
+            source.animations.len()
+        );
     }
     Ok(clip)
 }
