@@ -73,25 +73,34 @@ pub fn metres_per_unit(height: f64, explicit: Option<f64>) -> Result<f64> {
     Ok(guess.metres_per_unit())
 }
 
+/// How motions go into a glTF file: their up axis, metres per unit, and whether to add the
+/// proxy mesh.
+#[derive(Debug, Clone, Copy)]
+pub struct GltfPlacement {
+    /// The motions' up axis.
+    pub up: UpAxis,
+    /// Metres per unit.
+    pub metres: f64,
+    /// Add a one-triangle mesh skinned to the root.
+    pub proxy_mesh: bool,
+}
+
+impl GltfPlacement {
+    /// For BVH output, where none of it applies.
+    pub const NONE: GltfPlacement = GltfPlacement {
+        up: UpAxis::PosY,
+        metres: 1.0,
+        proxy_mesh: false,
+    };
+}
+
 /// Writes motions to `path`: glTF (`.glb`/`.gltf`) takes all of them, one animation each named
-/// `sample_000`, ... (or `name` when there is one motion); BVH takes one. `up` is the motions'
-/// up axis, `metres` metres per unit.
+/// `sample_000`, ... (or `name` when there is one motion); BVH takes one.
 pub fn write_motion_file(
     path: &Path,
     motions: &[LocalMotion],
-    up: UpAxis,
-    metres: f64,
-) -> Result<()> {
-    write_named_motions(path, motions, None, up, metres)
-}
-
-/// [`write_motion_file`], naming a single motion's glTF animation `name`.
-pub fn write_named_motions(
-    path: &Path,
-    motions: &[LocalMotion],
     name: Option<&str>,
-    up: UpAxis,
-    metres: f64,
+    placement: GltfPlacement,
 ) -> Result<()> {
     if is_gltf(path) {
         let named: Vec<(String, &LocalMotion)> = motions
@@ -103,13 +112,19 @@ pub fn write_named_motions(
             })
             .collect();
         let options = GltfWriteOptions {
-            up,
-            metres_per_unit: metres,
+            up: placement.up,
+            metres_per_unit: placement.metres,
+            proxy_mesh: placement.proxy_mesh,
         };
         sinmdm_formats::gltf::write_gltf(path, &named, &options)?;
         return Ok(());
     }
     ClipFormat::of(path)?;
+    anyhow::ensure!(
+        !placement.proxy_mesh,
+        "{}: --proxy-mesh is for glTF output; BVH has no meshes",
+        path.display()
+    );
     let [motion] = motions else {
         anyhow::bail!(
             "{}: a BVH file holds one motion, {} were given",

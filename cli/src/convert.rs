@@ -8,7 +8,9 @@ use clap::Args;
 use sinmdm::motion::up::{choose_up, to_canonical};
 use sinmdm::motion::{UpAxis, global_poses, skeleton_height};
 
-use crate::clip_files::{is_gltf, metres_per_unit, read_motion_file, write_named_motions};
+use crate::clip_files::{
+    GltfPlacement, is_gltf, metres_per_unit, read_motion_file, write_motion_file,
+};
 
 pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm convert tests/data/bvh/human_walk_cmu_131_01.bvh -o walk.glb   # for an engine
@@ -32,6 +34,10 @@ pub struct ConvertArgs {
     /// Metres per file unit, for glTF output (default: from the skeleton's height).
     #[arg(long, value_name = "METRES")]
     pub unit_scale: Option<f64>,
+    /// Add a one-triangle mesh skinned to the root (glTF output), for importers that build
+    /// skeletons only from skinned meshes (Unreal's).
+    #[arg(long)]
+    pub proxy_mesh: bool,
 }
 
 pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
@@ -55,12 +61,16 @@ pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
         .clip
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned());
-    write_named_motions(
+    let placement = GltfPlacement {
+        up,
+        metres,
+        proxy_mesh: args.proxy_mesh,
+    };
+    write_motion_file(
         &args.output,
         std::slice::from_ref(&motion),
         name.as_deref(),
-        up,
-        metres,
+        placement,
     )?;
     eprintln!(
         "wrote {} ({} joints, {} frames at {} fps)",

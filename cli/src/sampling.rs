@@ -16,7 +16,9 @@ use sinmdm::{Feet, Generated, Method, Plan, Request, Span, Task};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_render::{Camera, Figure};
 
-use crate::clip_files::{is_gltf, metres_per_unit, read_motion_file, write_motion_file};
+use crate::clip_files::{
+    GltfPlacement, is_gltf, metres_per_unit, read_motion_file, write_motion_file,
+};
 use crate::render::write_picture;
 use sinmdm_formats::ClipFormat;
 
@@ -39,6 +41,10 @@ pub struct SamplingArgs {
     /// height: metres, centimetres, or CMU units when unsure, said).
     #[arg(long, value_name = "METRES")]
     pub unit_scale: Option<f64>,
+    /// Add a one-triangle mesh skinned to the root (glTF output), for importers that build
+    /// skeletons only from skinned meshes (Unreal's).
+    #[arg(long)]
+    pub proxy_mesh: bool,
     /// Samples to make in one batched run (a crowd).
     #[arg(long, default_value_t = 1)]
     pub count: usize,
@@ -314,8 +320,8 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
     } else {
         ClipFormat::of(&args.output)?;
         anyhow::ensure!(
-            args.unit_scale.is_none(),
-            "--unit-scale is for glTF output; BVH keeps the clip's units"
+            args.unit_scale.is_none() && !args.proxy_mesh,
+            "--unit-scale and --proxy-mesh are for glTF output; BVH keeps the clip's units and has no meshes"
         );
         1.0
     };
@@ -333,7 +339,12 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         .collect::<Result<Vec<_>>>()?;
     let layout = generated.layout();
     if is_gltf(&args.output) {
-        write_motion_file(&args.output, &motions, layout.up, metres)?;
+        let placement = GltfPlacement {
+            up: layout.up,
+            metres,
+            proxy_mesh: args.proxy_mesh,
+        };
+        write_motion_file(&args.output, &motions, None, placement)?;
         eprintln!(
             "wrote {} ({} animation{})",
             args.output.display(),
@@ -343,7 +354,12 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
     } else {
         for (i, motion) in motions.iter().enumerate() {
             let path = args.output_path(i, motions.len());
-            write_motion_file(&path, std::slice::from_ref(motion), layout.up, 1.0)?;
+            write_motion_file(
+                &path,
+                std::slice::from_ref(motion),
+                None,
+                GltfPlacement::NONE,
+            )?;
             eprintln!("wrote {}", path.display());
         }
     }

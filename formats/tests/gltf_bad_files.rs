@@ -35,6 +35,7 @@ fn fox() -> (Value, Vec<u8>) {
     let options = GltfWriteOptions {
         up: UpAxis::PosY,
         metres_per_unit: 0.01,
+        proxy_mesh: false,
     };
     gltf_document(&[("Survey".into(), &motion)], &options).unwrap()
 }

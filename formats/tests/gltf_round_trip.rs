@@ -84,6 +84,7 @@ fn bvh_to_gltf_and_back_keeps_every_joint_where_it_was() {
         let options = GltfWriteOptions {
             up,
             metres_per_unit: unit,
+            proxy_mesh: false,
         };
         // Expected: the source's points in glTF's frame and metres.
         let turn = up.canonical_from_file();
@@ -119,6 +120,7 @@ fn bvh_to_gltf_and_back_keeps_every_joint_where_it_was() {
             let same_frame = GltfWriteOptions {
                 up: UpAxis::PosY,
                 metres_per_unit: 1.0,
+                proxy_mesh: false,
             };
             write_gltf(&again, &[("clip".into(), &bvh.to_local())], &same_frame).unwrap();
             let twice = read_gltf(&again, &GltfReadOptions::default()).unwrap();
@@ -161,6 +163,7 @@ fn a_crowd_is_one_file_with_one_animation_each() {
     let options = GltfWriteOptions {
         up: UpAxis::PosY,
         metres_per_unit: 0.05,
+        proxy_mesh: false,
     };
     write_gltf(&file, &samples, &options).unwrap();
     for (index, (name, motion)) in samples.iter().enumerate() {

@@ -27,6 +27,7 @@ fn as_gltf(clip: &str, metres: f64, extension: &str) -> PathBuf {
     let options = GltfWriteOptions {
         up: UpAxis::PosY,
         metres_per_unit: metres,
+        proxy_mesh: false,
     };
     write_gltf(&path, &[("Take 1".into(), &motion)], &options).unwrap();
     path

@@ -18,7 +18,17 @@ pub struct GltfWriteOptions {
     pub up: UpAxis,
     /// Metres per unit of the motions' translations (glTF is in metres).
     pub metres_per_unit: f64,
+    /// Add a tiny mesh (one triangle) skinned to the root, for importers that build skeletons
+    /// only from skinned meshes (Unreal's).
+    pub proxy_mesh: bool,
 }
+
+/// Vertex attribute data (`ARRAY_BUFFER`).
+const ARRAY_BUFFER: u32 = 34962;
+/// glTF's component type for unsigned bytes.
+const UNSIGNED_BYTE: u32 = 5121;
+/// Half the width of the proxy triangle, in metres.
+const PROXY_SIZE: f32 = 0.02;
 
 /// glTF's component type for 32-bit floats.
 const FLOAT: u32 = 5126;
@@ -32,23 +42,44 @@ struct Binary {
 }
 
 impl Binary {
-    /// Appends `values` as an accessor of `kind` (`SCALAR`, `VEC3`, `VEC4`, `MAT4`) with
-    /// `width` floats per element, with its min and max when `bounds` is set; returns its index.
-    fn accessor(&mut self, values: &[f32], kind: &str, width: usize, bounds: bool) -> usize {
+    /// Appends `bytes` in a buffer view of their own (with `target`, for vertex data), 4-byte
+    /// aligned; returns the view's index.
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
         while !self.bytes.len().is_multiple_of(4) {
             self.bytes.push(0);
         }
-        let offset = self.bytes.len();
-        for v in values {
-            self.bytes.extend_from_slice(&v.to_le_bytes());
-        }
-        self.views.push(json!({
+        let mut view = json!({
             "buffer": 0,
-            "byteOffset": offset,
-            "byteLength": values.len() * 4,
-        }));
+            "byteOffset": self.bytes.len(),
+            "byteLength": bytes.len(),
+        });
+        if let Some(target) = target {
+            view["target"] = json!(target);
+        }
+        self.bytes.extend_from_slice(bytes);
+        self.views.push(view);
+        self.views.len() - 1
+    }
+
+    /// Appends `values` as an accessor of `kind` (`SCALAR`, `VEC3`, `VEC4`, `MAT4`) with
+    /// `width` floats per element, with its min and max when `bounds` is set; returns its index.
+    fn accessor(&mut self, values: &[f32], kind: &str, width: usize, bounds: bool) -> usize {
+        self.float_accessor(values, kind, width, bounds, None)
+    }
+
+    /// [`Binary::accessor`] with a buffer-view target.
+    fn float_accessor(
+        &mut self,
+        values: &[f32],
+        kind: &str,
+        width: usize,
+        bounds: bool,
+        target: Option<u32>,
+    ) -> usize {
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.view(&bytes, target);
         let mut accessor = json!({
-            "bufferView": self.views.len() - 1,
+            "bufferView": view,
             "componentType": FLOAT,
             "count": values.len() / width,
             "type": kind,
@@ -68,6 +99,48 @@ impl Binary {
         self.accessors.push(accessor);
         self.accessors.len() - 1
     }
+
+    /// Appends `values` as a VEC4 accessor of unsigned bytes (joint indices); returns its index.
+    fn joints_accessor(&mut self, values: &[u8]) -> usize {
+        let view = self.view(values, Some(ARRAY_BUFFER));
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": UNSIGNED_BYTE,
+            "count": values.len() / 4,
+            "type": "VEC4",
+        }));
+        self.accessors.len() - 1
+    }
+}
+
+/// A one-triangle mesh bound to the root joint (`root_position`, its rest position in metres),
+/// so that importers that make bones only for skinned meshes see the skeleton: the mesh's JSON.
+fn proxy_mesh(binary: &mut Binary, root_position: Vec3) -> Value {
+    let [x, y, z] = root_position.map(|v| v as f32);
+    let positions = [
+        x - PROXY_SIZE,
+        y,
+        z,
+        x + PROXY_SIZE,
+        y,
+        z,
+        x,
+        y + PROXY_SIZE,
+        z,
+    ];
+    let position = binary.float_accessor(&positions, "VEC3", 3, true, Some(ARRAY_BUFFER));
+    // Every vertex on the root alone (joint 0, weight 1; unused slots 0 with weight 0).
+    let joint_indices = [0u8; 12];
+    let joints_0 = binary.joints_accessor(&joint_indices);
+    let weights: Vec<f32> = (0..3).flat_map(|_| [1.0, 0.0, 0.0, 0.0]).collect();
+    let weights_0 = binary.float_accessor(&weights, "VEC4", 4, false, Some(ARRAY_BUFFER));
+    json!({
+        "name": "proxy",
+        "primitives": [{
+            "attributes": {"POSITION": position, "JOINTS_0": joints_0, "WEIGHTS_0": weights_0},
+            "mode": 4,
+        }],
+    })
 }
 
 /// A rotation as glTF's unit quaternion `[x, y, z, w]`, on the same side as `previous` (so
@@ -255,10 +328,19 @@ pub fn gltf_document(
         }
         animations.push(json!({"name": name, "samplers": samplers, "channels": channels}));
     }
-    let document = json!({
+    let mut nodes = nodes;
+    let mut scene_nodes = roots.clone();
+    let mut meshes = Vec::new();
+    if options.proxy_mesh {
+        let (_, root_translation) = rest[roots[0]];
+        meshes.push(proxy_mesh(&mut binary, root_translation));
+        nodes.push(json!({"name": "proxy_mesh", "mesh": 0, "skin": 0}));
+        scene_nodes.push(nodes.len() - 1);
+    }
+    let mut document = json!({
         "asset": {"version": "2.0", "generator": concat!("sinmdm-rs ", env!("CARGO_PKG_VERSION"))},
         "scene": 0,
-        "scenes": [{"nodes": roots}],
+        "scenes": [{"nodes": scene_nodes}],
         "nodes": nodes,
         "skins": [{"joints": (0..joints).collect::<Vec<_>>(), "inverseBindMatrices": ibm, "skeleton": roots[0]}],
         "animations": animations,
@@ -266,6 +348,9 @@ pub fn gltf_document(
         "bufferViews": binary.views,
         "buffers": [{"byteLength": binary.bytes.len()}],
     });
+    if !meshes.is_empty() {
+        document["meshes"] = json!(meshes);
+    }
     Ok((document, binary.bytes))
 }
 
