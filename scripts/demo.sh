@@ -4,7 +4,9 @@
 #  - an in-between (the clip's first 3 s and its last part kept, the gap generated),
 #  - a style transfer: the CMU walk in the style of the model trained on the CMU hop,
 #  - three new fox motions from the fox model,
-# as BVH files (they open in Blender with the clip's skeleton, units and frame rate).
+# as BVH files (they open in Blender with the clip's skeleton, units and frame rate),
+#  - and a crowd of eight walks as ONE glTF file (walk_crowd.glb: one animation each, metres,
+#    +Y up), which Godot, Blender, three.js and Unity's glTFast open as it is.
 # Usage: scripts/demo.sh [OUT_DIR]   (default: out)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,6 +22,8 @@ walk=tests/data/bvh/human_walk_cmu_131_01.bvh
 "$sinmdm" inbetween -m "$walk_model" --reference "$walk" --keep 0:3s --keep 5s: -o "$out/walk_inbetween.bvh"
 "$sinmdm" harmonize -m "$hop_model" --content "$walk" -o "$out/walk_in_hop_style.bvh"
 "$sinmdm" generate -m "$fox_model" --count 3 --seed 1 -o "$out/fox_new.bvh" --render "$out/fox_new.gif"
+# CMU's unit is unsure from the skeleton's height alone; it is 1/0.45 inch.
+"$sinmdm" generate -m "$walk_model" --count 8 --seed 2 -o "$out/walk_crowd.glb" --unit-scale 0.056444
 echo
-echo "demo: BVH files and GIFs written to $(cd "$out" && pwd)/"
+echo "demo: BVH, GLB and GIF files written to $(cd "$out" && pwd)/"
 ls "$out"
