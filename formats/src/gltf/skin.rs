@@ -199,6 +199,26 @@ fn recorded(node: &Value, unit: f64) -> (Option<Vec<Channel>>, Option<Vec3>) {
     (channels, end)
 }
 
+/// A joint's translation holds still when it changes by less than this share of its length
+/// over the clip (glTF's f32 values round at about 1e-7 of it; exporters that sample every bone
+/// every frame write that rounding as motion).
+const STILL_SHARE: f64 = 1e-5;
+/// A joint's rotation holds still when no matrix entry changes by more than this.
+const STILL_TURN: f64 = 1e-5;
+
+/// Whether joint `j` turns and whether it moves, over the frames.
+fn turns_and_moves(
+    rotations: &[Mat3],
+    translations: &[Vec3],
+    joints: usize,
+    frames: usize,
+    j: usize,
+) -> (bool, bool) {
+    let (turns, moves) = joint_motion(rotations, translations, joints, frames, j);
+    let length = math::norm(translations[j]).max(1e-12);
+    (turns > STILL_TURN, moves > STILL_SHARE * length)
+}
+
 /// Largest change of joint `j`'s local rotation and translation over the frames.
 fn joint_motion(
     rotations: &[Mat3],
@@ -239,11 +259,11 @@ pub(super) fn build_joints(
     (0..joints)
         .map(|j| {
             let (recorded_channels, end_site) = recorded(&nodes[order[j]], unit);
-            let (turns, moves) = joint_motion(rotations, translations, joints, frames, j);
+            let (turns, moves) = turns_and_moves(rotations, translations, joints, frames, j);
             let parent = parent_of(j);
             let default_channels = || {
                 let mut channels = Vec::new();
-                if parent.is_none() || moves > 1e-9 {
+                if parent.is_none() || moves {
                     channels.extend(
                         ["Xposition", "Yposition", "Zposition"]
                             .map(|c| Channel::parse(c).expect("channel")),
@@ -261,8 +281,9 @@ pub(super) fn build_joints(
                 Some(channels) => {
                     let rotates = channels.iter().any(|c| matches!(c, Channel::Rotation(_)));
                     let positions = channels.iter().any(|c| matches!(c, Channel::Position(_)));
-                    let identity = math::mat_max_abs_diff(&rotations[j], &math::IDENTITY) < 1e-6;
-                    if (rotates || (turns < 1e-6 && identity)) && (positions || moves < 1e-9) {
+                    let identity =
+                        math::mat_max_abs_diff(&rotations[j], &math::IDENTITY) < STILL_TURN;
+                    if (rotates || (!turns && identity)) && (positions || !moves) {
                         channels
                     } else {
                         default_channels()
@@ -324,13 +345,8 @@ pub(super) fn drop_static_leaves(
         let Some(p) = joints[j].parent else { continue };
         let leaf = !joints.iter().any(|o| o.parent == Some(j));
         let only_child = joints.iter().filter(|o| o.parent == Some(p)).count() == 1;
-        let (turns, moves) = joint_motion(&rotations, &translations, count, frames, j);
-        if !written_by_us
-            && leaf
-            && only_child
-            && turns < 1e-6
-            && moves < 1e-9
-            && joints[p].end_site.is_none()
+        let (turns, moves) = turns_and_moves(&rotations, &translations, count, frames, j);
+        if !written_by_us && leaf && only_child && !turns && !moves && joints[p].end_site.is_none()
         {
             joints[p].end_site = Some(translations[j]);
             keep[j] = false;
