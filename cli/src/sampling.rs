@@ -21,6 +21,7 @@ use crate::clip_files::{
 };
 use crate::render::write_picture;
 use sinmdm_formats::ClipFormat;
+use sinmdm_formats::gltf::splice_into_character;
 
 /// Default respaced sampling steps of the command line: the library's `sinmdm::DEFAULT_STEPS`
 /// (clap needs it as text; a test checks they agree).
@@ -45,6 +46,11 @@ pub struct SamplingArgs {
     /// skeletons only from skinned meshes (Unreal's).
     #[arg(long)]
     pub proxy_mesh: bool,
+    /// The character's own .glb: the output (a .glb) is that file, meshes, skin and materials
+    /// unchanged, with every sample appended as one more animation of its bones (joints
+    /// matched by name, the travel scaled to its units).
+    #[arg(long, value_name = "CHARACTER.glb")]
+    pub mesh_from: Option<PathBuf>,
     /// Samples to make in one batched run (a crowd).
     #[arg(long, default_value_t = 1)]
     pub count: usize,
@@ -315,7 +321,21 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         .map(|i| args.output_path(i, plan.count()))
         .collect();
     outputs.dedup();
-    let metres = if is_gltf(&args.output) {
+    if args.mesh_from.is_some() {
+        anyhow::ensure!(
+            args.output
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("glb")),
+            "--mesh-from writes the character's file with the new animations: -o must be a .glb"
+        );
+        anyhow::ensure!(
+            args.unit_scale.is_none() && !args.proxy_mesh,
+            "--mesh-from takes the character's units and meshes; leave out --unit-scale and --proxy-mesh"
+        );
+    }
+    let metres = if args.mesh_from.is_some() {
+        1.0
+    } else if is_gltf(&args.output) {
         metres_per_unit(model.metadata().layout.skeleton_height, args.unit_scale)?
     } else {
         ClipFormat::of(&args.output)?;
@@ -338,7 +358,32 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         })
         .collect::<Result<Vec<_>>>()?;
     let layout = generated.layout();
-    if is_gltf(&args.output) {
+    if let Some(character) = &args.mesh_from {
+        let named: Vec<(String, &sinmdm::motion::LocalMotion)> = motions
+            .iter()
+            .enumerate()
+            .map(|(i, m)| (format!("sample_{i:03}"), m))
+            .collect();
+        let report = splice_into_character(character, &args.output, &named, layout.up)?;
+        eprintln!(
+            "wrote {}: {} with {} new animation{} after its {} ({} of its units per the model's; {})",
+            args.output.display(),
+            character.display(),
+            report.added_animations,
+            if report.added_animations == 1 {
+                ""
+            } else {
+                "s"
+            },
+            report.kept_animations,
+            report.scale,
+            if report.same_frames {
+                "its bones' frames are the model's"
+            } else {
+                "its bind pose is the model's rest pose"
+            }
+        );
+    } else if is_gltf(&args.output) {
         let placement = GltfPlacement {
             up: layout.up,
             metres,

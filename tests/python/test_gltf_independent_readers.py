@@ -160,3 +160,45 @@ def test_our_reader_plays_blender_files_as_three_does(tmp_path, name, variant):
     height = float(np.ptp(positions[..., 1], axis=1).mean())
     worst = compare(three, 0, positions, names, frames, np.eye(3), 1.0, height, missing=2)
     assert worst <= 1e-5, f"worst {worst:.2e} of the height"
+
+
+def test_a_crowd_spliced_into_the_character_keeps_it_and_plays_as_the_bvh_crowd(tmp_path):
+    """`generate --mesh-from` on Blender's skinned walk: the character's JSON is unchanged but for
+    the appended arrays and the buffer length, its binary data is kept, the validator finds
+    nothing the character did not already have, and three.js plays each new animation where
+    bvhio puts the same sample written as BVH."""
+    character = FIXTURES / "human_walk_cmu_131_01_skinned.glb"
+    glb, bvh = tmp_path / "crowd.glb", tmp_path / "crowd.bvh"
+    args = ["-m", MODEL, "--count", 3, "--seed", 5, "--seconds", 3, "--quiet"]
+    run("generate", *args, "-o", glb, "--mesh-from", character)
+    run("generate", *args, "-o", bvh)
+
+    def chunks(path):
+        data = path.read_bytes()
+        length = int.from_bytes(data[12:16], "little")
+        return json.loads(data[20:20 + length]), data[20 + length + 8:]
+
+    (before, bin_before), (after, bin_after) = chunks(character), chunks(glb)
+    for key in ("accessors", "bufferViews", "animations"):
+        assert len(after[key]) > len(before[key])
+        after[key] = after[key][:len(before[key])]
+    assert len(json.loads(json.dumps(chunks(glb)[0]["animations"]))) == 1 + 3
+    after["buffers"][0]["byteLength"] = before["buffers"][0]["byteLength"]
+    assert after == before
+    assert bin_after[:before["buffers"][0]["byteLength"]] == bin_before[:before["buffers"][0]["byteLength"]]
+
+    report = node("validate.mjs", character, glb)
+    ours, theirs = report[str(glb)], report[str(character)]
+    assert ours["errors"] == 0
+    assert sorted(m["code"] for m in ours["messages"]) == sorted(m["code"] for m in theirs["messages"])
+    assert set(ours["infoCodes"]) <= set(theirs["infoCodes"])
+
+    samples = [bvhio_joint_positions(tmp_path / f"crowd_{i:03}.bvh") for i in range(3)]
+    count = len(samples[0][0])
+    frames, times = frame_times(count, 30.0, [0, 7, count // 2, -1])
+    three = node("three_positions.mjs", glb, ",".join(map(str, times)))
+    assert [a["name"] for a in three["animations"]][1:] == ["sample_000", "sample_001", "sample_002"]
+    for i, (positions, names) in enumerate(samples):
+        height = float(np.ptp(positions[..., 1], axis=1).mean())
+        worst = compare(three, 1 + i, positions, names, frames, np.eye(3), 1.0, height)
+        assert worst <= 1e-5, f"sample {i}: worst {worst:.2e} of the height"

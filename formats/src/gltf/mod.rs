@@ -6,12 +6,14 @@ pub mod container;
 mod nodes;
 mod read;
 mod skin;
+mod splice;
 mod tracks;
 mod write;
 
 pub use read::{
     AnimationChoice, AnimationInfo, GltfClip, GltfReadOptions, list_animations, read_gltf,
 };
+pub use splice::{SpliceReport, splice_into_character};
 pub use write::{GltfWriteOptions, gltf_document, write_gltf};
 
 /// The key under a node's `extras` where this crate keeps what glTF has no place for: the

@@ -35,13 +35,25 @@ const FLOAT: u32 = 5126;
 
 /// The binary buffer under construction, with one buffer view and accessor per array.
 #[derive(Default)]
-struct Binary {
-    bytes: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
+pub(super) struct Binary {
+    pub(super) bytes: Vec<u8>,
+    pub(super) views: Vec<Value>,
+    pub(super) accessors: Vec<Value>,
+    /// Accessors and buffer views the document holds before these (their indices start there).
+    base: (usize, usize),
 }
 
 impl Binary {
+    /// A buffer that continues `bytes`, in a document that already has `accessors` accessors and
+    /// `views` buffer views.
+    pub(super) fn after(bytes: Vec<u8>, accessors: usize, views: usize) -> Binary {
+        Binary {
+            bytes,
+            base: (accessors, views),
+            ..Binary::default()
+        }
+    }
+
     /// Appends `bytes` in a buffer view of their own (with `target`, for vertex data), 4-byte
     /// aligned; returns the view's index.
     fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
@@ -58,12 +70,18 @@ impl Binary {
         }
         self.bytes.extend_from_slice(bytes);
         self.views.push(view);
-        self.views.len() - 1
+        self.base.1 + self.views.len() - 1
     }
 
     /// Appends `values` as an accessor of `kind` (`SCALAR`, `VEC3`, `VEC4`, `MAT4`) with
     /// `width` floats per element, with its min and max when `bounds` is set; returns its index.
-    fn accessor(&mut self, values: &[f32], kind: &str, width: usize, bounds: bool) -> usize {
+    pub(super) fn accessor(
+        &mut self,
+        values: &[f32],
+        kind: &str,
+        width: usize,
+        bounds: bool,
+    ) -> usize {
         self.float_accessor(values, kind, width, bounds, None)
     }
 
@@ -97,7 +115,7 @@ impl Binary {
             accessor["max"] = json!(max);
         }
         self.accessors.push(accessor);
-        self.accessors.len() - 1
+        self.base.0 + self.accessors.len() - 1
     }
 
     /// Appends `values` as a VEC4 accessor of unsigned bytes (joint indices); returns its index.
@@ -109,7 +127,7 @@ impl Binary {
             "count": values.len() / 4,
             "type": "VEC4",
         }));
-        self.accessors.len() - 1
+        self.base.0 + self.accessors.len() - 1
     }
 }
 
@@ -145,7 +163,7 @@ fn proxy_mesh(binary: &mut Binary, root_position: Vec3) -> Value {
 
 /// A rotation as glTF's unit quaternion `[x, y, z, w]`, on the same side as `previous` (so
 /// interpolating consecutive keys takes the short way).
-fn quaternion_xyzw(m: &Mat3, previous: Option<[f64; 4]>) -> [f64; 4] {
+pub(super) fn quaternion_xyzw(m: &Mat3, previous: Option<[f64; 4]>) -> [f64; 4] {
     let [w, x, y, z] = math::quat_wxyz_from_mat(m);
     let q = [x, y, z, w];
     match previous {
@@ -157,7 +175,7 @@ fn quaternion_xyzw(m: &Mat3, previous: Option<[f64; 4]>) -> [f64; 4] {
 }
 
 /// The quaternion rounded to f32 and renormalised there, as validators measure unit length.
-fn unit_f32(q: [f64; 4]) -> [f32; 4] {
+pub(super) fn unit_f32(q: [f64; 4]) -> [f32; 4] {
     let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
     let q = q.map(|v| (v / n) as f32);
     let n32 = q.iter().map(|v| v * v).sum::<f32>().sqrt();

@@ -1,0 +1,187 @@
+//! Motion spliced into a character's own GLB (Blender's export of the walk, with a skinned
+//! cube): the character's file is kept as it was, and the new animation moves its bones where
+//! Blender's own animation of the same motion moves them.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+use sinmdm::bvh::read_bvh;
+use sinmdm::motion::math;
+use sinmdm::motion::{LocalMotion, UpAxis, global_poses};
+use sinmdm_formats::gltf::container::parse_glb;
+use sinmdm_formats::gltf::{AnimationChoice, GltfReadOptions, read_gltf, splice_into_character};
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .join("tests/data/gltf")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sinmdm-splice-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn character() -> PathBuf {
+    fixtures().join("human_walk_cmu_131_01_skinned.glb")
+}
+
+/// World positions by joint name of animation `which` of `file`, every frame.
+fn played(file: &Path, which: AnimationChoice) -> Vec<Vec<(String, [f64; 3])>> {
+    let options = GltfReadOptions {
+        animation: Some(which),
+        fps: None,
+    };
+    let motion = read_gltf(file, &options).unwrap().clip.to_local();
+    global_poses(&motion)
+        .iter()
+        .map(|pose| {
+            motion
+                .skeleton
+                .joints
+                .iter()
+                .zip(&pose.joints)
+                .map(|(j, p)| (j.name.clone(), *p))
+                .collect()
+        })
+        .collect()
+}
+
+/// The largest distance between same-named joints of two plays, and the figure's height.
+fn worst_distance(a: &[Vec<(String, [f64; 3])>], b: &[Vec<(String, [f64; 3])>]) -> (f64, f64) {
+    assert_eq!(a.len(), b.len(), "frame counts differ");
+    let mut worst = 0.0f64;
+    let (mut low, mut high) = (f64::MAX, f64::MIN);
+    for (fa, fb) in a.iter().zip(b) {
+        for (name, p) in fa {
+            let (_, q) = fb.iter().find(|(n, _)| n == name).expect("same joints");
+            worst = worst.max(math::norm(math::sub(*p, *q)));
+            low = low.min(q[1]);
+            high = high.max(q[1]);
+        }
+    }
+    (worst, high - low)
+}
+
+/// The document and binary chunk of a GLB file.
+fn document(file: &Path) -> (Value, Vec<u8>) {
+    let asset = parse_glb(file, &std::fs::read(file).unwrap()).unwrap();
+    (asset.json, asset.buffers.into_iter().next().unwrap())
+}
+
+fn the_walk() -> LocalMotion {
+    read_bvh(fixtures().join("human_walk_cmu_131_01_2s.bvh"))
+        .unwrap()
+        .to_local()
+}
+
+#[test]
+fn a_spliced_walk_moves_the_character_as_blenders_own_animation_does() {
+    let out = scratch("character_with_walk.glb");
+    let walk = the_walk();
+    // The same walk in other units (a model trained on it in metres, say): scaled back.
+    let mut small = walk.clone();
+    for joint in &mut small.skeleton.joints {
+        joint.offset = math::scale(joint.offset, 0.01);
+        joint.end_site = joint.end_site.map(|e| math::scale(e, 0.01));
+    }
+    for t in &mut small.translations {
+        *t = math::scale(*t, 0.01);
+    }
+    let report =
+        splice_into_character(&character(), &out, &[("copy".into(), &walk)], UpAxis::PosY).unwrap();
+    assert_eq!((report.kept_animations, report.added_animations), (1, 1));
+    assert!(
+        !report.same_frames,
+        "Blender's bones have their own rest rotations"
+    );
+    assert!((report.scale - 1.0).abs() < 1e-4, "{}", report.scale);
+    // Into the result again: appended after the first.
+    let twice = scratch("character_with_two.glb");
+    let report = splice_into_character(
+        &out,
+        &twice,
+        &[("copy_in_metres".into(), &small)],
+        UpAxis::PosY,
+    )
+    .unwrap();
+    assert_eq!(report.kept_animations, 2);
+    assert!((report.scale - 100.0).abs() < 1e-2, "{}", report.scale);
+    let out = twice;
+
+    let blender = played(&out, AnimationChoice::Index(0));
+    for added in ["copy", "copy_in_metres"] {
+        let ours = played(&out, AnimationChoice::Name(added.into()));
+        let (worst, height) = worst_distance(&ours, &blender);
+        assert!(worst <= 1e-5 * height, "{added}: {worst} > 1e-5 x {height}");
+    }
+
+    // Nothing of the character's file changed but the appended arrays and the buffer length.
+    let (before, bin_before) = document(&character());
+    let (mut after, bin_after) = document(&out);
+    for key in ["accessors", "bufferViews", "animations"] {
+        let kept = before[key].as_array().unwrap().len();
+        let grown = after[key].as_array_mut().unwrap();
+        assert!(grown.len() > kept, "{key} did not grow");
+        if key == "animations" {
+            assert_eq!(grown.len(), kept + 2);
+        }
+        grown.truncate(kept);
+    }
+    after["buffers"][0]["byteLength"] = before["buffers"][0]["byteLength"].clone();
+    assert_eq!(after, before);
+    assert_eq!(&bin_after[..bin_before.len()], &bin_before[..]);
+}
+
+#[test]
+fn a_model_read_from_the_character_itself_keeps_its_joint_frames() {
+    // A clip read from the character's own file (as a model trained on it has): its joints'
+    // frames are the nodes' own, and splicing it back reproduces Blender's animation.
+    let read = read_gltf(&character(), &GltfReadOptions::default())
+        .unwrap()
+        .clip
+        .to_local();
+    let out = scratch("character_again.glb");
+    let report =
+        splice_into_character(&character(), &out, &[("again".into(), &read)], UpAxis::PosY)
+            .unwrap();
+    assert!(report.same_frames);
+    let (worst, height) = worst_distance(
+        &played(&out, AnimationChoice::Name("again".into())),
+        &played(&out, AnimationChoice::Index(0)),
+    );
+    assert!(worst <= 1e-5 * height, "{worst} > 1e-5 x {height}");
+}
+
+#[test]
+fn a_skeleton_the_character_lacks_is_refused_by_name() {
+    let mut walk = the_walk();
+    walk.skeleton.joints[3].name = "Tail".into();
+    let err = splice_into_character(
+        &character(),
+        &scratch("never.glb"),
+        &[("x".into(), &walk)],
+        UpAxis::PosY,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("no node named 'Tail'"), "{err}");
+    assert!(!scratch("never.glb").exists());
+    // Bones that point elsewhere: the fox's motion on the walk's names.
+    let mut bent = the_walk();
+    for joint in &mut bent.skeleton.joints {
+        joint.offset = [joint.offset[2], joint.offset[0], -joint.offset[1]];
+    }
+    let err = splice_into_character(
+        &character(),
+        &scratch("never.glb"),
+        &[("x".into(), &bent)],
+        UpAxis::PosY,
+    )
+    .unwrap_err();
+    assert!(
+        err.to_string().contains("is not the model's skeleton"),
+        "{err}"
+    );
+}
