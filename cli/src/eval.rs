@@ -35,7 +35,7 @@ pub struct EvalArgs {
     #[arg(short, long, value_name = "MODEL.onnx")]
     model: PathBuf,
     /// The clip to score against: the model's training clip.
-    #[arg(long, value_name = "CLIP.bvh")]
+    #[arg(long, value_name = "CLIP.bvh|CLIP.glb")]
     clip: PathBuf,
     #[command(flatten)]
     up: crate::sampling::ClipUpArg,

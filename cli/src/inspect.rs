@@ -25,7 +25,7 @@ pub(crate) const EXAMPLES: &str = "Examples:
 /// Arguments of `sinmdm inspect`.
 #[derive(Debug, Args)]
 pub struct InspectArgs {
-    /// The BVH clip.
+    /// The clip: .bvh, .glb or .gltf.
     pub clip: PathBuf,
     /// Frame rate of the features (default: the clip's own).
     #[arg(long)]

@@ -45,7 +45,7 @@ pub enum Command {
     /// Style transfer: a content clip's low frequencies in the style the model learned.
     #[command(after_help = tasks::HARMONIZE_EXAMPLES)]
     Harmonize(tasks::HarmonizeArgs),
-    /// Draw BVH clips as stick figures: an animated GIF, or a PNG contact sheet.
+    /// Draw clips (BVH, glTF) as stick figures: an animated GIF, or a PNG contact sheet.
     #[command(after_help = render::EXAMPLES)]
     Render(render::RenderArgs),
     /// Convert a clip between motion formats (BVH, glTF .glb/.gltf).

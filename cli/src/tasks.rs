@@ -54,7 +54,7 @@ pub struct InbetweenArgs {
     #[command(flatten)]
     sampling: SamplingArgs,
     /// The clip whose spans are kept (same skeleton as the model).
-    #[arg(long, value_name = "CLIP.bvh")]
+    #[arg(long, value_name = "CLIP.bvh|CLIP.glb")]
     reference: PathBuf,
     #[command(flatten)]
     up: ClipUpArg,
@@ -73,7 +73,7 @@ pub struct ExpandArgs {
     #[command(flatten)]
     sampling: SamplingArgs,
     /// The clip to expand (same skeleton as the model).
-    #[arg(long, value_name = "CLIP.bvh")]
+    #[arg(long, value_name = "CLIP.bvh|CLIP.glb")]
     reference: PathBuf,
     #[command(flatten)]
     up: ClipUpArg,
@@ -94,7 +94,7 @@ pub struct ComposeArgs {
     #[command(flatten)]
     sampling: SamplingArgs,
     /// The clip the chosen joints come from (same skeleton as the model).
-    #[arg(long, value_name = "CLIP.bvh")]
+    #[arg(long, value_name = "CLIP.bvh|CLIP.glb")]
     reference: PathBuf,
     #[command(flatten)]
     up: ClipUpArg,
@@ -122,7 +122,7 @@ pub struct HarmonizeArgs {
     #[command(flatten)]
     sampling: SamplingArgs,
     /// The content clip (same skeleton as the model, which was trained on the style clip).
-    #[arg(long, value_name = "CLIP.bvh")]
+    #[arg(long, value_name = "CLIP.bvh|CLIP.glb")]
     content: PathBuf,
     #[command(flatten)]
     up: ClipUpArg,

@@ -181,3 +181,125 @@ fn eval_command_refuses_bad_input_and_writes_nothing() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Runs `sinmdm` with string arguments and returns (success, stdout, stderr).
+fn run_text(args: &[&str]) -> (bool, String, String) {
+    let os: Vec<&std::ffi::OsStr> = args.iter().map(std::ffi::OsStr::new).collect();
+    let out = sinmdm(&os);
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn every_command_that_reads_a_clip_reads_gltf_and_names_what_it_refuses() {
+    let dir = std::env::temp_dir().join(format!("sinmdm-gltf-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    let model = test_model();
+    let model = model.to_str().unwrap();
+    let walk = repo_file("tests/data/bvh/human_walk_cmu_131_01.bvh");
+    let walk = walk.to_str().unwrap();
+    let (ok, _, err) = run_text(&["convert", walk, "-o", &path("walk.glb")]);
+    assert!(ok, "{err}");
+    // The same clip as BVH and as GLB encodes to the same features in the model's layout.
+    for (clip, json) in [
+        (walk.to_string(), "bvh.json"),
+        (path("walk.glb"), "glb.json"),
+    ] {
+        let (ok, _, err) = run_text(&["encode", &clip, "-m", model, "-o", &path(json)]);
+        assert!(ok, "{err}");
+    }
+    let read = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join(name)).unwrap()).unwrap()
+    };
+    let (bvh, glb) = (read("bvh.json"), read("glb.json"));
+    let values = |v: &serde_json::Value| -> Vec<f64> {
+        v["samples"][0]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|row| row.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()))
+            .collect()
+    };
+    assert_eq!(bvh["columns"], glb["columns"]);
+    let (a, b) = (values(&bvh), values(&glb));
+    assert_eq!(a.len(), b.len());
+    // 6D rotations agree to f32 rounding; root travel is in metres against CMU units, so the
+    // comparison is of rotations (columns with "rot6d").
+    let columns: Vec<String> = bvh["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap().to_string())
+        .collect();
+    let frames = a.len() / columns.len();
+    for (c, name) in columns.iter().enumerate() {
+        if !name.contains("rot6d") {
+            continue;
+        }
+        for f in 0..frames {
+            let (x, y) = (a[c * frames + f], b[c * frames + f]);
+            assert!((x - y).abs() < 1e-5, "{name} frame {f}: {x} against {y}");
+        }
+    }
+    // inspect, render, reorient and a task's reference take the GLB.
+    let (ok, out, err) = run_text(&["inspect", &path("walk.glb")]);
+    assert!(
+        ok && out.contains("animations 1") && out.contains("joints     31"),
+        "{out}{err}"
+    );
+    let (ok, _, err) = run_text(&["render", &path("walk.glb"), "-o", &path("walk.png")]);
+    assert!(ok && dir.join("walk.png").is_file(), "{err}");
+    let (ok, _, err) = run_text(&[
+        "reorient",
+        &path("walk.glb"),
+        "--to",
+        "z",
+        "-o",
+        &path("z.bvh"),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = run_text(&[
+        "inbetween",
+        "-m",
+        model,
+        "--reference",
+        &path("walk.glb"),
+        "--keep",
+        "0:1s",
+        "--keep",
+        "2s:",
+        "--steps",
+        "3",
+        "-o",
+        &path("ib.glb"),
+        "--quiet",
+    ]);
+    assert!(ok && dir.join("ib.glb").is_file(), "{err}");
+    // Refusals name the file and the problem; nothing is written.
+    let (ok, _, err) = run_text(&["inspect", &path("walk.glb"), "--clip-anim", "Run"]);
+    assert!(
+        !ok && err.contains("walk.glb") && err.contains("no animation named 'Run'"),
+        "{err}"
+    );
+    std::fs::write(dir.join("clip.fbx"), b"Kaydara FBX Binary").unwrap();
+    let (ok, _, err) = run_text(&["inspect", &path("clip.fbx")]);
+    assert!(
+        !ok && err.contains("FBX is not read yet") && err.contains(".glb"),
+        "{err}"
+    );
+    let (ok, _, err) = run_text(&["convert", walk, "-o", &path("walk.fbx")]);
+    assert!(
+        !ok && err.contains("FBX") && !dir.join("walk.fbx").exists(),
+        "{err}"
+    );
+    let (ok, _, err) = run_text(&["convert", walk, "-o", &path("walk.bvh"), "--proxy-mesh"]);
+    assert!(
+        !ok && err.contains("--proxy-mesh is for glTF output"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
