@@ -193,3 +193,39 @@ fn a_crowd_is_one_file_with_one_animation_each() {
     assert!(err.to_string().contains("no animation 3"), "{err}");
     std::fs::remove_file(file).unwrap();
 }
+
+#[test]
+fn a_gltf_with_a_side_car_buffer_reads_like_the_embedded_one() {
+    let fox = read_bvh(root().join("tests/data/bvh/fox_survey_khronos.bvh"))
+        .unwrap()
+        .to_local();
+    let options = GltfWriteOptions {
+        up: UpAxis::PosY,
+        metres_per_unit: 0.01,
+        proxy_mesh: false,
+    };
+    let embedded = scratch("fox_embedded.gltf");
+    write_gltf(&embedded, &[("Survey".into(), &fox)], &options).unwrap();
+    // The same document with its buffer moved to a file beside it (a name with a space, so
+    // the URI is percent-encoded).
+    let mut document: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&embedded).unwrap()).unwrap();
+    let uri = document["buffers"][0]["uri"].as_str().unwrap().to_string();
+    let data = uri.split_once("base64,").unwrap().1;
+    let bytes = sinmdm_formats::gltf::container::base64_decode(data).unwrap();
+    std::fs::write(scratch("fox data.bin"), &bytes).unwrap();
+    document["buffers"][0]["uri"] = serde_json::json!("fox%20data.bin");
+    let side_car = scratch("fox_side_car.gltf");
+    std::fs::write(&side_car, serde_json::to_vec(&document).unwrap()).unwrap();
+    let a = read_gltf(&embedded, &GltfReadOptions::default())
+        .unwrap()
+        .clip;
+    let b = read_gltf(&side_car, &GltfReadOptions::default())
+        .unwrap()
+        .clip;
+    assert_eq!(a, b);
+    // Without its buffer file, the error names the file it looked for.
+    std::fs::remove_file(scratch("fox data.bin")).unwrap();
+    let err = read_gltf(&side_car, &GltfReadOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("fox data.bin"), "{err}");
+}
