@@ -106,11 +106,23 @@ pub type FrameRows = Array2<f64>;
 /// The metric features of a motion: rows are frames, columns every 6D rotation component and
 /// every contact label of `layout`, from features `[F, N]` in file units.
 pub fn metric_features(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> FrameRows {
+    frame_rows(layout, features, |kind| {
+        matches!(kind, ColumnKind::Rotation6d(_) | ColumnKind::Contact)
+    })
+}
+
+/// The columns of `layout` whose kind `keep` accepts, as frame rows `[N, D]` (f64) of
+/// features `[F, N]`.
+pub(crate) fn frame_rows(
+    layout: &FeatureLayout,
+    features: ArrayView2<'_, f32>,
+    keep: impl Fn(ColumnKind) -> bool,
+) -> FrameRows {
     let columns: Vec<usize> = layout
         .columns()
         .iter()
         .enumerate()
-        .filter(|(_, c)| matches!(c.kind, ColumnKind::Rotation6d(_) | ColumnKind::Contact))
+        .filter(|(_, c)| keep(c.kind))
         .map(|(i, _)| i)
         .collect();
     let frames = features.len_of(Axis(1));

@@ -12,7 +12,7 @@
 //! vector's coordinate, so 0.05 is about 3 degrees of rotation on every joint, a distance that
 //! does not grow with the skeleton's joint count.
 
-use ndarray::{Array2, ArrayView2, ArrayView3, Axis};
+use ndarray::{Array2, ArrayView2, ArrayView3};
 use serde::{Deserialize, Serialize};
 
 use sinmdm::motion::{ColumnKind, FeatureLayout};
@@ -24,16 +24,8 @@ pub const REPLAY_TOLERANCE: f64 = 0.05;
 /// The 6D rotation values of a motion: rows are frames, columns every `Rotation6d` column of
 /// `layout`, from features `[F, N]` in file units.
 pub fn rotation_rows(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> Array2<f64> {
-    let columns: Vec<usize> = layout
-        .columns()
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| matches!(c.kind, ColumnKind::Rotation6d(_)))
-        .map(|(i, _)| i)
-        .collect();
-    let frames = features.len_of(Axis(1));
-    Array2::from_shape_fn((frames, columns.len()), |(n, c)| {
-        f64::from(features[[columns[c], n]])
+    crate::frame_rows(layout, features, |kind| {
+        matches!(kind, ColumnKind::Rotation6d(_))
     })
 }
 

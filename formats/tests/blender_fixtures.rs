@@ -2,35 +2,13 @@
 //! 2 s): our reader puts every joint where forward kinematics of the source BVH puts it, within
 //! 1e-5 of the skeleton's height, every frame, and reads the same up axis and frame rate.
 
-use std::path::{Path, PathBuf};
-
 use sinmdm::bvh::read_bvh;
 use sinmdm::motion::math;
-use sinmdm::motion::{LocalMotion, UpAxis, detect_up, global_poses};
+use sinmdm::motion::{UpAxis, detect_up};
 use sinmdm_formats::gltf::{GltfReadOptions, read_gltf};
 
-fn fixtures() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .join("tests/data/gltf")
-}
-
-/// Every frame's joint positions by joint name.
-fn positions(motion: &LocalMotion) -> Vec<Vec<(String, [f64; 3])>> {
-    global_poses(motion)
-        .iter()
-        .map(|pose| {
-            motion
-                .skeleton
-                .joints
-                .iter()
-                .zip(&pose.joints)
-                .map(|(j, p)| (j.name.clone(), *p))
-                .collect()
-        })
-        .collect()
-}
+mod common;
+use common::{fixtures, positions_by_name};
 
 #[test]
 fn blender_files_put_every_joint_where_the_bvh_does() {
@@ -38,7 +16,7 @@ fn blender_files_put_every_joint_where_the_bvh_does() {
         let source = read_bvh(fixtures().join(format!("{clip}_2s.bvh")))
             .unwrap()
             .to_local();
-        let expected = positions(&source);
+        let expected = positions_by_name(&source);
         let height = {
             let ys: Vec<f64> = expected.iter().flatten().map(|(_, p)| p[1]).collect();
             ys.iter().cloned().fold(f64::MIN, f64::max)
@@ -55,7 +33,7 @@ fn blender_files_put_every_joint_where_the_bvh_does() {
                 "{clip} {variant}"
             );
             assert_eq!(detect_up(&motion).axis, UpAxis::PosY);
-            let got = positions(&motion);
+            let got = positions_by_name(&motion);
             let mut compared = 0;
             let mut worst = 0.0f64;
             for (frame_got, frame_expected) in got.iter().zip(&expected) {

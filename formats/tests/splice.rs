@@ -7,16 +7,12 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 use sinmdm::bvh::read_bvh;
 use sinmdm::motion::math;
-use sinmdm::motion::{LocalMotion, UpAxis, global_poses};
+use sinmdm::motion::{LocalMotion, UpAxis};
 use sinmdm_formats::gltf::container::parse_glb;
 use sinmdm_formats::gltf::{AnimationChoice, GltfReadOptions, read_gltf, splice_into_character};
 
-fn fixtures() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .join("tests/data/gltf")
-}
+mod common;
+use common::{fixtures, positions_by_name};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("sinmdm-splice-{}", std::process::id()));
@@ -34,19 +30,7 @@ fn played(file: &Path, which: AnimationChoice) -> Vec<Vec<(String, [f64; 3])>> {
         animation: Some(which),
         fps: None,
     };
-    let motion = read_gltf(file, &options).unwrap().clip.to_local();
-    global_poses(&motion)
-        .iter()
-        .map(|pose| {
-            motion
-                .skeleton
-                .joints
-                .iter()
-                .zip(&pose.joints)
-                .map(|(j, p)| (j.name.clone(), *p))
-                .collect()
-        })
-        .collect()
+    positions_by_name(&read_gltf(file, &options).unwrap().clip.to_local())
 }
 
 /// The largest distance between same-named joints of two plays, and the figure's height.
