@@ -27,6 +27,26 @@ fn name(path: &std::path::Path) -> String {
     path.file_name().unwrap().to_string_lossy().into_owned()
 }
 
+/// The up axis each clip is known to have: the shared zombie walk was captured Z-up, every
+/// other clip is Y-up.
+fn known_up(path: &std::path::Path) -> UpAxis {
+    if name(path) == "human_zombie_walk_fair.bvh" {
+        UpAxis::PosZ
+    } else {
+        UpAxis::PosY
+    }
+}
+
+/// A clip as a Y-up file: one captured with another up axis is re-oriented first, as
+/// `sinmdm reorient --to y` does, so that the tests below can turn it into every other frame.
+fn read_y_up(path: &std::path::Path) -> ChannelClip {
+    let clip = read_bvh(path).unwrap();
+    match known_up(path) {
+        UpAxis::PosY => clip,
+        up => turned(&clip, &up.canonical_from_file()),
+    }
+}
+
 /// Largest difference between two feature arrays, column by column.
 fn max_diff(a: &EncodedClip, b: &EncodedClip) -> f32 {
     assert_eq!(a.features.dim(), b.features.dim());
@@ -38,14 +58,14 @@ fn max_diff(a: &EncodedClip, b: &EncodedClip) -> f32 {
 }
 
 #[test]
-fn every_clip_is_read_as_y_up_with_confidence() {
+fn every_clip_is_read_with_its_own_up_axis_and_confidence() {
     let clips = common::all_clips();
     assert!(clips.len() >= 4, "the shipped clips are missing");
     for path in clips {
         let found = detect_up(&read_bvh(&path).unwrap().to_local());
         assert_eq!(
             found.axis,
-            UpAxis::PosY,
+            known_up(&path),
             "{}: {}",
             name(&path),
             found.describe()
@@ -65,7 +85,7 @@ fn re_oriented_copies_are_detected_and_encode_to_the_same_features() {
     let clips = common::all_clips();
     assert!(clips.len() >= 4, "the shipped clips are missing");
     for path in clips {
-        let clip = read_bvh(&path).unwrap();
+        let clip = read_y_up(&path);
         let original = encode(&clip, &EncodeOptions::default()).unwrap();
         for up in [UpAxis::PosZ, UpAxis::PosX, UpAxis::NegZ] {
             let copy = turned(&clip, &up.file_from_canonical());
@@ -118,7 +138,7 @@ fn re_oriented_copies_are_detected_and_encode_to_the_same_features() {
 #[test]
 fn a_turn_about_up_changes_only_the_root_heading() {
     for path in common::all_clips() {
-        let clip = read_bvh(&path).unwrap();
+        let clip = read_y_up(&path);
         let original = encode(&clip, &EncodeOptions::default()).unwrap();
         for degrees in [90.0f64, 180.0] {
             let turn = math::axis_rotation(UP, degrees.to_radians());
@@ -175,7 +195,7 @@ fn a_turn_about_up_changes_only_the_root_heading() {
 #[test]
 fn a_z_up_copy_round_trips_in_its_own_frame() {
     for path in common::all_clips() {
-        let clip = read_bvh(&path).unwrap();
+        let clip = read_y_up(&path);
         let copy = turned(&clip, &UpAxis::PosZ.file_from_canonical());
         let options = EncodeOptions {
             fps: None,
@@ -243,12 +263,14 @@ fn in_place_cycles_keep_their_contacts() {
         .into_iter()
         .filter(|p| {
             let n = name(p);
-            n.contains("walk") || n.starts_with("dog_")
+            // The zombie walk turns round half way: held in place it is no treadmill (its feet
+            // drift one way, then the other), which the in-place measure does not model.
+            (n.contains("walk") || n.starts_with("dog_")) && n != "human_zombie_walk_fair.bvh"
         })
         .collect();
     assert!(!walks_and_dogs.is_empty());
     for path in walks_and_dogs {
-        let clip = read_bvh(&path).unwrap();
+        let clip = read_y_up(&path);
         let travelling = encode(&clip, &EncodeOptions::default()).unwrap();
         let options = EncodeOptions {
             contacts: sinmdm::motion::ContactConfig {

@@ -25,8 +25,17 @@ def extent(positions, axis):
     return float(np.mean(positions[:, :, axis].max(axis=1) - positions[:, :, axis].min(axis=1)))
 
 
+# Clips captured Z-up (the shared zombie walk); every other clip is Y-up.
+Z_UP_CLIPS = {"human_zombie_walk_fair.bvh"}
+
+
 @pytest.mark.parametrize("clip", clips(), ids=lambda p: p.stem)
 def test_z_up_copy_is_detected_and_round_trips_in_its_own_frame(clip, tmp_path, sinmdm):
+    if clip.name in Z_UP_CLIPS:
+        # Start from its Y-up twin, so that the copy below is a known turn of the original.
+        yup = tmp_path / "yup.bvh"
+        sinmdm("reorient", clip, "--to", "y", "-o", yup)
+        clip = yup
     zup = tmp_path / "zup.bvh"
     sinmdm("reorient", clip, "--to", "z", "-o", zup)
     original = bvhio_positions(clip)

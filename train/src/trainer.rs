@@ -574,6 +574,9 @@ impl Trainer {
             learning_rate: target.learning_rate / target.recovery.rate_scale * scale,
             recovery: record,
             elapsed_seconds: elapsed,
+            // The run's configuration as it is now: a resume may have raised its step count
+            // since the checkpoint was written.
+            config: self.state.config.clone(),
             ..target
         };
         self.model = Some(model);
