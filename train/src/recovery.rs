@@ -125,16 +125,29 @@ impl RecoveryRecord {
         recent >= SKIPS_BEFORE_ROLLBACK
     }
 
-    /// Records a roll-back from step `at` to step `to` and returns the new rate scale.
-    pub fn roll_back(&mut self, at: u64, to: u64) -> f64 {
+    /// Whether the run may roll back to step `to` once more: fewer than [`MAX_ROLLBACKS`]
+    /// roll-backs went there before (checkpoints only move forward, so these were in a row).
+    pub fn may_roll_back_to(&self, to: u64) -> bool {
+        let before = self
+            .events
+            .iter()
+            .filter(|e| matches!(e, RecoveryEvent::RolledBack { to: t, .. } if *t == to))
+            .count();
+        before < MAX_ROLLBACKS as usize
+    }
+
+    /// Records a roll-back from step `at` to step `to`, with the learning rate scaled down
+    /// again, and returns the event.
+    pub fn roll_back(&mut self, at: u64, to: u64) -> RecoveryEvent {
         self.rollbacks += 1;
         self.rate_scale *= ROLLBACK_RATE_FACTOR;
-        self.events.push(RecoveryEvent::RolledBack {
+        let event = RecoveryEvent::RolledBack {
             at,
             to,
             rate_scale: self.rate_scale,
-        });
-        self.rate_scale
+        };
+        self.events.push(event);
+        event
     }
 
     /// A one-line summary for logs and tables ("none" when clean).
@@ -161,18 +174,39 @@ mod tests {
         // 10 is 100 steps before 110: out of the window.
         assert!(!record.skip(110, NonFinite::Gradient));
         assert!(record.skip(120, NonFinite::Gradient));
-        assert_eq!(record.roll_back(120, 100), 0.5);
+        assert!(record.may_roll_back_to(100));
+        record.roll_back(120, 100);
+        assert_eq!(record.rate_scale, 0.5);
         // Skips before the roll-back no longer count.
         assert!(!record.skip(121, NonFinite::Gradient));
         assert!(!record.skip(122, NonFinite::Gradient));
         assert!(record.skip(123, NonFinite::Gradient));
-        assert_eq!(record.roll_back(123, 100), 0.25);
+        assert_eq!(
+            record.roll_back(123, 100),
+            RecoveryEvent::RolledBack {
+                at: 123,
+                to: 100,
+                rate_scale: 0.25
+            }
+        );
         assert_eq!(record.skipped_steps, 7);
         assert_eq!(record.rollbacks, 2);
         assert_eq!(
             record.summary(),
             "7 skipped step(s), 2 roll-back(s), learning rate x0.25"
         );
+    }
+
+    #[test]
+    fn three_roll_backs_to_one_checkpoint_are_the_last() {
+        let mut record = RecoveryRecord::default();
+        for at in [10, 20, 30] {
+            assert!(record.may_roll_back_to(5));
+            record.roll_back(at, 5);
+        }
+        assert!(!record.may_roll_back_to(5));
+        // A newer checkpoint may still be tried.
+        assert!(record.may_roll_back_to(40));
     }
 
     #[test]

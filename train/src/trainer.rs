@@ -20,7 +20,7 @@ use crate::foot_contact::FootContact;
 use crate::loss::LossTerms;
 use crate::loss_log::LossLog;
 use crate::model::{QnaUnet, on_cpu};
-use crate::recovery::{MAX_ROLLBACKS, NonFinite, RecoveryEvent, RecoveryRecord};
+use crate::recovery::{NonFinite, RecoveryEvent, RecoveryRecord};
 use crate::shards::{gradients_are_finite, poison_first_gradient, sharded_gradients};
 use crate::weight_average::WeightAverage;
 
@@ -126,15 +126,6 @@ pub enum StepOutcome {
         /// What was not finite.
         cause: NonFinite,
     },
-}
-
-impl StepOutcome {
-    /// The batch's loss, whether or not the model was updated.
-    pub fn loss(&self) -> f64 {
-        match *self {
-            StepOutcome::Updated(loss) | StepOutcome::Skipped { loss, .. } => loss,
-        }
-    }
 }
 
 /// The optimiser of a configuration (AdamW, epsilon 1e-8 as in PyTorch).
@@ -551,12 +542,7 @@ impl Trainer {
             },
         };
         let mut record = self.state.recovery.clone();
-        let tries = record
-            .events
-            .iter()
-            .filter(|e| matches!(e, RecoveryEvent::RolledBack { to, .. } if *to == target.step))
-            .count();
-        if tries >= MAX_ROLLBACKS as usize {
+        if !record.may_roll_back_to(target.step) {
             return Err(TrainError::Unrecoverable {
                 step: at,
                 to: target.step,
@@ -568,10 +554,10 @@ impl Trainer {
             Some(dir) => load_parts(dir, &target, &self.device)?,
             None => fresh_parts(&target.config, target.features, &self.device),
         };
-        let scale = record.roll_back(at, target.step);
+        let event = record.roll_back(at, target.step);
         let elapsed = self.elapsed();
         self.state = CheckpointState {
-            learning_rate: target.learning_rate / target.recovery.rate_scale * scale,
+            learning_rate: target.learning_rate / target.recovery.rate_scale * record.rate_scale,
             recovery: record,
             elapsed_seconds: elapsed,
             // The run's configuration as it is now: a resume may have raised its step count
@@ -587,12 +573,7 @@ impl Trainer {
         self.elapsed_before = elapsed;
         self.session_start = Instant::now();
         self.save()?;
-        Ok(*self
-            .state
-            .recovery
-            .events
-            .last()
-            .expect("the roll-back was recorded"))
+        Ok(event)
     }
 
     /// Makes the gradients of the given steps (1-based, as in the loss log) NaN, once each: a
