@@ -175,7 +175,9 @@ fn sample_frames(
     (first, fps, frames): (f64, f64, usize),
 ) -> Result<(Vec<math::Mat3>, Vec<math::Vec3>), FormatError> {
     let bad = |part: Part, message: String| FormatError::bad(path, part, message);
-    let SkinJoints { order, pre, unit } = skin;
+    let SkinJoints {
+        order, pre, unit, ..
+    } = skin;
     let unit = *unit;
     // Each joint's local transform, frame by frame.
     let joints = order.len();
@@ -253,15 +255,7 @@ pub fn read_gltf(path: &Path, options: &GltfReadOptions) -> Result<GltfClip, For
     }
     let (rotations, translations) = sample_frames(path, nodes, &rest, &skin, &tracks, timing)?;
     let names = unique_names(nodes, &skin.order);
-    let joints = build_joints(
-        &skin.order,
-        nodes,
-        &names,
-        &rotations,
-        &translations,
-        frames,
-        skin.unit,
-    );
+    let joints = build_joints(&skin, nodes, &names, &rotations, &translations, frames);
     let (skeleton, rotations, translations) =
         drop_static_leaves(joints, rotations, translations, frames, nodes, &skin.order);
     let motion = LocalMotion {

@@ -13,10 +13,12 @@ use super::nodes::{Similarity, Trs, node_name, numbers, uniform};
 use crate::error::{FormatError, Part};
 
 /// The skin's joints as a skeleton's: node indices in depth-first order from the root joint,
-/// the fixed transform of the non-joint nodes above each, and the scale of the nodes above the
-/// root (which multiplies every translation below it).
+/// each joint's parent joint (an index into `order`), the fixed transform of the non-joint
+/// nodes above each, and the scale of the nodes above the root (which multiplies every
+/// translation below it).
 pub(super) struct SkinJoints {
     pub(super) order: Vec<usize>,
+    pub(super) parents: Vec<Option<usize>>,
     pub(super) pre: Vec<Similarity>,
     pub(super) unit: f64,
 }
@@ -147,8 +149,18 @@ pub(super) fn skin_joints(
     }
     // The scale of the nodes above the root multiplies every translation below it.
     let unit = pre[0].scale;
+    // Parents precede children in depth-first order, so each parent's index is known.
+    let parents = order
+        .iter()
+        .map(|&n| joint_parent(n).and_then(|p| order.iter().position(|&o| o == p)))
+        .collect();
 
-    Ok(SkinJoints { order, pre, unit })
+    Ok(SkinJoints {
+        order,
+        parents,
+        pre,
+        unit,
+    })
 }
 
 /// The joints' names: the nodes', with whitespace runs as `_`, `joint_N` for unnamed nodes, and
@@ -240,27 +252,25 @@ fn joint_motion(
 /// The skeleton's joints: offsets from the first frame's translations where no position
 /// channel moves them, and channels as recorded, or rotations (and positions where they move).
 pub(super) fn build_joints(
-    order: &[usize],
+    skin: &SkinJoints,
     nodes: &[Value],
     names: &[String],
     rotations: &[Mat3],
     translations: &[Vec3],
     frames: usize,
-    unit: f64,
 ) -> Vec<Joint> {
+    let SkinJoints {
+        order,
+        parents,
+        unit,
+        ..
+    } = skin;
     let joints = order.len();
-    let parent_of = |j: usize| -> Option<usize> {
-        // The joint's parent is the nearest earlier joint that lists it beneath: recomputed
-        // from the node tree in read_gltf's order (parents precede children).
-        (0..j)
-            .rev()
-            .find(|&p| is_ancestor(nodes, order[p], order[j]))
-    };
     (0..joints)
         .map(|j| {
-            let (recorded_channels, end_site) = recorded(&nodes[order[j]], unit);
+            let (recorded_channels, end_site) = recorded(&nodes[order[j]], *unit);
             let (turns, moves) = turns_and_moves(rotations, translations, joints, frames, j);
-            let parent = parent_of(j);
+            let parent = parents[j];
             let default_channels = || {
                 let mut channels = Vec::new();
                 if parent.is_none() || moves {
@@ -300,29 +310,6 @@ pub(super) fn build_joints(
             }
         })
         .collect()
-}
-
-/// Whether node `a` is an ancestor of node `b`.
-fn is_ancestor(nodes: &[Value], a: usize, b: usize) -> bool {
-    let mut stack = vec![a];
-    while let Some(n) = stack.pop() {
-        for c in nodes[n]
-            .get("children")
-            .and_then(Value::as_array)
-            .into_iter()
-            .flatten()
-        {
-            if let Some(c) = c.as_u64().map(|c| c as usize) {
-                if c == b {
-                    return true;
-                }
-                if c < nodes.len() {
-                    stack.push(c);
-                }
-            }
-        }
-    }
-    false
 }
 
 /// Leaf joints that never move and are their parent's only child become the parent's End Site
