@@ -303,7 +303,6 @@ fn spliced_animation(
         .map(|f| (f as f64 / motion.fps) as f32)
         .collect();
     let input = binary.accessor(&times, "SCALAR", 1, true);
-    let node_of_joint = |n: usize| mapped.iter().position(|&m| m == n);
     let mut samplers = Vec::new();
     let mut channels = Vec::new();
     for (j, joint) in motion.skeleton.joints.iter().enumerate() {
@@ -311,44 +310,31 @@ fn spliced_animation(
         let moves = joint.parent.is_none() || !joint.position_axes().is_empty();
         let mut rotations = Vec::with_capacity(frames * 4);
         let mut translations = Vec::with_capacity(frames * 3);
+        let (anchor, fixed) = parent_frame(node, parent, rest, mapped);
         let mut previous = None;
         for pose in &poses {
-            // The node's parent's global transform at this frame: a mapped joint's, or a
-            // node's rest transform below one (or below the scene).
-            let parent_global = |n: usize| -> (Mat3, Vec3, f64) {
-                let mut chain: Vec<usize> = Vec::new();
-                let mut at: Option<usize> = parent[n];
-                while let Some(p) = at {
-                    if let Some(k) = node_of_joint(p) {
-                        let r = math::mat_mul(&pose.rotations[k], &offset_turn[k]);
-                        let mut g = Similarity {
-                            rotation: r,
-                            translation: pose.joints[k],
-                            scale: rest[p].scale,
-                        };
-                        for &c in chain.iter().rev() {
-                            let local: Similarity = rest[c];
-                            let above: Similarity = rest[parent[c].expect("chain below p")];
-                            g = g.then(&relative(&above, &local));
-                        }
-                        return (g.rotation, g.translation, g.scale);
-                    }
-                    chain.push(p);
-                    at = parent[p];
+            let parent_global = match anchor {
+                Some((k, p)) => Similarity {
+                    rotation: math::mat_mul(&pose.rotations[k], &offset_turn[k]),
+                    translation: pose.joints[k],
+                    scale: rest[p].scale,
                 }
-                let top = chain.first().map_or(Similarity::IDENTITY, |&c| rest[c]);
-                (top.rotation, top.translation, top.scale)
+                .then(&fixed),
+                None => fixed,
             };
-            let (pr, pt, ps) = parent_global(node);
+            let inverse_parent = math::transpose(&parent_global.rotation);
             let global_rotation = math::mat_mul(&pose.rotations[j], &offset_turn[j]);
-            let local_rotation = math::mat_mul(&math::transpose(&pr), &global_rotation);
+            let local_rotation = math::mat_mul(&inverse_parent, &global_rotation);
             let q = quaternion_xyzw(&local_rotation, previous);
             previous = Some(q);
             rotations.extend(unit_f32(q));
             if moves {
                 let local = math::scale(
-                    math::mat_vec(&math::transpose(&pr), math::sub(pose.joints[j], pt)),
-                    1.0 / ps,
+                    math::mat_vec(
+                        &inverse_parent,
+                        math::sub(pose.joints[j], parent_global.translation),
+                    ),
+                    1.0 / parent_global.scale,
                 );
                 translations.extend(local.map(|v| v as f32));
             }
@@ -365,6 +351,33 @@ fn spliced_animation(
         }
     }
     json!({"name": name, "samplers": samplers, "channels": channels})
+}
+
+/// How the global transform of node `n`'s parent is had at any frame: the nearest mapped joint
+/// above it (its index among the motion's joints, and its node) followed by the fixed rest
+/// transforms of the nodes between; or, with no joint above, that parent's fixed global rest
+/// transform.
+fn parent_frame(
+    n: usize,
+    parent: &[Option<usize>],
+    rest: &[Similarity],
+    mapped: &[usize],
+) -> (Option<(usize, usize)>, Similarity) {
+    let mut chain: Vec<usize> = Vec::new();
+    let mut at = parent[n];
+    while let Some(p) = at {
+        if let Some(k) = mapped.iter().position(|&m| m == p) {
+            let fixed = chain.iter().rev().fold(Similarity::IDENTITY, |g, &c| {
+                let above = rest[parent[c].expect("a node below a joint has a parent")];
+                g.then(&relative(&above, &rest[c]))
+            });
+            return (Some((k, p)), fixed);
+        }
+        chain.push(p);
+        at = parent[p];
+    }
+    let fixed = chain.first().map_or(Similarity::IDENTITY, |&c| rest[c]);
+    (None, fixed)
 }
 
 /// `local` as a transform relative to `above` (both global): `above^-1 local`.
