@@ -73,6 +73,15 @@ pub fn metres_per_unit(height: f64, explicit: Option<f64>) -> Result<f64> {
     Ok(guess.metres_per_unit())
 }
 
+/// Each motion with its animation name in a glTF file: `sample_000`, `sample_001`, ...
+pub fn named_samples(motions: &[LocalMotion]) -> Vec<(String, &LocalMotion)> {
+    motions
+        .iter()
+        .enumerate()
+        .map(|(i, m)| (format!("sample_{i:03}"), m))
+        .collect()
+}
+
 /// How motions go into a glTF file: their up axis, metres per unit, and whether to add the
 /// proxy mesh.
 #[derive(Debug, Clone, Copy)]
@@ -103,14 +112,10 @@ pub fn write_motion_file(
     placement: GltfPlacement,
 ) -> Result<()> {
     if is_gltf(path) {
-        let named: Vec<(String, &LocalMotion)> = motions
-            .iter()
-            .enumerate()
-            .map(|(i, m)| match name {
-                Some(name) if motions.len() == 1 => (name.to_string(), m),
-                _ => (format!("sample_{i:03}"), m),
-            })
-            .collect();
+        let named = match (name, motions) {
+            (Some(name), [motion]) => vec![(name.to_string(), motion)],
+            _ => named_samples(motions),
+        };
         let options = GltfWriteOptions {
             up: placement.up,
             metres_per_unit: placement.metres,

@@ -17,7 +17,7 @@ use sinmdm::{Model, ModelOptions};
 use sinmdm_render::{Camera, Figure};
 
 use crate::clip_files::{
-    GltfPlacement, is_gltf, metres_per_unit, read_motion_file, write_motion_file,
+    GltfPlacement, is_gltf, metres_per_unit, named_samples, read_motion_file, write_motion_file,
 };
 use crate::render::write_picture;
 use sinmdm_formats::ClipFormat;
@@ -180,6 +180,46 @@ impl SamplingArgs {
     }
 }
 
+/// Where a run's motions go, decided and checked before any sampling.
+enum MotionOutput<'a> {
+    /// One BVH file per sample.
+    Bvh,
+    /// One glTF file with every sample as an animation, at `metres` per unit of the model's clip.
+    Gltf { metres: f64 },
+    /// The character's own GLB (`--mesh-from`) with the samples appended.
+    Character(&'a Path),
+}
+
+impl SamplingArgs {
+    /// The output `-o`, `--mesh-from`, `--unit-scale` and `--proxy-mesh` ask for, checked
+    /// together; `skeleton_height` (file units) gives a glTF file's unit when none is given.
+    fn motion_output(&self, skeleton_height: f64) -> Result<MotionOutput<'_>> {
+        if let Some(character) = &self.mesh_from {
+            anyhow::ensure!(
+                self.output
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("glb")),
+                "--mesh-from writes the character's file with the new animations: -o must be a .glb"
+            );
+            anyhow::ensure!(
+                self.unit_scale.is_none() && !self.proxy_mesh,
+                "--mesh-from takes the character's units and meshes; leave out --unit-scale and --proxy-mesh"
+            );
+            return Ok(MotionOutput::Character(character));
+        }
+        if is_gltf(&self.output) {
+            let metres = metres_per_unit(skeleton_height, self.unit_scale)?;
+            return Ok(MotionOutput::Gltf { metres });
+        }
+        ClipFormat::of(&self.output)?;
+        anyhow::ensure!(
+            self.unit_scale.is_none() && !self.proxy_mesh,
+            "--unit-scale and --proxy-mesh are for glTF output; BVH keeps the clip's units and has no meshes"
+        );
+        Ok(MotionOutput::Bvh)
+    }
+}
+
 /// `--steps`: a number of respaced steps, or `all` (`None`) for the model's full T.
 pub fn parse_steps(text: &str) -> Result<Option<usize>> {
     if text.eq_ignore_ascii_case("all") {
@@ -300,7 +340,8 @@ pub fn check_writable(paths: &[PathBuf]) -> Result<()> {
 }
 
 /// Runs a task with the shared options: checks the request and the outputs, samples with a
-/// progress bar, and writes every BVH (and the features JSON, and the picture) atomically.
+/// progress bar, and writes the motions (BVH files, one glTF file, or the character's GLB with
+/// them appended), the features JSON and the picture, each atomically.
 pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Generated> {
     if !(1..=MAX_COUNT).contains(&args.count) {
         bail!(
@@ -321,30 +362,7 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         .map(|i| args.output_path(i, plan.count()))
         .collect();
     outputs.dedup();
-    if args.mesh_from.is_some() {
-        anyhow::ensure!(
-            args.output
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("glb")),
-            "--mesh-from writes the character's file with the new animations: -o must be a .glb"
-        );
-        anyhow::ensure!(
-            args.unit_scale.is_none() && !args.proxy_mesh,
-            "--mesh-from takes the character's units and meshes; leave out --unit-scale and --proxy-mesh"
-        );
-    }
-    let metres = if args.mesh_from.is_some() {
-        1.0
-    } else if is_gltf(&args.output) {
-        metres_per_unit(model.metadata().layout.skeleton_height, args.unit_scale)?
-    } else {
-        ClipFormat::of(&args.output)?;
-        anyhow::ensure!(
-            args.unit_scale.is_none() && !args.proxy_mesh,
-            "--unit-scale and --proxy-mesh are for glTF output; BVH keeps the clip's units and has no meshes"
-        );
-        1.0
-    };
+    let destination = args.motion_output(model.metadata().layout.skeleton_height)?;
     outputs.extend(args.features_json.iter().cloned());
     outputs.extend(args.render.iter().cloned());
     check_writable(&outputs)?;
@@ -358,54 +376,54 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         })
         .collect::<Result<Vec<_>>>()?;
     let layout = generated.layout();
-    if let Some(character) = &args.mesh_from {
-        let named: Vec<(String, &sinmdm::motion::LocalMotion)> = motions
-            .iter()
-            .enumerate()
-            .map(|(i, m)| (format!("sample_{i:03}"), m))
-            .collect();
-        let report = splice_into_character(character, &args.output, &named, layout.up)?;
-        eprintln!(
-            "wrote {}: {} with {} new animation{} after its {} ({} of its units per the model's; {})",
-            args.output.display(),
-            character.display(),
-            report.added_animations,
-            if report.added_animations == 1 {
-                ""
-            } else {
-                "s"
-            },
-            report.kept_animations,
-            report.scale,
-            if report.same_frames {
-                "its bones' frames are the model's"
-            } else {
-                "its bind pose is the model's rest pose"
-            }
-        );
-    } else if is_gltf(&args.output) {
-        let placement = GltfPlacement {
-            up: layout.up,
-            metres,
-            proxy_mesh: args.proxy_mesh,
-        };
-        write_motion_file(&args.output, &motions, None, placement)?;
-        eprintln!(
-            "wrote {} ({} animation{})",
-            args.output.display(),
-            motions.len(),
-            if motions.len() == 1 { "" } else { "s" }
-        );
-    } else {
-        for (i, motion) in motions.iter().enumerate() {
-            let path = args.output_path(i, motions.len());
-            write_motion_file(
-                &path,
-                std::slice::from_ref(motion),
-                None,
-                GltfPlacement::NONE,
+    match destination {
+        MotionOutput::Character(character) => {
+            let report = splice_into_character(
+                character,
+                &args.output,
+                &named_samples(&motions),
+                layout.up,
             )?;
-            eprintln!("wrote {}", path.display());
+            eprintln!(
+                "wrote {}: {} with {} new animation{} after its {} ({} of its units per the model's; {})",
+                args.output.display(),
+                character.display(),
+                report.added_animations,
+                if report.added_animations == 1 {
+                    ""
+                } else {
+                    "s"
+                },
+                report.kept_animations,
+                report.scale,
+                if report.same_frames {
+                    "its bones' frames are the model's"
+                } else {
+                    "its bind pose is the model's rest pose"
+                }
+            );
+        }
+        MotionOutput::Gltf { metres } => {
+            let placement = GltfPlacement {
+                up: layout.up,
+                metres,
+                proxy_mesh: args.proxy_mesh,
+            };
+            write_motion_file(&args.output, &motions, None, placement)?;
+            eprintln!(
+                "wrote {} ({} animation{})",
+                args.output.display(),
+                motions.len(),
+                if motions.len() == 1 { "" } else { "s" }
+            );
+        }
+        MotionOutput::Bvh => {
+            for (i, motion) in motions.iter().enumerate() {
+                let path = args.output_path(i, motions.len());
+                let one = std::slice::from_ref(motion);
+                write_motion_file(&path, one, None, GltfPlacement::NONE)?;
+                eprintln!("wrote {}", path.display());
+            }
         }
     }
     if let Some(path) = &args.features_json {
