@@ -8,8 +8,8 @@ use crate::graph::{Attr, GraphBuilder};
 use crate::weights::get;
 use sinmdm::network::{
     BATCH_AXIS, CONV_KERNEL, EMBEDDING_MULTIPLIER, FRAMES_AXIS, INPUT_FEATURES, INPUT_STEP,
-    NORM_EPSILON, NORM_GROUPS, NetworkShape, OUTPUT_FEATURES, RPE_SPREAD_FLOOR, SCORE_FLOOR,
-    SINUSOID_WIDTH, Weights, timestep_frequencies,
+    NORM_EPSILON, NORM_GROUPS, NetworkShape, OUTPUT_FEATURES, SCORE_FLOOR, SINUSOID_WIDTH, Weights,
+    position_weights, timestep_frequencies,
 };
 
 struct Net<'a> {
@@ -216,18 +216,9 @@ impl Net<'_> {
         let weighted = self.b.op("Mul", &[&v4, &e4], vec![]);
         let weighted = self.b.op("Reshape", &[&weighted, "channels_shape"], vec![]);
         let rpe = &get(self.w, &format!("{prefix}.rpe"), &[h, k])?.values;
-        // exp of each position logit less its head's largest (the softmax ignores the shift):
-        // every weight in (0, 1], with the contract's floor, so the window sums below can
-        // neither overflow nor, with the score floor, underflow to 0.
-        let bias: Vec<f32> = rpe
-            .chunks(k)
-            .flat_map(|head| {
-                let top = head.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-                head.iter().map(move |&r| {
-                    (f64::from(r.max(top + RPE_SPREAD_FLOOR)) - f64::from(top)).exp() as f32
-                })
-            })
-            .collect();
+        // Every weight in (0, 1], so the window sums below can neither overflow nor, with the
+        // score floor, underflow to 0.
+        let bias = position_weights(rpe, k);
         let per_channel: Vec<f32> = (0..c)
             .flat_map(|ch| bias[(ch / d) * k..(ch / d + 1) * k].to_vec())
             .collect();

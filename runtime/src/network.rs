@@ -27,6 +27,21 @@ pub const SCORE_FLOOR: f32 = -60.0;
 /// With the score floor, every weight of a window sum is at least `exp(-80)`, a normal f32, so
 /// the graph's sums (which take the weights unshifted) never underflow to 0.
 pub const RPE_SPREAD_FLOOR: f32 = -20.0;
+/// The QnA position weights of the exported graph, `[H, k]` from the learned biases `rpe`
+/// `[H, k]`: `exp(max(rpe_j, top + RPE_SPREAD_FLOOR) - top)` with `top` each head's largest
+/// bias, so every weight lies in `[exp(RPE_SPREAD_FLOOR), 1]`. The softmax ignores the shift;
+/// the floor is the training network's too, which applies it to the biases as tensors.
+pub fn position_weights(rpe: &[f32], window: usize) -> Vec<f32> {
+    rpe.chunks(window)
+        .flat_map(|head| {
+            let top = head.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+            head.iter().map(move |&r| {
+                (f64::from(r.max(top + RPE_SPREAD_FLOOR)) - f64::from(top)).exp() as f32
+            })
+        })
+        .collect()
+}
+
 /// Width of the sinusoidal timestep features (cosines, then sines).
 pub const SINUSOID_WIDTH: usize = 256;
 /// Longest period of the timestep sinusoids.

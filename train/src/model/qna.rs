@@ -143,7 +143,8 @@ impl QnaBlock {
 }
 
 /// The relative-position logits `[H, k]` as the network uses them: each raised to at most
-/// [`RPE_SPREAD_FLOOR`] below its head's largest. The floor keeps the exported graph's window
+/// [`RPE_SPREAD_FLOOR`] below its head's largest (the rule of
+/// [`sinmdm::network::position_weights`], here on tensors, so that gradients flow). The floor keeps the exported graph's window
 /// sums (which take `exp(rpe)` as they are) clear of f32 underflow; trained biases spread by a
 /// few units, so it changes nothing in practice. The head's largest is a detached constant.
 pub(crate) fn position_logits(rpe: Tensor<2>) -> Tensor<2> {
@@ -344,5 +345,16 @@ mod tests {
             .try_to_vec::<f32>()
             .unwrap();
         assert_eq!(got, vec![0.5, -19.0, 1.0, -2.0, -2.5, -22.0]);
+        // The exported graph's weights are these logits' exponentials less each head's largest.
+        let weights = sinmdm::network::position_weights(&[0.5, -30.0, 1.0, -2.0, -2.5, -23.0], 3);
+        for (head, w) in got.chunks(3).zip(weights.chunks(3)) {
+            let top = head.iter().copied().fold(f32::MIN, f32::max);
+            for (l, w) in head.iter().zip(w) {
+                assert!(
+                    ((l - top).exp() - w).abs() <= 1e-6 * w.max(1e-30),
+                    "{l} {w}"
+                );
+            }
+        }
     }
 }
