@@ -8,6 +8,7 @@
 
 pub mod error;
 pub mod gltf;
+mod sampled;
 pub mod units;
 
 use std::path::Path;

@@ -17,15 +17,16 @@
 use std::path::Path;
 
 use serde_json::Value;
+use sinmdm::motion::ChannelClip;
 use sinmdm::motion::math;
-use sinmdm::motion::{ChannelClip, LocalMotion};
 
 use super::accessor::{field_usize, read_floats};
 use super::container::{Asset, read_asset};
 use super::nodes::{Similarity, Trs, node_name, node_trs, parents, rotation_of, unit_scale};
-use super::skin::{SkinJoints, build_joints, drop_static_leaves, skin_joints, unique_names};
+use super::skin::{SkinJoints, node_names, recorded_joints, skin_joints};
 use super::tracks::{MAX_JOINT_FRAMES, Property, Track, frame_rate, read_tracks};
 use crate::error::{FormatError, Part};
+use crate::sampled::{SampledJoints, unique_names};
 
 /// Which animation of a file is the clip.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -254,16 +255,16 @@ pub fn read_gltf(path: &Path, options: &GltfReadOptions) -> Result<GltfClip, For
         ));
     }
     let (rotations, translations) = sample_frames(path, nodes, &rest, &skin, &tracks, timing)?;
-    let names = unique_names(nodes, &skin.order);
-    let joints = build_joints(&skin, nodes, &names, &rotations, &translations, frames);
-    let (skeleton, rotations, translations) =
-        drop_static_leaves(joints, rotations, translations, frames, nodes, &skin.order);
-    let motion = LocalMotion {
-        skeleton,
+    let motion = SampledJoints {
+        names: unique_names(node_names(nodes, &skin.order)),
+        parents: skin.parents.clone(),
+        recorded: recorded_joints(nodes, &skin),
         fps,
+        frames,
         rotations,
         translations,
-    };
+    }
+    .into_motion();
     Ok(GltfClip {
         clip: motion.to_channels(),
         animation: animations[chosen].clone(),
