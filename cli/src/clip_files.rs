@@ -1,4 +1,5 @@
-//! Motion files in and out by extension: `.bvh`, `.glb` and `.gltf` (through `sinmdm-formats`).
+//! Motion files in and out by extension (through `sinmdm-formats`): `.bvh`, `.glb` and `.gltf`
+//! in and out, `.fbx` in.
 
 use std::path::Path;
 
@@ -7,20 +8,21 @@ use sinmdm::bvh::to_bvh_string;
 use sinmdm::files::write_atomically;
 use sinmdm::motion::{ChannelClip, LocalMotion, UpAxis};
 use sinmdm_formats::{
-    AnimationChoice, ClipFormat, GltfReadOptions, GltfWriteOptions, UnitGuess, read_clip,
+    AnimationChoice, ClipFormat, GltfWriteOptions, ReadOptions, UnitGuess, read_clip,
+    writable_format,
 };
 
-/// Reads a clip from a `.bvh`, `.glb` or `.gltf` file; `animation` picks one of a glTF file's
-/// animations by name or index (default: the first), and which one was read is said when the
+/// Reads a clip from a `.bvh`, `.glb`, `.gltf` or `.fbx` file; `animation` picks one of a glTF
+/// or FBX file's animations by name or index (default: the first), and which one was read is said when the
 /// file holds several.
 pub fn read_motion_file(path: &Path, animation: Option<&str>) -> Result<ChannelClip> {
-    let options = GltfReadOptions {
+    let options = ReadOptions {
         animation: animation.map(AnimationChoice::parse),
         fps: None,
     };
     if animation.is_some() && ClipFormat::of(path)? == ClipFormat::Bvh {
         anyhow::bail!(
-            "{}: --clip-anim picks an animation of a glTF file; a BVH file holds one",
+            "{}: --clip-anim picks an animation of a glTF or FBX file; a BVH file holds one",
             path.display()
         );
     }
@@ -50,6 +52,11 @@ pub fn describe_animation(info: &sinmdm_formats::AnimationInfo) -> String {
 /// Whether `path` names a glTF file, which holds every sample of a run as one animation each.
 pub fn is_gltf(path: &Path) -> bool {
     matches!(ClipFormat::of(path), Ok(ClipFormat::Gltf))
+}
+
+/// Checks that motion can be written to `path` (BVH or glTF; FBX is read only).
+pub fn check_output(path: &Path) -> Result<ClipFormat> {
+    Ok(writable_format(path)?)
 }
 
 /// Metres per file unit for a glTF output: `explicit`, or the guess from the skeleton's height
@@ -124,7 +131,7 @@ pub fn write_motion_file(
         sinmdm_formats::gltf::write_gltf(path, &named, &options)?;
         return Ok(());
     }
-    ClipFormat::of(path)?;
+    check_output(path)?;
     anyhow::ensure!(
         !placement.proxy_mesh,
         "{}: --proxy-mesh is for glTF output; BVH has no meshes",

@@ -41,6 +41,7 @@ pub struct ConvertArgs {
 }
 
 pub(crate) fn run(args: &ConvertArgs) -> Result<()> {
+    crate::clip_files::check_output(&args.output)?;
     let clip = read_motion_file(&args.clip, args.read.clip_anim.as_deref())?;
     let motion = clip.to_local();
     let (up, metres) = if is_gltf(&args.output) {

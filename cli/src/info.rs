@@ -117,10 +117,14 @@ pub fn describe(path: &std::path::Path, m: &ModelMetadata) -> String {
     if let Some(source) = &t.clip_source {
         let _ = writeln!(
             s,
-            "clip source  {}, animation {} (one of {})",
+            "clip source  {}, animation {} (one of {}){}",
             source.format,
             source.animation.as_deref().unwrap_or("?"),
-            source.animations
+            source.animations,
+            source
+                .file_unit_meters
+                .map(|m| format!(", file unit {m} m, read as metres"))
+                .unwrap_or_default()
         );
     }
     let _ = writeln!(

@@ -65,8 +65,8 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
         bail!("--fps must be a positive number, got {fps}");
     }
     let clip = read_motion_file(&args.clip, args.up.clip_anim.as_deref())?;
-    if crate::clip_files::is_gltf(&args.clip) {
-        let animations = sinmdm_formats::gltf::list_animations(&args.clip)?;
+    let animations = sinmdm_formats::list_animations(&args.clip)?;
+    if !animations.is_empty() {
         println!("animations {}", animations.len());
         for a in &animations {
             println!(

@@ -20,7 +20,6 @@ use crate::clip_files::{
     GltfPlacement, is_gltf, metres_per_unit, named_samples, read_motion_file, write_motion_file,
 };
 use crate::render::write_picture;
-use sinmdm_formats::ClipFormat;
 use sinmdm_formats::gltf::splice_into_character;
 
 /// Default respaced sampling steps of the command line: the library's `sinmdm::DEFAULT_STEPS`
@@ -211,7 +210,7 @@ impl SamplingArgs {
             let metres = metres_per_unit(skeleton_height, self.unit_scale)?;
             return Ok(MotionOutput::Gltf { metres });
         }
-        ClipFormat::of(&self.output)?;
+        crate::clip_files::check_output(&self.output)?;
         anyhow::ensure!(
             self.unit_scale.is_none() && !self.proxy_mesh,
             "--unit-scale and --proxy-mesh are for glTF output; BVH keeps the clip's units and has no meshes"

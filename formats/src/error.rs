@@ -28,6 +28,8 @@ pub enum Part {
     Channel(usize, usize),
     /// The skeleton the file describes.
     Skeleton,
+    /// An FBX file's data as a whole.
+    Fbx,
 }
 
 impl fmt::Display for Part {
@@ -49,6 +51,7 @@ impl fmt::Display for Part {
             Part::Sampler(a, s) => write!(f, "animation {a}, sampler {s}"),
             Part::Channel(a, c) => write!(f, "animation {a}, channel {c}"),
             Part::Skeleton => f.write_str("skeleton"),
+            Part::Fbx => f.write_str("FBX data"),
         }
     }
 }

@@ -1,12 +1,15 @@
 //! # sinmdm-formats
 //!
 //! Motion files beyond the engine's BVH: glTF 2.0 (`.glb`, `.gltf`) read as clips and written
-//! from generated motion, chosen by file extension. Kept out of the engine crate, which takes
+//! from generated motion, and FBX (`.fbx`, binary and ASCII) read as clips, chosen by file
+//! extension. Kept out of the engine crate, which takes
 //! and returns poses and stays free of file-format dependencies.
 
 #![warn(missing_docs)]
 
+pub mod animation;
 pub mod error;
+pub mod fbx;
 pub mod gltf;
 mod sampled;
 pub mod units;
@@ -15,8 +18,11 @@ use std::path::Path;
 
 use sinmdm::motion::ChannelClip;
 
+pub use animation::{
+    AnimationChoice, AnimationInfo, MAX_CLIP_FRAMES, MAX_JOINT_FRAMES, ReadOptions,
+};
 pub use error::{FormatError, Part};
-pub use gltf::{AnimationChoice, AnimationInfo, GltfReadOptions, GltfWriteOptions};
+pub use gltf::GltfWriteOptions;
 pub use units::UnitGuess;
 
 /// A motion file format, as its extension names it.
@@ -26,11 +32,22 @@ pub enum ClipFormat {
     Bvh,
     /// `.glb` or `.gltf`.
     Gltf,
+    /// `.fbx` (binary or ASCII).
+    Fbx,
 }
 
 impl ClipFormat {
+    /// The format's short name (`bvh`, `gltf`, `fbx`), as model files record it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ClipFormat::Bvh => "bvh",
+            ClipFormat::Gltf => "gltf",
+            ClipFormat::Fbx => "fbx",
+        }
+    }
+
     /// The format of `path` by its extension (case-insensitive), or an error that names what is
-    /// read and, for FBX, the way round.
+    /// read.
     pub fn of(path: &Path) -> Result<ClipFormat, FormatError> {
         let extension = path
             .extension()
@@ -40,13 +57,10 @@ impl ClipFormat {
         match extension.as_str() {
             "bvh" => Ok(ClipFormat::Bvh),
             "glb" | "gltf" => Ok(ClipFormat::Gltf),
-            "fbx" => Err(FormatError::Unsupported {
-                path: path.to_path_buf(),
-                message: "FBX is not read yet; export the clip as glTF (.glb) or BVH from Blender or your DCC tool".into(),
-            }),
+            "fbx" => Ok(ClipFormat::Fbx),
             _ => Err(FormatError::Unsupported {
                 path: path.to_path_buf(),
-                message: "is not a motion file this reads (.bvh, .glb, .gltf)".into(),
+                message: "is not a motion file this reads (.bvh, .glb, .gltf, .fbx)".into(),
             }),
         }
     }
@@ -61,13 +75,17 @@ pub struct ClipSource {
     pub animation: Option<AnimationInfo>,
     /// Every animation of the file (empty for BVH).
     pub animations: Vec<AnimationInfo>,
+    /// The length of the file's own unit in metres, where the format says (glTF: 1; FBX: its
+    /// unit, 0.01 for centimetres), the clip then being read in metres. `None` for BVH, whose
+    /// units are guessed from the skeleton.
+    pub file_unit_meters: Option<f64>,
 }
 
-/// Reads a clip from a `.bvh`, `.glb` or `.gltf` file. `options` choose the animation and the
+/// Reads a clip from a `.bvh`, `.glb`, `.gltf` or `.fbx` file. `options` choose the animation and the
 /// frame rate of formats that hold keyframes rather than frames (BVH ignores them).
 pub fn read_clip(
     path: &Path,
-    options: &GltfReadOptions,
+    options: &ReadOptions,
 ) -> Result<(ChannelClip, ClipSource), FormatError> {
     match ClipFormat::of(path)? {
         ClipFormat::Bvh => Ok((
@@ -76,6 +94,7 @@ pub fn read_clip(
                 format: ClipFormat::Bvh,
                 animation: None,
                 animations: Vec::new(),
+                file_unit_meters: None,
             },
         )),
         ClipFormat::Gltf => {
@@ -86,8 +105,43 @@ pub fn read_clip(
                     format: ClipFormat::Gltf,
                     animation: Some(read.animation),
                     animations: read.animations,
+                    file_unit_meters: Some(1.0),
                 },
             ))
         }
+        ClipFormat::Fbx => {
+            let read = fbx::read_fbx(path, options)?;
+            Ok((
+                read.clip,
+                ClipSource {
+                    format: ClipFormat::Fbx,
+                    animation: Some(read.animation),
+                    animations: read.animations,
+                    file_unit_meters: Some(read.file_unit_meters),
+                },
+            ))
+        }
+    }
+}
+
+/// The animations of a glTF or FBX file with their lengths, as `inspect` lists them (empty for
+/// BVH, which holds one motion).
+pub fn list_animations(path: &Path) -> Result<Vec<AnimationInfo>, FormatError> {
+    match ClipFormat::of(path)? {
+        ClipFormat::Bvh => Ok(Vec::new()),
+        ClipFormat::Gltf => gltf::list_animations(path),
+        ClipFormat::Fbx => fbx::list_fbx_animations(path),
+    }
+}
+
+/// The format to write `path` in, or an error naming the way round for formats that are read
+/// but not written (FBX).
+pub fn writable_format(path: &Path) -> Result<ClipFormat, FormatError> {
+    match ClipFormat::of(path)? {
+        ClipFormat::Fbx => Err(FormatError::Unsupported {
+            path: path.to_path_buf(),
+            message: "FBX is read but not written: write .glb (Blender, Godot, Unity's glTFast, Unreal and three.js import it) or .bvh".into(),
+        }),
+        format => Ok(format),
     }
 }

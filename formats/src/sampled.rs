@@ -33,11 +33,17 @@ pub(crate) struct SampledJoints {
     pub(crate) rotations: Vec<Mat3>,
     /// Local translations, `[frames][joints]`.
     pub(crate) translations: Vec<Vec3>,
+    /// Each joint's local rotation in the file's rest pose (its nodes' own transforms, the
+    /// pose a skin is bound in). Joint frames are turned to line up with the world in this
+    /// pose, as BVH's are in its zero pose.
+    pub(crate) rest_rotations: Vec<Mat3>,
 }
 
 impl SampledJoints {
-    /// The clip's motion: joints built from the samples, static leaves as End Sites.
-    pub(crate) fn into_motion(self) -> LocalMotion {
+    /// The clip's motion: joint frames lined up with the world at rest, joints built from the
+    /// samples, static leaves as End Sites.
+    pub(crate) fn into_motion(mut self) -> LocalMotion {
+        self.line_up_frames_at_rest();
         let joints = build_joints(&self);
         let SampledJoints {
             recorded,
@@ -54,6 +60,42 @@ impl SampledJoints {
             fps,
             rotations,
             translations,
+        }
+    }
+}
+
+impl SampledJoints {
+    /// Re-expresses every joint in a frame that is the world's in the rest pose, as BVH joints
+    /// are in their zero pose: a joint of rest world rotation `A` under a parent of `P` gets the
+    /// local rotation `P R A^T` and translation `P t`. World positions do not change; a file
+    /// made from a BVH by a tool that re-bases joints onto bones (Blender) gives back the BVH's
+    /// rotations, so the model learns the same features from either.
+    fn line_up_frames_at_rest(&mut self) {
+        let joints = self.names.len();
+        let mut rest_world: Vec<Mat3> = Vec::with_capacity(joints);
+        for j in 0..joints {
+            let world = match self.parents[j] {
+                Some(p) => math::mat_mul(&rest_world[p], &self.rest_rotations[j]),
+                None => self.rest_rotations[j],
+            };
+            rest_world.push(world);
+        }
+        // An End Site hangs in its joint's frame.
+        for (recorded, turn) in self.recorded.iter_mut().zip(&rest_world) {
+            if let Some(end) = &mut recorded.end_site {
+                *end = math::mat_vec(turn, *end);
+            }
+        }
+        for f in 0..self.frames {
+            for j in 0..joints {
+                let k = f * joints + j;
+                let parent = self.parents[j].map_or(math::IDENTITY, |p| rest_world[p]);
+                let turned = math::mat_mul(&parent, &self.rotations[k]);
+                self.rotations[k] = math::mat_mul(&turned, &math::transpose(&rest_world[j]));
+                if self.parents[j].is_some() {
+                    self.translations[k] = math::mat_vec(&parent, self.translations[k]);
+                }
+            }
         }
     }
 }
@@ -90,9 +132,11 @@ pub(crate) fn well_formed(channels: &[Channel]) -> bool {
     })
 }
 
-/// A joint's translation holds still when it changes by less than this share of its length
-/// over the clip (f32 values round at about 1e-7 of it; exporters that sample every bone every
-/// frame write that rounding as motion).
+/// A joint's translation holds still when it changes by less than this share of the skeleton's
+/// longest bone over the clip. Exporters that sample every bone every frame write their f32
+/// rounding as motion, and that rounding scales with the world coordinates the exporter worked
+/// in, not with the bone: a short finger bone's translation wobbles by far more than 1e-7 of
+/// its own length.
 const STILL_SHARE: f64 = 1e-5;
 /// A joint's rotation holds still when no matrix entry changes by more than this.
 const STILL_TURN: f64 = 1e-5;
@@ -101,8 +145,7 @@ const STILL_TURN: f64 = 1e-5;
 fn turns_and_moves(
     rotations: &[Mat3],
     translations: &[Vec3],
-    joints: usize,
-    frames: usize,
+    (joints, frames, reach): (usize, usize, f64),
     j: usize,
 ) -> (bool, bool) {
     let (r0, t0) = (rotations[j], translations[j]);
@@ -112,8 +155,18 @@ fn turns_and_moves(
         turns = turns.max(math::mat_max_abs_diff(&rotations[k], &r0));
         moves = moves.max(math::norm(math::sub(translations[k], t0)));
     }
-    let length = math::norm(t0).max(1e-12);
-    (turns > STILL_TURN, moves > STILL_SHARE * length)
+    (turns > STILL_TURN, moves > STILL_SHARE * reach)
+}
+
+/// The length of the skeleton's longest bone (its largest first-frame translation below the
+/// root), the scale of what counts as a joint moving.
+fn reach(translations: &[Vec3], parents: &[Option<usize>]) -> f64 {
+    parents
+        .iter()
+        .zip(translations)
+        .filter(|(parent, _)| parent.is_some())
+        .map(|(_, t)| math::norm(*t))
+        .fold(1e-12, f64::max)
 }
 
 /// The skeleton's joints: offsets from the first frame's translations where no position
@@ -129,9 +182,10 @@ fn build_joints(sampled: &SampledJoints) -> Vec<Joint> {
         ..
     } = sampled;
     let joints = names.len();
+    let shape = (joints, *frames, reach(translations, parents));
     (0..joints)
         .map(|j| {
-            let (turns, moves) = turns_and_moves(rotations, translations, joints, *frames, j);
+            let (turns, moves) = turns_and_moves(rotations, translations, shape, j);
             let parent = parents[j];
             let default_channels = || {
                 let mut channels = Vec::new();
@@ -185,12 +239,14 @@ fn drop_static_leaves(
     recorded: &[Recorded],
 ) -> (Skeleton, Vec<Mat3>, Vec<Vec3>) {
     let count = joints.len();
+    let parents: Vec<Option<usize>> = joints.iter().map(|j| j.parent).collect();
+    let shape = (count, frames, reach(&translations, &parents));
     let mut keep = vec![true; count];
     for j in 1..count {
         let Some(p) = joints[j].parent else { continue };
         let leaf = !joints.iter().any(|o| o.parent == Some(j));
         let only_child = joints.iter().filter(|o| o.parent == Some(p)).count() == 1;
-        let (turns, moves) = turns_and_moves(&rotations, &translations, count, frames, j);
+        let (turns, moves) = turns_and_moves(&rotations, &translations, shape, j);
         if !recorded[j].ours
             && leaf
             && only_child
@@ -259,6 +315,60 @@ mod tests {
         );
     }
 
+    /// A turn by `angle` about `axis` (unit).
+    fn turn(axis: Vec3, angle: f64) -> Mat3 {
+        let (s, c) = (angle / 2.0).sin_cos();
+        math::mat_from_quat_wxyz([c, axis[0] * s, axis[1] * s, axis[2] * s])
+    }
+
+    #[test]
+    fn lining_up_frames_at_rest_keeps_every_position_and_makes_rest_the_identity() {
+        // A chain of three joints whose rest frames are turned every which way, in two frames:
+        // the rest pose itself and a bent pose.
+        let rest = vec![
+            turn([0.0, 0.0, 1.0], 0.7),
+            turn([1.0, 0.0, 0.0], -1.1),
+            turn([0.0, 1.0, 0.0], 2.0),
+        ];
+        let bend = turn([0.6, 0.0, 0.8], 0.5);
+        let offsets = [[0.1, 0.9, 0.2], [0.0, 0.5, 0.1], [0.3, 0.4, 0.0]];
+        let mut rotations = rest.clone();
+        rotations.extend([rest[0], math::mat_mul(&rest[1], &bend), rest[2]]);
+        let translations: Vec<Vec3> = offsets.iter().chain(&offsets).copied().collect();
+        let world = |rotations: &[Mat3], translations: &[Vec3]| -> Vec<Vec3> {
+            let mut out = Vec::new();
+            for f in 0..2 {
+                let (mut r, mut p) = (math::IDENTITY, [0.0; 3]);
+                for j in 0..3 {
+                    p = math::add(p, math::mat_vec(&r, translations[3 * f + j]));
+                    r = math::mat_mul(&r, &rotations[3 * f + j]);
+                    out.push(p);
+                }
+            }
+            out
+        };
+        let before = world(&rotations, &translations);
+        let mut sampled = SampledJoints {
+            names: unique_names(["a", "b", "c"].map(|s| Some(s.to_string()))),
+            parents: vec![None, Some(0), Some(1)],
+            recorded: vec![Recorded::default(); 3],
+            fps: 30.0,
+            frames: 2,
+            rotations,
+            translations,
+            rest_rotations: rest,
+        };
+        sampled.line_up_frames_at_rest();
+        let after = world(&sampled.rotations, &sampled.translations);
+        for (a, b) in before.iter().zip(&after) {
+            assert!(math::norm(math::sub(*a, *b)) < 1e-12, "{a:?} {b:?}");
+        }
+        for j in 0..3 {
+            assert!(math::mat_max_abs_diff(&sampled.rotations[j], &math::IDENTITY) < 1e-12);
+        }
+        assert!(math::mat_max_abs_diff(&sampled.rotations[4], &math::IDENTITY) > 0.1);
+    }
+
     #[test]
     fn a_still_only_child_leaf_becomes_its_parents_end_site() {
         // Root, a turning child, and a leaf under it that never moves.
@@ -278,6 +388,7 @@ mod tests {
             frames,
             rotations,
             translations,
+            rest_rotations: vec![math::IDENTITY; 3],
         }
         .into_motion();
         assert_eq!(motion.skeleton.len(), 2);

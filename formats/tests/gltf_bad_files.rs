@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 use serde_json::{Value, json};
 use sinmdm::bvh::read_bvh;
 use sinmdm::motion::UpAxis;
+use sinmdm_formats::ReadOptions;
 use sinmdm_formats::gltf::container::{Asset, glb_bytes, parse_glb};
-use sinmdm_formats::gltf::{GltfReadOptions, GltfWriteOptions, gltf_document, read_gltf};
+use sinmdm_formats::gltf::{GltfWriteOptions, gltf_document, read_gltf};
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -44,7 +45,7 @@ fn fox() -> (Value, Vec<u8>) {
 fn read(json: &Value, bin: &[u8], name: &str) -> Option<String> {
     let path = scratch(name);
     std::fs::write(&path, glb_bytes(json, bin)).unwrap();
-    let result = read_gltf(&path, &GltfReadOptions::default());
+    let result = read_gltf(&path, &ReadOptions::default());
     std::fs::remove_file(&path).unwrap();
     result.err().map(|e| e.to_string())
 }
@@ -147,7 +148,7 @@ fn each_problem_is_named_with_the_file_and_the_part() {
     // Not a motion file at all.
     let path = scratch("text.glb");
     std::fs::write(&path, b"glTF and nothing else").unwrap();
-    let message = read_gltf(&path, &GltfReadOptions::default())
+    let message = read_gltf(&path, &ReadOptions::default())
         .unwrap_err()
         .to_string();
     assert!(
@@ -269,7 +270,7 @@ fn two_thousand_mutated_files_give_errors_never_a_panic() {
         let path = scratch(&format!("case{case}.glb"));
         std::fs::write(&path, &glb).unwrap();
         let result = catch_unwind(AssertUnwindSafe(|| {
-            read_gltf(&path, &GltfReadOptions::default())
+            read_gltf(&path, &ReadOptions::default())
         }));
         std::fs::remove_file(&path).unwrap();
         match result {

@@ -9,7 +9,8 @@ use sinmdm::bvh::{parse_bvh, read_bvh, to_bvh_string};
 use sinmdm::motion::math::{self, Vec3};
 use sinmdm::motion::up::choose_up;
 use sinmdm::motion::{LocalMotion, UpAxis, global_poses, skeleton_height};
-use sinmdm_formats::gltf::{GltfReadOptions, GltfWriteOptions, read_gltf, write_gltf};
+use sinmdm_formats::ReadOptions;
+use sinmdm_formats::gltf::{GltfWriteOptions, read_gltf, write_gltf};
 use sinmdm_formats::{UnitGuess, read_clip};
 
 fn root() -> PathBuf {
@@ -101,7 +102,7 @@ fn bvh_to_gltf_and_back_keeps_every_joint_where_it_was() {
         for extension in ["glb", "gltf"] {
             let file = scratch(&format!("{name}.{extension}"));
             write_gltf(&file, &[("clip".into(), &source)], &options).unwrap();
-            let read = read_gltf(&file, &GltfReadOptions::default()).unwrap();
+            let read = read_gltf(&file, &ReadOptions::default()).unwrap();
             assert_eq!(read.clip.fps, source.fps, "{name}");
             let motion = read.clip.to_local();
             assert_eq!(motion.skeleton.len(), source.skeleton.len(), "{name}");
@@ -123,7 +124,7 @@ fn bvh_to_gltf_and_back_keeps_every_joint_where_it_was() {
                 proxy_mesh: false,
             };
             write_gltf(&again, &[("clip".into(), &bvh.to_local())], &same_frame).unwrap();
-            let twice = read_gltf(&again, &GltfReadOptions::default()).unwrap();
+            let twice = read_gltf(&again, &ReadOptions::default()).unwrap();
             let worst = worst_distance(&expected, &positions(&twice.clip.to_local()));
             assert!(
                 worst <= tolerance,
@@ -167,7 +168,7 @@ fn a_crowd_is_one_file_with_one_animation_each() {
     };
     write_gltf(&file, &samples, &options).unwrap();
     for (index, (name, motion)) in samples.iter().enumerate() {
-        let by_name = GltfReadOptions {
+        let by_name = ReadOptions {
             animation: Some(sinmdm_formats::AnimationChoice::Name(name.clone())),
             fps: None,
         };
@@ -184,7 +185,7 @@ fn a_crowd_is_one_file_with_one_animation_each() {
     }
     let err = read_clip(
         &file,
-        &GltfReadOptions {
+        &ReadOptions {
             animation: Some(sinmdm_formats::AnimationChoice::Index(3)),
             fps: None,
         },
@@ -217,15 +218,11 @@ fn a_gltf_with_a_side_car_buffer_reads_like_the_embedded_one() {
     document["buffers"][0]["uri"] = serde_json::json!("fox%20data.bin");
     let side_car = scratch("fox_side_car.gltf");
     std::fs::write(&side_car, serde_json::to_vec(&document).unwrap()).unwrap();
-    let a = read_gltf(&embedded, &GltfReadOptions::default())
-        .unwrap()
-        .clip;
-    let b = read_gltf(&side_car, &GltfReadOptions::default())
-        .unwrap()
-        .clip;
+    let a = read_gltf(&embedded, &ReadOptions::default()).unwrap().clip;
+    let b = read_gltf(&side_car, &ReadOptions::default()).unwrap().clip;
     assert_eq!(a, b);
     // Without its buffer file, the error names the file it looked for.
     std::fs::remove_file(scratch("fox data.bin")).unwrap();
-    let err = read_gltf(&side_car, &GltfReadOptions::default()).unwrap_err();
+    let err = read_gltf(&side_car, &ReadOptions::default()).unwrap_err();
     assert!(err.to_string().contains("fox data.bin"), "{err}");
 }

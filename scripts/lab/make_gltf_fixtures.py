@@ -87,8 +87,55 @@ def export_gltf(path, sampling=True):
                               export_yup=True, export_skins=True)
 
 
+def compress_fbx_arrays_fully():
+    """Blender's FBX writer compresses arrays with zlib at level 1; level 9 gives the same
+    arrays in a smaller file."""
+    import zlib
+
+    import io_scene_fbx.encode_bin as encode_bin
+
+    class Zlib9:
+        @staticmethod
+        def compress(data, level=9):
+            return zlib.compress(data, 9)
+
+    encode_bin.zlib = Zlib9
+
+
 def export_fbx(path, **extra):
-    bpy.ops.export_scene.fbx(filepath=path, bake_anim=True, add_leaf_bones=extra.pop("leaf", False), **extra)
+    bpy.ops.export_scene.fbx(filepath=path, bake_anim=True, bake_anim_simplify_factor=0.0,
+                             bake_anim_use_all_actions=False, bake_anim_use_nla_strips=False,
+                             add_leaf_bones=extra.pop("leaf", False), **extra)
+
+
+FBX_SECONDS = 1.0
+
+
+def export_fbx_cut(path, **extra):
+    """FBX files hold every bone's nine curves with their own key times, so the FBX fixtures
+    keep the first FBX_SECONDS of the cut clip to stay small. Leaf bones (Blender's `_end`
+    bones) carry the End Sites."""
+    scene = bpy.context.scene
+    end = scene.frame_end
+    scene.frame_end = scene.frame_start + int(round(FBX_SECONDS * scene.render.fps))
+    export_fbx(path, leaf=True, **extra)
+    scene.frame_end = end
+
+
+def add_end_bones(armature):
+    """A still bone at the tail of every leaf bone, so the GLB keeps the BVH's End Sites (glTF
+    has no bone tails; a reader folds a still leaf bone back into an End Site)."""
+    bpy.context.view_layer.objects.active = armature
+    bpy.ops.object.mode_set(mode="EDIT")
+    bones = armature.data.edit_bones
+    for bone in [b for b in bones if not b.children]:
+        end = bones.new(bone.name + "_end")
+        end.head = bone.tail
+        end.tail = bone.tail + (bone.tail - bone.head) * 0.25
+        end.roll = bone.roll
+        end.parent = bone
+        end.use_connect = True
+    bpy.ops.object.mode_set(mode="OBJECT")
 
 
 def main():
@@ -97,30 +144,29 @@ def main():
     argv = [a for a in argv if a != "--fbx"]
     out, clips = argv[0], argv[1:]
     os.makedirs(out, exist_ok=True)
+    compress_fbx_arrays_fully()
     for clip in clips:
         name = os.path.splitext(os.path.basename(clip))[0]
         cut = os.path.join(out, name + "_2s.bvh")
         cut_bvh(clip, cut)
         reset()
         armature = import_bvh(cut)
-        export_gltf(os.path.join(out, name + "_armature.glb"))
         if fbx:
-            export_fbx(os.path.join(out, name + "_armature.fbx"), object_types={"ARMATURE"})
+            export_fbx_cut(os.path.join(out, name + "_armature.fbx"), object_types={"ARMATURE"})
+        add_end_bones(armature)
+        export_gltf(os.path.join(out, name + "_armature.glb"))
         set_interpolation(armature, "CONSTANT")
         export_gltf(os.path.join(out, name + "_step.glb"), sampling=False)
         set_interpolation(armature, "BEZIER")
         export_gltf(os.path.join(out, name + "_cubic.glb"), sampling=False)
-        set_interpolation(armature, "LINEAR")
+
+        reset()
+        armature = import_bvh(cut)
         add_skinned_mesh(armature)
+        if fbx:
+            export_fbx_cut(os.path.join(out, name + "_skinned.fbx"))
+        add_end_bones(armature)
         export_gltf(os.path.join(out, name + "_skinned.glb"))
-        if not fbx:
-            continue
-        export_fbx(os.path.join(out, name + "_skinned.fbx"))
-        # Mixamo-style: prefixed names, centimetres, leaf bones.
-        for bone in armature.data.bones:
-            bone.name = "mixamorig:" + bone.name
-        export_fbx(os.path.join(out, name + "_mixamo_style.fbx"), global_scale=100.0, leaf=True,
-                   object_types={"ARMATURE"})
 
 
 main()

@@ -8,7 +8,7 @@ use sha2::{Digest, Sha256};
 
 use sinmdm::model_file::ClipSourceFacts;
 use sinmdm::motion::{ContactConfig, EncodeOptions, FeatureLayout, Normalizer, encode};
-use sinmdm_formats::{AnimationChoice, ClipFormat, GltfReadOptions, read_clip};
+use sinmdm_formats::{AnimationChoice, ClipFormat, ReadOptions, read_clip};
 
 use crate::config::{DataConfig, ModelConfig};
 use crate::error::TrainError;
@@ -56,7 +56,7 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 }
 
 impl ClipData {
-    /// Reads (BVH, or glTF with `data.animation` choosing the animation), encodes and normalises
+    /// Reads (BVH, or glTF or FBX with `data.animation` choosing the animation), encodes and normalises
     /// `path`; rejects a clip shorter than the receptive field.
     pub fn load(
         path: &Path,
@@ -68,7 +68,7 @@ impl ClipData {
             path: path.to_path_buf(),
             source,
         })?;
-        let read_options = GltfReadOptions {
+        let read_options = ReadOptions {
             animation: data.animation.as_deref().map(AnimationChoice::parse),
             fps: None,
         };
@@ -77,7 +77,7 @@ impl ClipData {
                 if data.animation.is_some() {
                     return Err(TrainError::Config {
                         path: path.to_path_buf(),
-                        message: "data.animation (--clip-anim) picks an animation of a glTF clip; a BVH file holds one".into(),
+                        message: "data.animation (--clip-anim) picks an animation of a glTF or FBX clip; a BVH file holds one".into(),
                     });
                 }
                 let text = String::from_utf8_lossy(&bytes);
@@ -86,13 +86,16 @@ impl ClipData {
                     None,
                 )
             }
-            ClipFormat::Gltf => {
+            format @ (ClipFormat::Gltf | ClipFormat::Fbx) => {
                 let (clip, source) = read_clip(path, &read_options)?;
-                let read = source.animation.expect("a glTF clip names its animation");
+                let read = source
+                    .animation
+                    .expect("a glTF or FBX clip names its animation");
                 let facts = ClipSourceFacts {
-                    format: "gltf".into(),
+                    format: format.name().into(),
                     animation: Some(read.name.unwrap_or_else(|| format!("#{}", read.index))),
                     animations: source.animations.len(),
+                    file_unit_meters: source.file_unit_meters,
                 };
                 (clip, Some(facts))
             }

@@ -1,5 +1,5 @@
-//! Training from a glTF clip: the same training features as from the BVH it was made from, and
-//! a run that keeps its glTF clip, resumes from it and records it in the model file.
+//! Training from a glTF or FBX clip: the same training features as from the BVH it was made
+//! from, and a run that keeps its glTF clip, resumes from it and records it in the model file.
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -33,6 +33,41 @@ fn as_gltf(clip: &str, metres: f64, extension: &str) -> PathBuf {
     path
 }
 
+/// Asserts that `clip` gives the training features of `bvh`, read in units of `metres` per BVH
+/// unit: before normalisation, 6D rotations within `rotation_tolerance`, lengths (root travel and height,
+/// position channels) within 1e-5 of the skeleton's height once in the same unit, contact
+/// labels equal. (Normalised, a root that stands still turns f32's rounding of its position,
+/// under 1e-7 m, into unit-variance noise.)
+fn assert_same_features(
+    clip: &ClipData,
+    bvh: &ClipData,
+    (metres, rotation_tolerance): (f64, f64),
+    what: &str,
+) {
+    assert_eq!(clip.features.dim(), bvh.features.dim(), "{what}");
+    let raw_clip = clip.facts.normalizer.denormalize(clip.features.view());
+    let raw_bvh = bvh.facts.normalizer.denormalize(bvh.features.view());
+    let height = bvh.facts.layout.skeleton_height * metres;
+    for (r, column) in bvh.facts.layout.columns().iter().enumerate() {
+        let (scale, allowed) = match column.kind {
+            ColumnKind::Rotation6d(_) => (1.0, rotation_tolerance),
+            ColumnKind::Contact => (1.0, 0.0),
+            _ => (metres, 1e-5 * height),
+        };
+        let worst = raw_clip
+            .row(r)
+            .iter()
+            .zip(raw_bvh.row(r).iter())
+            .map(|(a, b)| (f64::from(*a) - f64::from(*b) * scale).abs())
+            .fold(0f64, f64::max);
+        assert!(
+            worst <= allowed,
+            "{what}, row {r} ({:?}): max |diff| {worst} > {allowed}",
+            column.kind
+        );
+    }
+}
+
 #[test]
 fn a_gltf_clip_gives_the_training_features_of_its_bvh() {
     let config = tiny();
@@ -49,38 +84,75 @@ fn a_gltf_clip_gives_the_training_features_of_its_bvh() {
         for extension in ["glb", "gltf"] {
             let file = as_gltf(clip, metres, extension);
             let gltf = ClipData::load(&file, &config.data, &config.model).unwrap();
-            assert_eq!(gltf.features.dim(), bvh.features.dim(), "{clip}");
-            // The features before normalisation: 6D rotations within 1e-5, lengths (root travel
-            // and height, position channels) within 1e-5 of the skeleton's height once in the
-            // same unit, contact labels equal. (Normalised, a root that stands still turns
-            // f32's rounding of its position, under 1e-7 m, into unit-variance noise.)
-            let raw_gltf = gltf.facts.normalizer.denormalize(gltf.features.view());
-            let raw_bvh = bvh.facts.normalizer.denormalize(bvh.features.view());
-            let height = bvh.facts.layout.skeleton_height * metres;
-            for (r, column) in bvh.facts.layout.columns().iter().enumerate() {
-                let (scale, allowed) = match column.kind {
-                    ColumnKind::Rotation6d(_) => (1.0, 1e-5),
-                    ColumnKind::Contact => (1.0, 0.0),
-                    _ => (metres, 1e-5 * height),
-                };
-                let worst = raw_gltf
-                    .row(r)
-                    .iter()
-                    .zip(raw_bvh.row(r).iter())
-                    .map(|(a, b)| (f64::from(*a) - f64::from(*b) * scale).abs())
-                    .fold(0f64, f64::max);
-                assert!(
-                    worst <= allowed,
-                    "{clip} as {extension}, row {r} ({:?}): max |diff| {worst} > {allowed}",
-                    column.kind
-                );
-            }
+            assert_same_features(
+                &gltf,
+                &bvh,
+                (metres, 1e-5),
+                &format!("{clip} as {extension}"),
+            );
             let source = gltf.facts.source.as_ref().expect("the source is recorded");
             assert_eq!(source.format, "gltf");
             assert_eq!(source.animation.as_deref(), Some("Take 1"));
             assert!(bvh.facts.source.is_none());
             std::fs::remove_file(file).unwrap();
         }
+    }
+}
+
+/// `tests/data/fbx/NAME.gz` unpacked beside the scratch files.
+fn fbx_fixture(name: &str) -> PathBuf {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    flate2::read::GzDecoder::new(
+        std::fs::File::open(root().join("tests/data/fbx").join(format!("{name}.gz"))).unwrap(),
+    )
+    .read_to_end(&mut bytes)
+    .unwrap();
+    let path = common::scratch("formats", name);
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+#[test]
+fn blenders_glb_and_fbx_give_the_training_features_of_their_bvh() {
+    let config = tiny();
+    let fixtures = root().join("tests/data/gltf");
+    for clip in ["human_walk_cmu_131_01", "fox_survey_khronos"] {
+        // The GLB holds the cut BVH's 2 s; the FBX its first second.
+        let bvh_clip = read_bvh(fixtures.join(format!("{clip}_2s.bvh"))).unwrap();
+        let glb = fixtures.join(format!("{clip}_skinned.glb"));
+        let fbx = fbx_fixture(&format!("{clip}_skinned.fbx"));
+        // Blender's glTF exporter composes bone matrices in single precision: its keys of the
+        // walk's deepest joints are off by up to 1.1e-5 (its FBX, in double, by 5e-6).
+        for (file, seconds, rotation_tolerance) in [(glb, 2.0, 2e-5), (fbx.clone(), 1.0, 1e-5)] {
+            let frames = (seconds * bvh_clip.fps).round() as usize + 1;
+            let channels = bvh_clip.skeleton.channel_count();
+            let cut = sinmdm::motion::ChannelClip {
+                values: bvh_clip.values[..frames * channels].to_vec(),
+                ..bvh_clip.clone()
+            };
+            let bvh_file = common::scratch("formats", clip).with_extension("bvh");
+            std::fs::write(&bvh_file, sinmdm::bvh::to_bvh_string(&cut)).unwrap();
+            let bvh = ClipData::load(&bvh_file, &config.data, &config.model).unwrap();
+            let read = ClipData::load(&file, &config.data, &config.model).unwrap();
+            // Blender reads BVH units as metres, so the files are in the BVH's units.
+            assert_same_features(
+                &read,
+                &bvh,
+                (1.0, rotation_tolerance),
+                &file.display().to_string(),
+            );
+            std::fs::remove_file(bvh_file).unwrap();
+        }
+        let source = ClipData::load(&fbx, &config.data, &config.model)
+            .unwrap()
+            .facts
+            .source
+            .expect("recorded");
+        assert_eq!(source.format, "fbx");
+        assert_eq!(source.animations, 1);
+        assert!(source.file_unit_meters.is_some_and(|m| m > 0.0));
+        std::fs::remove_file(fbx).unwrap();
     }
 }
 

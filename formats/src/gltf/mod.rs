@@ -10,9 +10,7 @@ mod splice;
 mod tracks;
 mod write;
 
-pub use read::{
-    AnimationChoice, AnimationInfo, GltfClip, GltfReadOptions, list_animations, read_gltf,
-};
+pub use read::{GltfClip, list_animations, read_gltf};
 pub use splice::{SpliceReport, splice_into_character};
 pub use write::{GltfWriteOptions, gltf_document, write_gltf};
 

@@ -25,47 +25,9 @@ use super::container::{Asset, read_asset};
 use super::nodes::{Similarity, Trs, node_name, node_trs, parents, rotation_of, unit_scale};
 use super::skin::{SkinJoints, node_names, recorded_joints, skin_joints};
 use super::tracks::{MAX_JOINT_FRAMES, Property, Track, frame_rate, read_tracks};
+use crate::animation::{AnimationInfo, ReadOptions, choose_animation};
 use crate::error::{FormatError, Part};
 use crate::sampled::{SampledJoints, unique_names};
-
-/// Which animation of a file is the clip.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum AnimationChoice {
-    /// By position in the file's `animations`.
-    Index(usize),
-    /// By name.
-    Name(String),
-}
-
-impl AnimationChoice {
-    /// A number is an index, anything else a name.
-    pub fn parse(text: &str) -> AnimationChoice {
-        match text.parse() {
-            Ok(index) => AnimationChoice::Index(index),
-            Err(_) => AnimationChoice::Name(text.to_string()),
-        }
-    }
-}
-
-/// What a reader is asked to do beyond the defaults.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct GltfReadOptions {
-    /// The animation to read (default: the first).
-    pub animation: Option<AnimationChoice>,
-    /// The frame rate to sample at (default: from the key spacing).
-    pub fps: Option<f64>,
-}
-
-/// One animation of a file, as `inspect` lists them.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AnimationInfo {
-    /// Its index in the file.
-    pub index: usize,
-    /// Its name, if it has one.
-    pub name: Option<String>,
-    /// From its first key to its last, in seconds.
-    pub seconds: f64,
-}
 
 /// A clip read from a glTF file, with what the file held besides.
 #[derive(Debug, Clone)]
@@ -132,39 +94,6 @@ pub fn list_animations(path: &Path) -> Result<Vec<AnimationInfo>, FormatError> {
     Ok(animation_infos(&read_asset(path)?))
 }
 
-/// The index of the animation `options` ask for (default: the first).
-fn choose_animation(
-    path: &Path,
-    animations: &[AnimationInfo],
-    options: &GltfReadOptions,
-) -> Result<usize, FormatError> {
-    let bad = |message: String| FormatError::bad(path, Part::Json, message);
-    if animations.is_empty() {
-        return Err(bad("has no animation".into()));
-    }
-    match &options.animation {
-        None => Ok(0),
-        Some(AnimationChoice::Index(i)) if *i < animations.len() => Ok(*i),
-        Some(AnimationChoice::Index(i)) => Err(bad(format!(
-            "has {} animations; there is no animation {i}",
-            animations.len()
-        ))),
-        Some(AnimationChoice::Name(name)) => animations
-            .iter()
-            .position(|a| a.name.as_deref() == Some(name.as_str()))
-            .ok_or_else(|| {
-                let names: Vec<String> = animations
-                    .iter()
-                    .map(|a| a.name.clone().unwrap_or_else(|| format!("#{}", a.index)))
-                    .collect();
-                bad(format!(
-                    "has no animation named '{name}' (it has: {})",
-                    names.join(", ")
-                ))
-            }),
-    }
-}
-
 /// Each joint's local rotation and translation, frame by frame (`[frames][joints]`), from the
 /// rest transforms and the tracks, with the nodes above each joint folded in.
 fn sample_frames(
@@ -225,7 +154,7 @@ fn sample_frames(
 }
 
 /// Reads the clip of one animation of a `.glb` or `.gltf` file.
-pub fn read_gltf(path: &Path, options: &GltfReadOptions) -> Result<GltfClip, FormatError> {
+pub fn read_gltf(path: &Path, options: &ReadOptions) -> Result<GltfClip, FormatError> {
     let asset = read_asset(path)?;
     let nodes: &[Value] = asset
         .json
@@ -239,7 +168,7 @@ pub fn read_gltf(path: &Path, options: &GltfReadOptions) -> Result<GltfClip, For
         .collect::<Result<_, _>>()?;
     let skin = skin_joints(path, &asset.json, nodes, &parent, &rest)?;
     let animations = animation_infos(&asset);
-    let chosen = choose_animation(path, &animations, options)?;
+    let chosen = choose_animation(path, &animations, options, (Part::Json, "animation"))?;
     let part = Part::Animation(chosen, node_name(&asset.json["animations"][chosen]));
     let tracks = read_tracks(path, &asset, chosen, |n| skin.joint_of(n))?;
     let timing = frame_rate(path, part, &tracks, options.fps)?;
@@ -255,6 +184,13 @@ pub fn read_gltf(path: &Path, options: &GltfReadOptions) -> Result<GltfClip, For
         ));
     }
     let (rotations, translations) = sample_frames(path, nodes, &rest, &skin, &tracks, timing)?;
+    // The joints' own transforms, with the nodes above each folded in.
+    let rest_rotations = skin
+        .order
+        .iter()
+        .zip(&skin.pre)
+        .map(|(&n, pre)| math::mat_mul(&pre.rotation, &rest[n].rotation))
+        .collect();
     let motion = SampledJoints {
         names: unique_names(node_names(nodes, &skin.order)),
         parents: skin.parents.clone(),
@@ -263,6 +199,7 @@ pub fn read_gltf(path: &Path, options: &GltfReadOptions) -> Result<GltfClip, For
         frames,
         rotations,
         translations,
+        rest_rotations,
     }
     .into_motion();
     Ok(GltfClip {

@@ -10,14 +10,8 @@ use sinmdm::motion::math;
 use super::accessor::{field_usize, read_floats};
 use super::container::Asset;
 use super::nodes::node_name;
+pub(crate) use crate::animation::{MAX_CLIP_FRAMES, MAX_JOINT_FRAMES};
 use crate::error::{FormatError, Part};
-
-/// The most frames a clip read from glTF may have: 14 minutes at 120 fps, far beyond a
-/// training clip, and a bound on what a malformed file (keys a million seconds apart, say) can
-/// make the reader allocate.
-pub const MAX_CLIP_FRAMES: usize = 100_000;
-/// The most joint transforms (frames x joints) a clip read from glTF may have: about 1 GB.
-pub const MAX_JOINT_FRAMES: usize = 10_000_000;
 
 /// How a sampler interpolates.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -108,12 +108,16 @@ pub struct TrainingFacts {
 /// Where a clip read from a format other than BVH came from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ClipSourceFacts {
-    /// The file format (`gltf`).
+    /// The file format (`gltf`, `fbx`).
     pub format: String,
     /// The animation read, by name (or `#index` when it has none).
     pub animation: Option<String>,
     /// How many animations the file held.
     pub animations: usize,
+    /// The length of the file's own unit in metres (FBX: 0.01 for centimetres; glTF: 1). The
+    /// reader converted the clip to metres, so positions in the model are metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file_unit_meters: Option<f64>,
 }
 
 impl NetworkFacts {

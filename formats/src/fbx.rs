@@ -1,0 +1,375 @@
+//! FBX (binary and ASCII) to a clip, through the `ufbx` library.
+//!
+//! - The scene is converted on load to glTF's frame, +Y up (right-handed) and metres, with the
+//!   conversion put into translations so that joints keep unit scale.
+//! - The skeleton is the file's bones (limb nodes and skin-cluster bones) under a single root
+//!   bone, in depth-first order. Nodes above the root (an armature, a unit scale) and between
+//!   bones are folded in: each joint's transform is taken from world transforms, so pre- and
+//!   post-rotations, pivots and inherit modes are all as the file means them.
+//! - Names lose their namespace (`mixamorig:Hips` is `Hips`), then are made unique.
+//! - The clip is one animation stack (`--clip-anim NAME|INDEX`, default the first), sampled at
+//!   the file's frame rate (`--fps` overrides) from the stack's start to its end.
+//! - A leaf bone that never moves (Mixamo's `_End` bones, Blender's leaf bones) becomes its
+//!   parent's End Site.
+
+use std::path::Path;
+
+use sinmdm::motion::math::{self, Mat3, Vec3};
+use sinmdm::motion::{ChannelClip, fps_from_frame_time};
+
+use crate::animation::{
+    AnimationInfo, MAX_CLIP_FRAMES, MAX_JOINT_FRAMES, ReadOptions, choose_animation,
+};
+use crate::error::{FormatError, Part};
+use crate::sampled::{Recorded, SampledJoints, unique_names};
+
+/// A clip read from an FBX file, with what the file held besides.
+#[derive(Debug, Clone)]
+pub struct FbxClip {
+    /// The clip, +Y up and in metres.
+    pub clip: ChannelClip,
+    /// The animation stack it was read from.
+    pub animation: AnimationInfo,
+    /// Every animation stack of the file.
+    pub animations: Vec<AnimationInfo>,
+    /// The length of the file's own unit in metres (0.01 for centimetres).
+    pub file_unit_meters: f64,
+}
+
+/// A joint's scale may differ from its parent's by this share before the file is refused.
+const SCALE_TOLERANCE: f64 = 1e-4;
+
+/// The scene of `path`, loaded and converted to +Y up, metres.
+fn load(path: &Path) -> Result<ufbx::SceneRoot, FormatError> {
+    let bytes = std::fs::read(path).map_err(|source| FormatError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let options = ufbx::LoadOpts {
+        target_axes: ufbx::CoordinateAxes {
+            right: ufbx::CoordinateAxis::PositiveX,
+            up: ufbx::CoordinateAxis::PositiveY,
+            front: ufbx::CoordinateAxis::PositiveZ,
+        },
+        target_unit_meters: 1.0,
+        space_conversion: ufbx::SpaceConversion::ModifyGeometry,
+        ..Default::default()
+    };
+    ufbx::load_memory(&bytes, options).map_err(|error| {
+        let info = error.info();
+        let detail = if info.is_empty() {
+            String::new()
+        } else {
+            format!(" ({info})")
+        };
+        FormatError::bad(
+            path,
+            Part::Fbx,
+            format!(
+                "is not an FBX file this reads: {}{detail}",
+                error.description
+            ),
+        )
+    })
+}
+
+/// The animation stacks of the scene.
+fn stack_infos(scene: &ufbx::Scene) -> Vec<AnimationInfo> {
+    scene
+        .anim_stacks
+        .iter()
+        .enumerate()
+        .map(|(index, stack)| AnimationInfo {
+            index,
+            name: Some(stack.element.name.to_string()).filter(|n| !n.is_empty()),
+            seconds: (stack.time_end - stack.time_begin).max(0.0),
+        })
+        .collect()
+}
+
+/// The animation stacks of an FBX file with their lengths (for `inspect`).
+pub fn list_fbx_animations(path: &Path) -> Result<Vec<AnimationInfo>, FormatError> {
+    let scene = load(path)?;
+    Ok(stack_infos(&scene))
+}
+
+/// A node's name without its namespace (`mixamorig:Hips` -> `Hips`).
+fn without_namespace(name: &str) -> &str {
+    name.rsplit(':').next().unwrap_or(name)
+}
+
+/// The skeleton's nodes: indices into `scene.nodes` in depth-first order from the single root
+/// bone, and each one's parent joint (an index into that order).
+fn skeleton_nodes(
+    path: &Path,
+    scene: &ufbx::Scene,
+) -> Result<(Vec<usize>, Vec<Option<usize>>), FormatError> {
+    let count = scene.nodes.len();
+    let mut is_bone = vec![false; count];
+    for node in scene.nodes.iter() {
+        if node.bone.is_some() && !node.is_root {
+            is_bone[node.element.typed_id as usize] = true;
+        }
+    }
+    for cluster in scene.skin_clusters.iter() {
+        if let Some(bone) = &cluster.bone_node
+            && !bone.is_root
+        {
+            is_bone[bone.element.typed_id as usize] = true;
+        }
+    }
+    let parent_bone = |n: usize| -> Option<usize> {
+        let mut at = scene.nodes[n]
+            .parent
+            .as_ref()
+            .map(|p| p.element.typed_id as usize);
+        while let Some(p) = at {
+            if is_bone[p] {
+                return Some(p);
+            }
+            at = scene.nodes[p]
+                .parent
+                .as_ref()
+                .map(|q| q.element.typed_id as usize);
+        }
+        None
+    };
+    let roots: Vec<usize> = (0..count)
+        .filter(|&n| is_bone[n] && parent_bone(n).is_none())
+        .collect();
+    match roots.len() {
+        0 => {
+            return Err(FormatError::bad(
+                path,
+                Part::Skeleton,
+                "has no bones (no limb nodes, no skinned bones), so no skeleton".into(),
+            ));
+        }
+        1 => {}
+        _ => {
+            let names: Vec<String> = roots
+                .iter()
+                .map(|&n| scene.nodes[n].element.name.to_string())
+                .collect();
+            return Err(FormatError::bad(
+                path,
+                Part::Skeleton,
+                format!(
+                    "has {} root bones ({}); a skeleton needs exactly one",
+                    roots.len(),
+                    names.join(", ")
+                ),
+            ));
+        }
+    }
+    // Depth-first from the root, children in file order; non-bone nodes are walked through.
+    let mut order = Vec::new();
+    let mut stack = vec![roots[0]];
+    while let Some(n) = stack.pop() {
+        if is_bone[n] {
+            order.push(n);
+        }
+        let children: Vec<usize> = scene.nodes[n]
+            .children
+            .iter()
+            .map(|c| c.element.typed_id as usize)
+            .collect();
+        stack.extend(children.into_iter().rev());
+    }
+    let parents = order
+        .iter()
+        .map(|&n| parent_bone(n).and_then(|p| order.iter().position(|&o| o == p)))
+        .collect();
+    Ok((order, parents))
+}
+
+/// A world matrix as rotation, position and uniform scale, or `None` when its scale is not
+/// uniform (or is zero).
+fn decompose(m: &ufbx::Matrix) -> Option<(Mat3, Vec3, f64)> {
+    let columns = [
+        [m.m00, m.m10, m.m20],
+        [m.m01, m.m11, m.m21],
+        [m.m02, m.m12, m.m22],
+    ];
+    let scales = columns.map(math::norm);
+    let s = scales[0];
+    if !(s > 1e-12 && scales.iter().all(|v| (v - s).abs() <= SCALE_TOLERANCE * s)) {
+        return None;
+    }
+    let rotation: Mat3 = std::array::from_fn(|r| std::array::from_fn(|c| columns[c][r] / s));
+    Some((rotation, [m.m03, m.m13, m.m23], s))
+}
+
+/// A bone's world transform in the file's rest pose: the bind pose it belongs to, else its
+/// node's own (unanimated) transform. (Exporters write the pose of the current frame into the
+/// nodes' own transforms; the bind pose is what a skin and BVH's zero pose mean by rest.)
+fn rest_to_world(node: &ufbx::Node) -> ufbx::Matrix {
+    node.bind_pose
+        .as_ref()
+        .and_then(|pose| {
+            pose.bone_poses
+                .iter()
+                .find(|bone| bone.bone_node.element.typed_id == node.element.typed_id)
+                .map(|bone| bone.bone_to_world)
+        })
+        .unwrap_or(node.node_to_world)
+}
+
+/// Each joint's rotation and translation relative to its parent joint in `scene` (a posed copy,
+/// or the file's rest pose), from the nodes' world transforms: translations in world units
+/// (metres), so a uniform scale above the root is folded into them. `when` says which pose in
+/// messages.
+fn local_transforms(
+    path: &Path,
+    (scene, world_of): (&ufbx::Scene, &dyn Fn(usize) -> ufbx::Matrix),
+    order: &[usize],
+    parents: &[Option<usize>],
+    when: &str,
+) -> Result<Vec<(Mat3, Vec3)>, FormatError> {
+    let bad = |n: usize, message: String| {
+        let name = scene.nodes[n].element.name.to_string();
+        FormatError::bad(path, Part::Node(n, Some(name)), message)
+    };
+    let mut world: Vec<(Mat3, Vec3, f64)> = Vec::with_capacity(order.len());
+    let mut local = Vec::with_capacity(order.len());
+    for (j, &n) in order.iter().enumerate() {
+        let (rotation, position, scale) = decompose(&world_of(n)).ok_or_else(|| {
+            bad(
+                n,
+                format!("has a non-uniform or zero scale {when}; bones must keep their shape"),
+            )
+        })?;
+        if !(position.iter().all(|v| v.is_finite()) && scale.is_finite()) {
+            return Err(bad(n, format!("has a non-finite transform {when}")));
+        }
+        local.push(match parents[j] {
+            None => (rotation, position),
+            Some(p) => {
+                let (parent_rotation, parent_position, parent_scale) = world[p];
+                if (scale / parent_scale - 1.0).abs() > SCALE_TOLERANCE {
+                    return Err(bad(
+                        n,
+                        format!(
+                            "scales by {:.4} against its parent bone {when}; joints must keep unit scale",
+                            scale / parent_scale
+                        ),
+                    ));
+                }
+                let inverse = math::transpose(&parent_rotation);
+                (
+                    math::mat_mul(&inverse, &rotation),
+                    math::mat_vec(&inverse, math::sub(position, parent_position)),
+                )
+            }
+        });
+        world.push((rotation, position, scale));
+    }
+    Ok(local)
+}
+
+/// Reads the clip of one animation stack of an `.fbx` file.
+pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatError> {
+    let scene = load(path)?;
+    let animations = stack_infos(&scene);
+    let chosen = choose_animation(path, &animations, options, (Part::Fbx, "animation stack"))?;
+    let stack = &scene.anim_stacks[chosen];
+    let part = || Part::Animation(chosen, animations[chosen].name.clone());
+    let bad = |part: Part, message: String| FormatError::bad(path, part, message);
+    // Frames are sampled at the file's own rate, on its keys, and the clip reports it snapped
+    // to a whole rate when within a hair of one (a BVH's 0.0333333 s frames, imported into a
+    // DCC tool, come out as 30.0001 fps).
+    let fps = options.fps.unwrap_or(scene.settings.frames_per_second);
+    let clip_fps = match options.fps {
+        Some(fps) => fps,
+        None => fps_from_frame_time(1.0 / fps),
+    };
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(bad(
+            part(),
+            format!("gives a frame rate of {fps}; give one (--fps)"),
+        ));
+    }
+    let (begin, end) = (stack.time_begin, stack.time_end);
+    let span = ((end - begin) * fps).round();
+    if !(span.is_finite() && span >= 0.0) || span >= MAX_CLIP_FRAMES as f64 {
+        return Err(bad(
+            part(),
+            format!(
+                "runs from {begin} s to {end} s, which at {fps} fps is not 1 to {MAX_CLIP_FRAMES} frames; is the frame rate right (--fps)?"
+            ),
+        ));
+    }
+    let frames = span as usize + 1;
+    let (order, parents) = skeleton_nodes(path, &scene)?;
+    let joints = order.len();
+    if frames.saturating_mul(joints) > MAX_JOINT_FRAMES {
+        return Err(bad(
+            Part::Skeleton,
+            format!(
+                "{joints} bones x {frames} frames are more transforms than the {MAX_JOINT_FRAMES} a clip may have"
+            ),
+        ));
+    }
+    let mut rotations = Vec::with_capacity(frames * joints);
+    let mut translations = Vec::with_capacity(frames * joints);
+    for f in 0..frames {
+        let t = begin + f as f64 / fps;
+        let posed = ufbx::evaluate_scene(&scene, &stack.anim, t, ufbx::EvaluateOpts::default())
+            .map_err(|error| {
+                bad(
+                    part(),
+                    format!("could not be evaluated at {t:.3} s: {}", error.description),
+                )
+            })?;
+        for (rotation, translation) in local_transforms(
+            path,
+            (&posed, &|n| posed.nodes[n].node_to_world),
+            &order,
+            &parents,
+            &format!("at {t:.3} s"),
+        )? {
+            rotations.push(rotation);
+            translations.push(translation);
+        }
+    }
+    let rest = |n: usize| rest_to_world(&scene.nodes[n]);
+    let rest_rotations = local_transforms(path, (&scene, &rest), &order, &parents, "at rest")?
+        .into_iter()
+        .map(|(rotation, _)| rotation)
+        .collect();
+
+    let names = unique_names(order.iter().map(|&n| {
+        let name = scene.nodes[n].element.name.to_string();
+        Some(without_namespace(&name).to_string())
+    }));
+    let motion = SampledJoints {
+        names,
+        parents,
+        recorded: vec![Recorded::default(); joints],
+        fps: clip_fps,
+        frames,
+        rotations,
+        translations,
+        rest_rotations,
+    }
+    .into_motion();
+    Ok(FbxClip {
+        clip: motion.to_channels(),
+        animation: animations[chosen].clone(),
+        animations,
+        file_unit_meters: scene.settings.original_unit_meters,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn namespaces_are_dropped_from_names() {
+        assert_eq!(without_namespace("mixamorig:Hips"), "Hips");
+        assert_eq!(without_namespace("mixamorig1:LeftUpLeg"), "LeftUpLeg");
+        assert_eq!(without_namespace("a:b:Spine"), "Spine");
+        assert_eq!(without_namespace("Hips"), "Hips");
+    }
+}
