@@ -8,7 +8,8 @@
 //!   post-rotations, pivots and inherit modes are all as the file means them.
 //! - Names lose their namespace (`mixamorig:Hips` is `Hips`), then are made unique.
 //! - The clip is one animation stack (`--clip-anim NAME|INDEX`, default the first), sampled at
-//!   the file's frame rate (`--fps` overrides) from the stack's start to its end.
+//!   the file's frame rate (`--fps` overrides) from the stack's start to its end (or, for a
+//!   stack that declares no range, from its first key to its last).
 //! - A leaf bone that never moves (Mixamo's `_End` bones, Blender's leaf bones) becomes its
 //!   parent's End Site.
 
@@ -21,7 +22,7 @@ use crate::animation::{
     AnimationInfo, MAX_CLIP_FRAMES, MAX_JOINT_FRAMES, ReadOptions, choose_animation,
 };
 use crate::error::{FormatError, Part};
-use crate::sampled::{Recorded, SampledJoints, unique_names};
+use crate::sampled::{Recorded, SampledJoints, unique_names, without_namespace};
 
 /// A clip read from an FBX file, with what the file held besides.
 #[derive(Debug, Clone)]
@@ -73,16 +74,43 @@ fn load(path: &Path) -> Result<ufbx::SceneRoot, FormatError> {
     })
 }
 
+/// A stack's time range: the one it declares, or where it declares none, from its first key to
+/// its last.
+fn stack_range(stack: &ufbx::AnimStack) -> (f64, f64) {
+    if stack.time_end > stack.time_begin {
+        return (stack.time_begin, stack.time_end);
+    }
+    let (mut first, mut last) = (f64::INFINITY, f64::NEG_INFINITY);
+    for layer in stack.layers.iter() {
+        for value in layer.anim_values.iter() {
+            for curve in value.curves.iter().flatten() {
+                if !curve.keyframes.is_empty() {
+                    first = first.min(curve.min_time);
+                    last = last.max(curve.max_time);
+                }
+            }
+        }
+    }
+    if last >= first {
+        (first, last)
+    } else {
+        (stack.time_begin, stack.time_begin)
+    }
+}
+
 /// The animation stacks of the scene.
 fn stack_infos(scene: &ufbx::Scene) -> Vec<AnimationInfo> {
     scene
         .anim_stacks
         .iter()
         .enumerate()
-        .map(|(index, stack)| AnimationInfo {
-            index,
-            name: Some(stack.element.name.to_string()).filter(|n| !n.is_empty()),
-            seconds: (stack.time_end - stack.time_begin).max(0.0),
+        .map(|(index, stack)| {
+            let (begin, end) = stack_range(stack);
+            AnimationInfo {
+                index,
+                name: Some(stack.element.name.to_string()).filter(|n| !n.is_empty()),
+                seconds: (end - begin).max(0.0),
+            }
         })
         .collect()
 }
@@ -91,11 +119,6 @@ fn stack_infos(scene: &ufbx::Scene) -> Vec<AnimationInfo> {
 pub fn list_fbx_animations(path: &Path) -> Result<Vec<AnimationInfo>, FormatError> {
     let scene = load(path)?;
     Ok(stack_infos(&scene))
-}
-
-/// A node's name without its namespace (`mixamorig:Hips` -> `Hips`).
-fn without_namespace(name: &str) -> &str {
-    name.rsplit(':').next().unwrap_or(name)
 }
 
 /// The skeleton's nodes: indices into `scene.nodes` in depth-first order from the single root
@@ -289,7 +312,7 @@ pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatErr
             format!("gives a frame rate of {fps}; give one (--fps)"),
         ));
     }
-    let (begin, end) = (stack.time_begin, stack.time_end);
+    let (begin, end) = stack_range(stack);
     let span = ((end - begin) * fps).round();
     if !(span.is_finite() && span >= 0.0) || span >= MAX_CLIP_FRAMES as f64 {
         return Err(bad(
@@ -359,17 +382,4 @@ pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatErr
         animations,
         file_unit_meters: scene.settings.original_unit_meters,
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn namespaces_are_dropped_from_names() {
-        assert_eq!(without_namespace("mixamorig:Hips"), "Hips");
-        assert_eq!(without_namespace("mixamorig1:LeftUpLeg"), "LeftUpLeg");
-        assert_eq!(without_namespace("a:b:Spine"), "Spine");
-        assert_eq!(without_namespace("Hips"), "Hips");
-    }
 }

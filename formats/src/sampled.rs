@@ -100,6 +100,11 @@ impl SampledJoints {
     }
 }
 
+/// A node's name without its namespace (`mixamorig:Hips` -> `Hips`).
+pub(crate) fn without_namespace(name: &str) -> &str {
+    name.rsplit(':').next().unwrap_or(name)
+}
+
 /// Names made unique: whitespace runs as `_`, `joint_N` (N the joint's index) for missing or
 /// blank names, and `_2`, `_3`, ... after repeats.
 pub(crate) fn unique_names(raw: impl IntoIterator<Item = Option<String>>) -> Vec<String> {
@@ -298,6 +303,14 @@ fn kept_joints<T>(values: Vec<T>, keep: &[bool]) -> Vec<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn namespaces_are_dropped_from_names() {
+        assert_eq!(without_namespace("mixamorig:Hips"), "Hips");
+        assert_eq!(without_namespace("mixamorig1:LeftUpLeg"), "LeftUpLeg");
+        assert_eq!(without_namespace("a:b:Spine"), "Spine");
+        assert_eq!(without_namespace("Hips"), "Hips");
+    }
 
     #[test]
     fn names_are_made_unique_and_blank_ones_numbered() {

@@ -172,3 +172,29 @@ fn a_skeleton_the_character_lacks_is_refused_by_name() {
         "{err}"
     );
 }
+
+#[test]
+fn a_namespaced_character_takes_a_model_without_the_namespace() {
+    // The character's bones as Mixamo names them (`mixamorig:Hips`); the model's joints as
+    // the FBX reader names them (`Hips`).
+    let (mut json, bin) = document(&character());
+    for node in json["nodes"].as_array_mut().unwrap() {
+        if let Some(name) = node["name"].as_str() {
+            node["name"] = Value::String(format!("mixamorig:{name}"));
+        }
+    }
+    let namespaced = scratch("namespaced.glb");
+    std::fs::write(
+        &namespaced,
+        sinmdm_formats::gltf::container::glb_bytes(&json, &bin),
+    )
+    .unwrap();
+    let out = scratch("namespaced_out.glb");
+    splice_into_character(&namespaced, &out, &[("walk".into(), &the_walk())], UpAxis::PosY)
+        .unwrap();
+    let (worst, height) = worst_distance(
+        &played(&out, AnimationChoice::Name("walk".into())),
+        &played(&out, AnimationChoice::Index(0)),
+    );
+    assert!(worst <= 1e-5 * height, "{worst} > 1e-5 x {height}");
+}

@@ -24,6 +24,7 @@ use super::container::{Asset, glb_bytes, parse_glb};
 use super::nodes::{Similarity, node_name, node_trs, parents, uniform};
 use super::write::{Binary, quaternion_xyzw, unit_f32};
 use crate::error::{FormatError, Part};
+use crate::sampled::without_namespace;
 
 /// Largest angle, in radians, between a bone's direction in the motions' skeleton and in the
 /// character's for the two to count as the same bone.
@@ -133,23 +134,34 @@ pub fn splice_into_character(
     let parent = parents(character, &nodes)?;
     let rest = global_rest(character, &nodes, &parent)?;
 
-    // Our joints by name among the character's nodes.
+    // Our joints by name among the character's nodes: the same name, or else the one node whose
+    // name is it after a namespace (a model read from Mixamo's FBX has `Hips` where the
+    // character's GLB has `mixamorig:Hips`).
     let mapped: Vec<usize> = skeleton
         .joints
         .iter()
         .map(|joint| {
-            nodes
+            let exact = nodes
                 .iter()
-                .position(|n| node_name(n).as_deref() == Some(joint.name.as_str()))
-                .ok_or_else(|| {
-                    bad(
-                        Part::Skeleton,
-                        format!(
-                            "has no node named '{}', a joint of the model's skeleton",
-                            joint.name
-                        ),
-                    )
-                })
+                .position(|n| node_name(n).as_deref() == Some(joint.name.as_str()));
+            let namespaced = || {
+                let mut found = nodes.iter().enumerate().filter(|(_, n)| {
+                    node_name(n).is_some_and(|name| without_namespace(&name) == joint.name)
+                });
+                match (found.next(), found.next()) {
+                    (Some((index, _)), None) => Some(index),
+                    _ => None,
+                }
+            };
+            exact.or_else(namespaced).ok_or_else(|| {
+                bad(
+                    Part::Skeleton,
+                    format!(
+                        "has no node named '{}', a joint of the model's skeleton",
+                        joint.name
+                    ),
+                )
+            })
         })
         .collect::<Result<_, _>>()?;
 

@@ -136,3 +136,26 @@ pub fn assert_matches_bvh(clip: &ChannelClip, source: &ChannelClip, what: &str) 
     );
     assert!(worst <= 1e-5 * height, "{what}: {worst} > 1e-5 x {height}");
 }
+
+/// `clip` with every length (offsets, End Sites, position channels) times `factor`.
+pub fn scaled(clip: &ChannelClip, factor: f64) -> ChannelClip {
+    use sinmdm::motion::Channel;
+    let mut out = clip.clone();
+    let mut is_position = Vec::new();
+    for joint in &mut out.skeleton.joints {
+        joint.offset = math::scale(joint.offset, factor);
+        joint.end_site = joint.end_site.map(|e| math::scale(e, factor));
+        is_position.extend(
+            joint
+                .channels
+                .iter()
+                .map(|c| matches!(c, Channel::Position(_))),
+        );
+    }
+    for (i, value) in out.values.iter_mut().enumerate() {
+        if is_position[i % is_position.len()] {
+            *value *= factor;
+        }
+    }
+    out
+}

@@ -1,0 +1,228 @@
+//! Bad FBX files get an error naming the file and the part at fault, never a panic: each kind
+//! of problem on its own (edits of the Mixamo-style ASCII fixture), then random mutations of the
+//! ASCII text and of Blender's binary file.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::PathBuf;
+
+use sinmdm_formats::fbx::read_fbx;
+use sinmdm_formats::{AnimationChoice, ReadOptions, read_clip};
+
+mod common;
+use common::{fbx_fixture, root};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sinmdm-bad-fbx-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn mixamo_text() -> String {
+    std::fs::read_to_string(root().join("tests/data/fbx/human_walk_cmu_131_01_mixamo_style.fbx"))
+        .unwrap()
+}
+
+/// Reads `bytes` written as `name`; the error's text, or the frame count when it reads.
+fn read(bytes: &[u8], name: &str, options: &ReadOptions) -> Result<usize, String> {
+    let path = scratch(name);
+    std::fs::write(&path, bytes).unwrap();
+    let result = read_fbx(&path, options);
+    std::fs::remove_file(&path).unwrap();
+    result
+        .map(|read| read.clip.frame_count())
+        .map_err(|e| e.to_string())
+}
+
+fn error(bytes: &[u8], name: &str) -> String {
+    match read(bytes, name, &ReadOptions::default()) {
+        Ok(frames) => panic!("{name} was read ({frames} frames)"),
+        Err(message) => {
+            assert!(message.contains(name), "{message} does not name the file");
+            message
+        }
+    }
+}
+
+#[test]
+fn each_kind_of_problem_is_named() {
+    let text = mixamo_text();
+    assert_eq!(
+        read(text.as_bytes(), "fine.fbx", &ReadOptions::default()),
+        Ok(31)
+    );
+
+    // Not FBX at all, and an empty file.
+    let message = error(b"solid cube\nendsolid cube\n", "not_fbx.fbx");
+    assert!(message.contains("not an FBX file"), "{message}");
+    error(b"", "empty.fbx");
+
+    // No bones: every limb node made a plain null.
+    let message = error(
+        text.replace("\"LimbNode\" {", "\"Null\" {").as_bytes(),
+        "no_bones.fbx",
+    );
+    assert!(message.contains("no bones"), "{message}");
+
+    // Two skeletons side by side: the toes' chain cut loose from the hips.
+    let left_hip = text
+        .lines()
+        .find(|l| l.contains("Model::mixamorig:LHipJoint"))
+        .map(|l| l.trim().split(['\t', ' ', ',']).nth(1).unwrap().to_string())
+        .unwrap();
+    let hips = text
+        .lines()
+        .find(|l| l.contains("Model::mixamorig:Hips"))
+        .map(|l| l.trim().split(['\t', ' ', ',']).nth(1).unwrap().to_string())
+        .unwrap();
+    let cut = text.replace(
+        &format!("C: \"OO\",{left_hip},{hips}"),
+        &format!("C: \"OO\",{left_hip},0"),
+    );
+    assert_ne!(cut, text);
+    let message = error(cut.as_bytes(), "two_roots.fbx");
+    assert!(
+        message.contains("2 root bones") && message.contains("LHipJoint"),
+        "{message}"
+    );
+
+    // No animation stack.
+    let start = text.find("\tAnimationStack:").unwrap();
+    let end = start + text[start..].find("\n\t}\n").unwrap() + 4;
+    let message = error(
+        format!("{}{}", &text[..start], &text[end..]).as_bytes(),
+        "no_stack.fbx",
+    );
+    assert!(message.contains("no animation stack"), "{message}");
+
+    // A stack that is not there by name or index, with the ones that are.
+    let by_name = ReadOptions {
+        animation: Some(AnimationChoice::Name("Run".into())),
+        fps: None,
+    };
+    let message = read(text.as_bytes(), "no_run.fbx", &by_name).unwrap_err();
+    assert!(
+        message.contains("'Run'") && message.contains("mixamo.com"),
+        "{message}"
+    );
+    let by_index = ReadOptions {
+        animation: Some(AnimationChoice::Index(3)),
+        fps: None,
+    };
+    let message = read(text.as_bytes(), "no_3.fbx", &by_index).unwrap_err();
+    assert!(message.contains("no animation stack 3"), "{message}");
+
+    // A frame rate that is no rate, and one that makes the clip absurdly long.
+    let zero_fps = ReadOptions {
+        animation: None,
+        fps: Some(0.0),
+    };
+    let message = read(text.as_bytes(), "zero_fps.fbx", &zero_fps).unwrap_err();
+    assert!(message.contains("frame rate"), "{message}");
+    let huge_fps = ReadOptions {
+        animation: None,
+        fps: Some(1e7),
+    };
+    let message = read(text.as_bytes(), "huge_fps.fbx", &huge_fps).unwrap_err();
+    assert!(message.contains("--fps"), "{message}");
+
+    // A bone squashed by a non-uniform scale.
+    let squashed = text.replacen(
+        "P: \"Lcl Scaling\", \"Lcl Scaling\", \"\", \"A\",1,1,1",
+        "P: \"Lcl Scaling\", \"Lcl Scaling\", \"\", \"A\",1,0.5,1",
+        3,
+    );
+    let message = error(squashed.as_bytes(), "squashed.fbx");
+    assert!(message.contains("scale"), "{message}");
+
+    // A stack that declares no time range is read from its first key to its last.
+    let no_range: String = text
+        .lines()
+        .filter(|l| !l.contains("LocalStart") && !l.contains("ReferenceStart"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_eq!(
+        read(no_range.as_bytes(), "no_range.fbx", &ReadOptions::default()),
+        Ok(31)
+    );
+
+    // The extension decides: FBX bytes under another name are refused by name.
+    let path = scratch("walk.fbz");
+    std::fs::write(&path, text.as_bytes()).unwrap();
+    let message = read_clip(&path, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("walk.fbz") && message.contains(".fbx"),
+        "{message}"
+    );
+    std::fs::remove_file(path).unwrap();
+}
+
+/// A small deterministic generator (SplitMix64).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+/// `bytes` with a few random edits: bytes overwritten, a run deleted, or the tail cut off.
+fn mutate(bytes: &[u8], rng: &mut Rng) -> Vec<u8> {
+    let mut out = bytes.to_vec();
+    for _ in 0..1 + rng.below(4) {
+        match rng.below(4) {
+            0 | 1 => {
+                let at = rng.below(out.len());
+                out[at] = rng.next() as u8;
+            }
+            2 => {
+                let at = rng.below(out.len());
+                let len = rng.below(64).min(out.len() - at);
+                out.drain(at..at + len);
+            }
+            _ => {
+                let keep = rng.below(out.len());
+                out.truncate(keep.max(1));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn random_mutations_give_errors_never_panics() {
+    let ascii = mixamo_text().into_bytes();
+    let binary = std::fs::read(fbx_fixture("fox_survey_khronos_armature.fbx")).unwrap();
+    let mut rng = Rng(0x5EED_F8B0);
+    let (mut read_fine, mut refused) = (0, 0);
+    for case in 0..600 {
+        let source = if case % 2 == 0 { &ascii } else { &binary };
+        let bytes = mutate(source, &mut rng);
+        let name = format!("mutant_{case}.fbx");
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            read(&bytes, &name, &ReadOptions::default())
+        }));
+        match outcome {
+            Ok(Ok(_)) => read_fine += 1,
+            Ok(Err(message)) => {
+                assert!(message.contains(&name), "case {case}: {message}");
+                refused += 1;
+            }
+            Err(_) => panic!("case {case} panicked"),
+        }
+    }
+    // Both outcomes happen: the mutations reach past the header.
+    assert!(
+        read_fine > 0 && refused > 0,
+        "{read_fine} read, {refused} refused"
+    );
+}
