@@ -24,9 +24,9 @@ own frame and units. FBX is not written.";
 /// Arguments of `sinmdm convert`.
 #[derive(Debug, Args)]
 pub struct ConvertArgs {
-    /// The clip (.bvh, .glb, .gltf).
+    /// The clip (.bvh, .glb, .gltf, .fbx).
     pub clip: PathBuf,
-    /// The file to write (.bvh, .glb, .gltf).
+    /// The file to write (.bvh, .glb, .gltf; FBX is read but not written: write .glb).
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     #[command(flatten)]

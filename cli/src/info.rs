@@ -32,7 +32,7 @@ pub struct InfoArgs {
 /// Arguments of `sinmdm encode`.
 #[derive(Debug, Args)]
 pub struct EncodeArgs {
-    /// The clip: .bvh, .glb or .gltf (same skeleton as the model).
+    /// The clip: .bvh, .glb, .gltf or .fbx (same skeleton as the model).
     pub clip: PathBuf,
     /// The model whose feature layout to use.
     #[arg(short, long, value_name = "MODEL.onnx")]

@@ -25,7 +25,7 @@ pub(crate) const EXAMPLES: &str = "Examples:
 /// Arguments of `sinmdm inspect`.
 #[derive(Debug, Args)]
 pub struct InspectArgs {
-    /// The clip: .bvh, .glb or .gltf.
+    /// The clip: .bvh, .glb, .gltf or .fbx.
     pub clip: PathBuf,
     /// Frame rate of the features (default: the clip's own).
     #[arg(long)]

@@ -27,7 +27,7 @@ pub enum CameraArg {
 /// Arguments of `sinmdm render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Clips (.bvh, .glb, .gltf), drawn side by side.
+    /// Clips (.bvh, .glb, .gltf, .fbx), drawn side by side.
     #[arg(required = true)]
     pub clips: Vec<PathBuf>,
     /// The picture: `.gif` (animated, at the clip's frame rate) or `.png` (a contact sheet).

@@ -19,7 +19,7 @@ pub(crate) const EXAMPLES: &str = "Examples:
 /// Arguments of `sinmdm reorient`.
 #[derive(Debug, Args)]
 pub struct ReorientArgs {
-    /// The clip (.bvh, .glb, .gltf).
+    /// The clip (.bvh, .glb, .gltf, .fbx).
     pub clip: PathBuf,
     /// The animation of a glTF clip to read, by name or index (default: the first).
     #[arg(long, value_name = "NAME|INDEX")]

@@ -273,12 +273,13 @@ pub struct ClipUpArg {
     /// reference or content clip, the model's own when the motion does not say clearly).
     #[arg(long, value_name = "AXIS")]
     pub up: Option<UpAxis>,
-    /// The animation of a glTF clip to read, by name or index (default: the first).
+    /// The animation of a glTF clip (or stack of an FBX clip) to read, by name or index (default:
+    /// the first).
     #[arg(long, value_name = "NAME|INDEX")]
     pub clip_anim: Option<String>,
 }
 
-/// Reads a clip (BVH or glTF) of the model's skeleton as raw features in the model's layout
+/// Reads a clip (BVH, glTF or FBX) of the model's skeleton as raw features in the model's layout
 /// ([`encode_for_model`]), saying so when the clip was turned into the model's up convention.
 pub fn reference_features(model: &Model, clip: &Path, read: &ClipUpArg) -> Result<Array2<f32>> {
     let channels = read_motion_file(clip, read.clip_anim.as_deref())?;

@@ -194,7 +194,7 @@ fn run_text(args: &[&str]) -> (bool, String, String) {
 }
 
 #[test]
-fn every_command_that_reads_a_clip_reads_gltf_and_names_what_it_refuses() {
+fn every_command_that_reads_a_clip_reads_gltf_and_fbx_and_names_what_it_refuses() {
     let dir = std::env::temp_dir().join(format!("sinmdm-gltf-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = |name: &str| dir.join(name).to_string_lossy().into_owned();
@@ -288,9 +288,24 @@ fn every_command_that_reads_a_clip_reads_gltf_and_names_what_it_refuses() {
     std::fs::write(dir.join("clip.fbx"), b"Kaydara FBX Binary").unwrap();
     let (ok, _, err) = run_text(&["inspect", &path("clip.fbx")]);
     assert!(
-        !ok && err.contains("FBX is not read yet") && err.contains(".glb"),
+        !ok && err.contains("clip.fbx") && err.contains("not an FBX file"),
         "{err}"
     );
+    // An FBX clip: its stack listed, its bones without their namespace, and BVH or GLB out.
+    let mixamo = repo_file("tests/data/fbx/human_walk_cmu_131_01_mixamo_style.fbx");
+    let mixamo = mixamo.to_str().unwrap();
+    let (ok, out, err) = run_text(&["inspect", mixamo]);
+    assert!(
+        ok && out.contains("animations 1")
+            && out.contains("'mixamo.com' (#0) 1.00 s")
+            && out.contains("joints     31 (7 End Sites)")
+            && out.contains("up         +Y"),
+        "{out}{err}"
+    );
+    let (ok, _, err) = run_text(&["convert", mixamo, "-o", &path("mixamo.glb")]);
+    assert!(ok && dir.join("mixamo.glb").is_file(), "{err}");
+    let (ok, _, err) = run_text(&["inspect", mixamo, "--clip-anim", "1"]);
+    assert!(!ok && err.contains("no animation stack 1"), "{err}");
     let (ok, _, err) = run_text(&["convert", walk, "-o", &path("walk.fbx")]);
     assert!(
         !ok && err.contains("FBX") && !dir.join("walk.fbx").exists(),

@@ -190,8 +190,13 @@ fn a_namespaced_character_takes_a_model_without_the_namespace() {
     )
     .unwrap();
     let out = scratch("namespaced_out.glb");
-    splice_into_character(&namespaced, &out, &[("walk".into(), &the_walk())], UpAxis::PosY)
-        .unwrap();
+    splice_into_character(
+        &namespaced,
+        &out,
+        &[("walk".into(), &the_walk())],
+        UpAxis::PosY,
+    )
+    .unwrap();
     let (worst, height) = worst_distance(
         &played(&out, AnimationChoice::Name("walk".into())),
         &played(&out, AnimationChoice::Index(0)),

@@ -215,7 +215,7 @@ pub struct DataConfig {
     /// motion.
     #[serde(default)]
     pub up: Option<sinmdm::motion::UpAxis>,
-    /// The animation of a glTF clip to learn, by name or index; absent reads the first.
+    /// The animation of a glTF or FBX clip to learn, by name or index; absent reads the first.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub animation: Option<String>,
 }

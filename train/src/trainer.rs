@@ -28,7 +28,7 @@ use crate::weight_average::WeightAverage;
 /// name with the clip's own extension (`clip.bvh`, `clip.glb`, `clip.gltf`).
 pub const CLIP_COPY: &str = "clip";
 /// The extensions a clip copy may have.
-const CLIP_EXTENSIONS: [&str; 3] = ["bvh", "glb", "gltf"];
+const CLIP_EXTENSIONS: [&str; 4] = ["bvh", "glb", "gltf", "fbx"];
 
 /// The clip copy in run folder `run` for a clip at `clip` (its extension kept, lower-case).
 fn clip_copy(run: &Path, clip: &Path) -> PathBuf {
@@ -340,7 +340,7 @@ impl Trainer {
             None => saved_clip(run).ok_or_else(|| TrainError::Checkpoint {
                 path: run.to_path_buf(),
                 message: format!(
-                    "holds no copy of its clip ({CLIP_COPY}.bvh, .glb or .gltf); pass the clip"
+                    "holds no copy of its clip ({CLIP_COPY}.bvh, .glb, .gltf or .fbx); pass the clip"
                 ),
             })?,
         };

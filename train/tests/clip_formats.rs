@@ -18,12 +18,13 @@ fn tiny() -> TrainConfig {
     TrainConfig::load(&root().join("configs/tiny.yaml")).unwrap()
 }
 
-/// `clip` written as glTF (`extension`) in metres at `metres` per unit, beside the scratch files.
-fn as_gltf(clip: &str, metres: f64, extension: &str) -> PathBuf {
+/// `clip` written as glTF (`extension`) in metres at `metres` per unit, beside the scratch files
+/// under `name` (tests running beside each other use names of their own).
+fn as_gltf(clip: &str, metres: f64, extension: &str, name: &str) -> PathBuf {
     let motion = read_bvh(root().join("tests/data/bvh").join(clip))
         .unwrap()
         .to_local();
-    let path = common::scratch("formats", clip).with_extension(extension);
+    let path = common::scratch("formats", name).with_extension(extension);
     let options = GltfWriteOptions {
         up: UpAxis::PosY,
         metres_per_unit: metres,
@@ -82,7 +83,7 @@ fn a_gltf_clip_gives_the_training_features_of_its_bvh() {
         )
         .unwrap();
         for extension in ["glb", "gltf"] {
-            let file = as_gltf(clip, metres, extension);
+            let file = as_gltf(clip, metres, extension, clip);
             let gltf = ClipData::load(&file, &config.data, &config.model).unwrap();
             assert_same_features(
                 &gltf,
@@ -158,7 +159,7 @@ fn blenders_glb_and_fbx_give_the_training_features_of_their_bvh() {
 
 #[test]
 fn a_run_keeps_its_gltf_clip_resumes_from_it_and_records_it() {
-    let file = as_gltf("fox_survey_khronos.bvh", 0.01, "glb");
+    let file = as_gltf("fox_survey_khronos.bvh", 0.01, "glb", "run_clip");
     let mut config = tiny();
     config.training.steps = 4;
     config.training.checkpoint_every = 2;
@@ -206,5 +207,26 @@ fn a_run_keeps_its_gltf_clip_resumes_from_it_and_records_it() {
     )
     .unwrap_err();
     assert!(err.to_string().contains("data.animation"), "{err}");
+    std::fs::remove_dir_all(&run).unwrap();
+}
+
+#[test]
+fn a_run_keeps_its_fbx_clip_and_resumes_from_it() {
+    let file = fbx_fixture("fox_survey_khronos_armature.fbx");
+    let mut config = tiny();
+    config.training.steps = 3;
+    config.training.checkpoint_every = 2;
+    let run = common::scratch("formats", "fbx_run");
+    let device = || Device::flex().autodiff();
+    let mut first = Trainer::start(&file, config, &run, device()).unwrap();
+    first.step().unwrap();
+    first.step().unwrap();
+    first.save().unwrap();
+    drop(first);
+    assert!(run.join("clip.fbx").is_file());
+    std::fs::remove_file(&file).unwrap();
+    let mut second = Trainer::resume(&run, None, None, device()).unwrap();
+    let end = second.run(&AtomicBool::new(false), |_| {}).unwrap();
+    assert!(matches!(end, sinmdm_train::RunEnd::Finished(_)), "{end:?}");
     std::fs::remove_dir_all(&run).unwrap();
 }

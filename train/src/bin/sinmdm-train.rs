@@ -15,7 +15,7 @@ use sinmdm_train::clip_data::ClipData;
 use sinmdm_train::motion_span;
 use sinmdm_train::{QnaUnet, RunEnd, TrainConfig, Trainer};
 
-/// Fit the single-motion QnA-UNet denoiser on one clip (BVH, or glTF: .glb/.gltf).
+/// Fit the single-motion QnA-UNet denoiser on one clip (BVH, glTF .glb/.gltf, or FBX).
 ///
 /// Examples:
 ///   sinmdm-train tests/data/bvh/human_walk_cmu_131_01.bvh --out runs/walk   (the default, ~6 min)
@@ -23,12 +23,13 @@ use sinmdm_train::{QnaUnet, RunEnd, TrainConfig, Trainer};
 ///   sinmdm-train --resume --out runs/walk            (continue after Ctrl-C or a crash)
 ///   sinmdm-train CLIP.bvh --config configs/paper.yaml --dry-run   (sizes only)
 ///   sinmdm-train character.glb --clip-anim Walk --out runs/walk   (one animation of a glTF file)
+///   sinmdm-train mixamo_walk.fbx --out runs/walk                  (an FBX clip, e.g. from Mixamo)
 #[derive(Parser, Debug)]
 #[command(name = "sinmdm-train", version, verbatim_doc_comment)]
 struct Args {
-    /// The clip to learn: .bvh, .glb or .gltf (optional with --resume: the run keeps a copy).
+    /// The clip to learn: .bvh, .glb, .gltf or .fbx (optional with --resume: the run keeps a copy).
     clip: Option<PathBuf>,
-    /// The animation of a glTF clip a new run learns, by name or index (default: the first),
+    /// The animation of a glTF or FBX clip a new run learns, by name or index (default: the first),
     /// replacing the config's data.animation.
     #[arg(long, value_name = "NAME|INDEX")]
     clip_anim: Option<String>,
