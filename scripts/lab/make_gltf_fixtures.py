@@ -1,8 +1,10 @@
 """Makes the glTF fixtures of tests/data/gltf with Blender, an independent writer: each source
 BVH (cut to 2 s, at most 30 fps) is imported, then exported as GLB with the armature only and
 with a small mesh skinned to it (both sampled every frame, LINEAR), and unsampled as a STEP and
-a CUBICSPLINE variant. With --fbx it also writes FBX files (armature only, skinned, and
-Mixamo-style: a 'mixamorig:' prefix, centimetres, leaf bones) for an FBX reader.
+a CUBICSPLINE variant. glTF keeps no bone tails, so a still bone is added at every leaf bone's
+tail to carry the BVH's End Site. With --fbx it also writes binary FBX files (armature only and
+skinned, the first second, Blender's own leaf bones), which tests/data/fbx keeps gzipped
+(`gzip -9n`). The Mixamo-style FBX comes from make_mixamo_style_fbx.py.
 
 Blender 3.4's unsampled export does not reproduce the BVH's pose (three.js and our reader agree
 on what the files hold, and both differ from the BVH), so the STEP and CUBICSPLINE files are
