@@ -193,9 +193,10 @@ fn a_run_keeps_its_gltf_clip_resumes_from_it_and_records_it() {
         (
             source.format.as_str(),
             source.animation.as_deref(),
-            source.animations
+            source.animations,
+            source.file_unit_meters
         ),
-        ("gltf", Some("Take 1"), 1)
+        ("gltf", Some("Take 1"), 1, Some(1.0))
     );
     // A BVH clip has one animation to learn.
     let mut wrong = tiny();
