@@ -11,7 +11,7 @@ use std::path::Path;
 use ndarray::{Array2, ArrayView2};
 use sinmdm::bvh::read_bvh;
 use sinmdm::features_file::read_features;
-use sinmdm::motion::feet::{Anchor, Kept, LegSolver, PlantOptions, plant_feet};
+use sinmdm::motion::feet::{Anchor, Kept, PlantOptions, plant_feet};
 use sinmdm::motion::{LocalMotion, decode, encode_for_model};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_eval::{FeetReference, evaluate, mean_scores, metric_features, motion_metric_features};
@@ -66,13 +66,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
 
     let base = PlantOptions::default();
-    let positions = PlantOptions {
-        solver: LegSolver::Positions,
-        ..base
-    };
     let settings = [
         ("default", base),
-        ("positions solver (two-bone / FABRIK)", positions),
         (
             "labelled spans only",
             PlantOptions {
@@ -179,23 +174,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ..base
             },
         ),
-        (
-            "root moves to reach",
-            PlantOptions {
-                reach_with_root: true,
-                ..base
-            },
-        ),
-        (
-            "positions solver, blend 0.2 s, stance over 0.4 s, spans grown by height alone, max hold 0.3 H",
-            PlantOptions {
-                blend_seconds: 0.2,
-                stance_smoothing_seconds: 0.4,
-                grow_below_speed: f64::INFINITY,
-                max_hold: 0.3,
-                ..positions
-            },
-        ),
     ];
 
     let clip_labels = labels_of(clip.features.view());
@@ -233,17 +211,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         layout.ground
     );
     println!(
-        "setting | skating % | deepest H | floor frames % | jitter ratio to raw | coverage / global diversity | lifted | reach | miss mean/max H | ms/sample"
+        "setting | skating % | deepest H | floor frames % | jitter ratio to raw | coverage / global diversity | lifted | miss mean/max H | ms/sample"
     );
     println!(
-        "clip | {:.1} | {:.4} | {:.1} | {:.3} | | | | |",
+        "clip | {:.1} | {:.4} | {:.1} | {:.3} | | | |",
         100.0 * clip_scores.skating_ratio,
         clip_scores.max_penetration,
         100.0 * clip_scores.penetrating_frames,
         clip_scores.jitter / raw.jitter
     );
     println!(
-        "raw | {:.1} | {:.4} | {:.1} | 1.000 | {} | | | |",
+        "raw | {:.1} | {:.4} | {:.1} | 1.000 | {} | | |",
         100.0 * raw.skating_ratio,
         raw.max_penetration,
         100.0 * raw.penetrating_frames,
@@ -263,7 +241,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .collect::<Vec<_>>(),
         );
         let lifted: usize = planted.iter().map(|(_, s)| s.lifted_frames).sum();
-        let reach: usize = planted.iter().map(|(_, s)| s.reach_frames).sum();
         let miss = format!(
             "{:.4}/{:.4}",
             planted.iter().map(|(_, s)| s.mean_miss).sum::<f64>() / planted.len() as f64,
@@ -271,7 +248,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
         let scores = benchmark(&planted.iter().map(|(m, _)| m).collect::<Vec<_>>())?;
         println!(
-            "{name} | {:.1} | {:.4} | {:.1} | {:.3} | {scores} | {lifted} | {reach} | {miss} | {ms:.1}",
+            "{name} | {:.1} | {:.4} | {:.1} | {:.3} | {scores} | {lifted} | {miss} | {ms:.1}",
             100.0 * s.skating_ratio,
             s.max_penetration,
             100.0 * s.penetrating_frames,

@@ -60,6 +60,23 @@ pub fn timestep_frequencies() -> Vec<f32> {
         .collect()
 }
 
+/// QnA blocks in the network, each seeing `(window - 1) / 2` frames on each side.
+pub const QNA_BLOCKS: usize = 3;
+
+/// The part of the receptive half-width that does not depend on the QnA window: the input and
+/// output convolutions (1 frame each) and two k3 convolutions in each of the 3 residual blocks.
+pub const FIXED_RECEPTIVE_HALF_WIDTH: usize = 1 + 3 * 2 + 1;
+
+/// Frames on each side of a frame that can change its prediction, for QnA window `window`.
+pub fn receptive_half_width(window: usize) -> usize {
+    FIXED_RECEPTIVE_HALF_WIDTH + QNA_BLOCKS * (window.max(1) - 1) / 2
+}
+
+/// The receptive field in frames for QnA window `window` (23 for window 3).
+pub fn receptive_field(window: usize) -> usize {
+    2 * receptive_half_width(window) + 1
+}
+
 /// The network's sizes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct NetworkShape {
@@ -74,6 +91,11 @@ pub struct NetworkShape {
 }
 
 impl NetworkShape {
+    /// The receptive field in frames ([`receptive_field`]).
+    pub fn receptive_field(&self) -> usize {
+        receptive_field(self.window)
+    }
+
     /// Checks the rules the layers need: C a multiple of the GroupNorm groups and of H, k odd,
     /// every size at least 1. The message names the size that breaks a rule.
     pub fn check(&self) -> Result<(), String> {

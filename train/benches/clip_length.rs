@@ -1,5 +1,5 @@
 //! Seconds per training step against the clip's length: the whole clip in each of 8 batch items,
-//! random windows of 256 frames (`training.window_frames`), and the default's frame budget
+//! random windows of 256 frames (the windowing that lost to the frame budget), and the default's frame budget
 //! (`training.frames_per_step`: fewer whole-clip items for a longer clip). The batch is made from
 //! a clip of 250, 1 000 and 2 000 frames (F 191, the CMU skeleton) and one optimisation step
 //! taken with the default configuration's model. Medians of the timed steps, side by side in one
@@ -13,7 +13,6 @@ use ndarray::Array2;
 use sinmdm::diffusion::Schedule;
 use sinmdm_train::config::TrainConfig;
 use sinmdm_train::data::make_batch;
-use sinmdm_train::loss::LossTerms;
 use sinmdm_train::model::QnaUnet;
 use sinmdm_train::trainer::{StepOutcome, new_optimizer, optimisation_step};
 
@@ -71,15 +70,7 @@ fn main() {
                 let x0 = Tensor::<3>::from_data(TensorData::new(b.clean, shape), &device);
                 let t: Vec<f32> = b.timesteps.iter().map(|&t| t as f32).collect();
                 let t = Tensor::<1>::from_data(TensorData::new(t, [items]), &device);
-                let (next, loss) = optimisation_step(
-                    model,
-                    &mut optimizer,
-                    xt,
-                    t,
-                    x0,
-                    1e-4,
-                    &LossTerms::default(),
-                );
+                let (next, loss) = optimisation_step(model, &mut optimizer, xt, t, x0, 1e-4);
                 model = next;
                 assert!(matches!(loss, StepOutcome::Updated(_)), "{loss:?}");
                 if step >= 1 {

@@ -6,7 +6,6 @@ use std::time::Instant;
 
 use burn::tensor::{Device, Distribution, Tensor, TensorData};
 use sinmdm_train::config::{ModelConfig, TrainConfig};
-use sinmdm_train::loss::LossTerms;
 use sinmdm_train::model::QnaUnet;
 use sinmdm_train::trainer::{StepOutcome, new_optimizer, optimisation_step};
 
@@ -59,7 +58,6 @@ fn main() {
                 t.clone(),
                 x0.clone(),
                 1e-4,
-                &LossTerms::default(),
             );
             model = next;
             assert!(matches!(loss, StepOutcome::Updated(_)), "{loss:?}");

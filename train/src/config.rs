@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+use sinmdm::network::{FIXED_RECEPTIVE_HALF_WIDTH, QNA_BLOCKS};
 
 use crate::error::TrainError;
 
@@ -41,13 +42,6 @@ pub struct ModelConfig {
 
 /// The frame rate at which a window that follows the frame rate is meant.
 pub const WINDOW_REFERENCE_FPS: f64 = 30.0;
-
-/// The part of the receptive half-width that does not depend on the QnA window: the input and
-/// output convolutions (1 frame each) and two k3 convolutions in each of the 3 residual blocks.
-const FIXED_RECEPTIVE_HALF_WIDTH: usize = 1 + 3 * 2 + 1;
-
-/// QnA blocks in the UNet, each seeing `(window - 1) / 2` frames on each side.
-const QNA_BLOCKS: usize = 3;
 
 fn is_false(b: &bool) -> bool {
     !*b
@@ -93,31 +87,14 @@ pub struct TrainingConfig {
     pub seed: u64,
     /// Steps between checkpoints (the last step is always saved).
     pub checkpoint_every: u64,
-    /// Frames each batch item sees: a random window of the stretched clip (each item its own),
-    /// so a step costs the same whatever the clip's length; absent or `null` uses the whole clip.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub window_frames: Option<usize>,
     /// Frames a step sees in all, in place of `batch_size` copies of the clip: a clip of F
     /// frames gets round(frames_per_step / F) batch items (at least 1, at most `batch_size`),
     /// each the whole stretched clip, or a random window of `frames_per_step` frames of one
     /// that is longer. A step then costs about the same whatever the clip's length, and
     /// GroupNorm's statistics are those of the whole clip, as when sampling. Absent or `null`:
-    /// `batch_size` items of `window_frames`.
+    /// `batch_size` items of the whole clip.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub frames_per_step: Option<usize>,
-    /// Weight of the foot-contact term of the loss ([`crate::foot_contact`]): the squared
-    /// speed, in skeleton heights per second, of each predicted contact point where the clip's
-    /// label says the foot is on the ground. Absent or 0 leaves the term out.
-    #[serde(default, skip_serializing_if = "is_zero_weight")]
-    pub foot_contact_weight: f64,
-    /// Weight of the acceleration term of the loss ([`crate::loss`]): the squared second
-    /// differences in time of the predicted x0's error. Absent or 0 leaves the term out.
-    #[serde(default, skip_serializing_if = "is_zero_weight")]
-    pub acceleration_weight: f64,
-    /// The acceleration term counts only for batch items whose diffusion timestep is below
-    /// this, in `1..=diffusion.steps`. Absent or `null`: every item.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub acceleration_below_timestep: Option<usize>,
 }
 
 /// What every step's batch is made of, for one clip ([`TrainingConfig::batch_shape`]).
@@ -152,10 +129,6 @@ fn is_zero(n: &u64) -> bool {
     *n == 0
 }
 
-fn is_zero_weight(w: &f64) -> bool {
-    *w == 0.0
-}
-
 impl TrainingConfig {
     /// The batch of every step for a clip of `clip_frames` frames (at the training frame
     /// rate, before stretching).
@@ -168,7 +141,7 @@ impl TrainingConfig {
             },
             None => BatchShape {
                 items: self.batch_size,
-                window: self.window_frames,
+                window: None,
             },
         }
     }
@@ -285,31 +258,18 @@ impl TrainConfig {
                 return Err(format!("{key} must be a positive number, got {value}"));
             }
         }
-        if !m.channels.is_multiple_of(crate::model::NORM_GROUPS) {
+        // The network contract's shape rules, named by the config's keys.
+        let shape = sinmdm::network::NetworkShape {
+            features: 1,
+            channels: m.channels,
+            heads: m.heads,
+            window: m.window,
+        };
+        if let Err(rule) = shape.check() {
             return Err(format!(
-                "model.channels must be a multiple of {} (GroupNorm groups), got {}",
-                crate::model::NORM_GROUPS,
-                m.channels
+                "model (channels {}, heads {}, window {}): {rule}",
+                m.channels, m.heads, m.window
             ));
-        }
-        if !m.channels.is_multiple_of(m.heads) {
-            return Err(format!(
-                "model.heads ({}) must divide model.channels ({})",
-                m.heads, m.channels
-            ));
-        }
-        for (key, weight) in [
-            ("training.acceleration_weight", t.acceleration_weight),
-            ("training.foot_contact_weight", t.foot_contact_weight),
-        ] {
-            if !(weight.is_finite() && weight >= 0.0) {
-                return Err(format!(
-                    "{key} must be 0 or a positive number, got {weight}"
-                ));
-            }
-        }
-        if m.window.is_multiple_of(2) {
-            return Err(format!("model.window must be odd, got {}", m.window));
         }
         if !(0.0..1.0).contains(&m.dropout) {
             return Err(format!(
@@ -320,15 +280,6 @@ impl TrainConfig {
         if self.diffusion.steps < 2 {
             return Err(format!(
                 "diffusion.steps must be at least 2, got {}",
-                self.diffusion.steps
-            ));
-        }
-        if let Some(cut) = t.acceleration_below_timestep
-            && !(1..=self.diffusion.steps).contains(&cut)
-        {
-            return Err(format!(
-                "training.acceleration_below_timestep must be in 1..={} (diffusion.steps) or \
-                 null, got {cut}",
                 self.diffusion.steps
             ));
         }
@@ -366,25 +317,13 @@ impl TrainConfig {
                 t.resample_min, t.resample_max
             ));
         }
-        for (key, frames) in [
-            ("training.window_frames", t.window_frames),
-            ("training.frames_per_step", t.frames_per_step),
-        ] {
-            if let Some(w) = frames
-                && w < m.receptive_field()
-            {
-                return Err(format!(
-                    "{key} must be at least the receptive field ({} frames), got {w}",
-                    m.receptive_field()
-                ));
-            }
-        }
-        if t.window_frames.is_some() && t.frames_per_step.is_some() {
-            return Err(
-                "training.window_frames and training.frames_per_step are two ways of bounding a \
-                 step's cost: set one of them (or neither)"
-                    .into(),
-            );
+        if let Some(w) = t.frames_per_step
+            && w < m.receptive_field()
+        {
+            return Err(format!(
+                "training.frames_per_step must be at least the receptive field ({} frames), got {w}",
+                m.receptive_field()
+            ));
         }
         if let Some(fps) = self.data.fps
             && !(fps.is_finite() && fps > 0.0)
@@ -423,16 +362,15 @@ impl ModelConfig {
         }
     }
 
-    /// Frames on each side of a frame that can change its prediction: the input and output
-    /// convolutions (1 each), two k3 convolutions in each of the 3 residual blocks (2 each) and
-    /// the 3 QnA windows.
+    /// Frames on each side of a frame that can change its prediction (the network contract's
+    /// [`receptive_half_width`](sinmdm::network::receptive_half_width)).
     pub fn receptive_half_width(&self) -> usize {
-        FIXED_RECEPTIVE_HALF_WIDTH + QNA_BLOCKS * (self.window - 1) / 2
+        sinmdm::network::receptive_half_width(self.window)
     }
 
     /// The receptive field in frames (23 for window 3).
     pub fn receptive_field(&self) -> usize {
-        2 * self.receptive_half_width() + 1
+        sinmdm::network::receptive_field(self.window)
     }
 }
 
@@ -507,28 +445,37 @@ mod tests {
         assert_eq!(shape(1054), (1, Some(1024)));
         assert_eq!(shape(5000), (1, Some(1024)));
         assert_eq!(shape(60), (8, Some(1024)));
-        // Without it: batch_size items of window_frames.
+        // Without it: batch_size items of the whole clip.
         let mut fixed = t.clone();
         fixed.frames_per_step = None;
-        fixed.window_frames = Some(128);
         assert_eq!(
             fixed.batch_shape(1054),
             BatchShape {
                 items: 8,
-                window: Some(128)
+                window: None
             }
         );
     }
 
     #[test]
-    fn frames_per_step_excludes_window_frames_and_covers_the_receptive_field() {
+    fn frames_per_step_covers_the_receptive_field_and_lost_knobs_are_refused() {
         let text = include_str!("../../configs/default.yaml");
-        let both = text.replace(
-            "  frames_per_step: 1024",
-            "  frames_per_step: 1024\n  window_frames: 256",
-        );
-        let err = TrainConfig::parse(&both).unwrap_err();
-        assert!(err.contains("set one of them"), "{err}");
+        // The knobs that lost their experiments are gone, and a config that still sets one is
+        // told so by name.
+        for knob in [
+            "window_frames: 256",
+            "foot_contact_weight: 1.0",
+            "acceleration_weight: 0.5",
+            "acceleration_below_timestep: 250",
+        ] {
+            let old = text.replace(
+                "  frames_per_step: 1024",
+                &format!("  frames_per_step: 1024\n  {knob}"),
+            );
+            let err = TrainConfig::parse(&old).unwrap_err();
+            let name = knob.split(':').next().unwrap();
+            assert!(err.contains(&format!("unknown field `{name}`")), "{err}");
+        }
         let tiny = text.replace("  frames_per_step: 1024", "  frames_per_step: 10");
         let err = TrainConfig::parse(&tiny).unwrap_err();
         assert!(
@@ -585,54 +532,6 @@ mod tests {
             ),
         ];
         let default = include_str!("../../configs/default.yaml");
-        assert_eq!(
-            TrainConfig::parse(default)
-                .unwrap()
-                .training
-                .foot_contact_weight,
-            0.0
-        );
-        let weighted = default.replace("foot_contact_weight: 0.0", "foot_contact_weight: 1.0");
-        assert_eq!(
-            TrainConfig::parse(&weighted)
-                .unwrap()
-                .training
-                .foot_contact_weight,
-            1.0
-        );
-        let err = TrainConfig::parse(&weighted.replace("weight: 1.0", "weight: -0.5")).unwrap_err();
-        assert!(err.contains("training.foot_contact_weight"), "{err}");
-        let accelerated = default.replace("acceleration_weight: 0.0", "acceleration_weight: 0.5");
-        assert_eq!(
-            TrainConfig::parse(&accelerated)
-                .unwrap()
-                .training
-                .acceleration_weight,
-            0.5
-        );
-        let err =
-            TrainConfig::parse(&accelerated.replace("weight: 0.5", "weight: -0.5")).unwrap_err();
-        assert!(err.contains("training.acceleration_weight"), "{err}");
-        let cut = accelerated.replace(
-            "acceleration_below_timestep: null",
-            "acceleration_below_timestep: 250",
-        );
-        assert_eq!(
-            TrainConfig::parse(&cut)
-                .unwrap()
-                .training
-                .acceleration_below_timestep,
-            Some(250)
-        );
-        for bad in ["0", "1001"] {
-            let err =
-                TrainConfig::parse(&cut.replace("timestep: 250", &format!("timestep: {bad}")))
-                    .unwrap_err();
-            assert!(
-                err.contains("training.acceleration_below_timestep"),
-                "{err}"
-            );
-        }
         for (from, to, expected) in cases {
             assert!(default.contains(from), "default.yaml lacks `{from}`");
             let err = TrainConfig::parse(&default.replacen(from, to, 1)).unwrap_err();
@@ -653,14 +552,14 @@ mod tests {
         let cases = [
             ("batch_size: 4", "batch_size: 0", "training.batch_size"),
             ("channels: 32", "channels: 0", "model.channels"),
-            ("channels: 32", "channels: 40", "multiple of 32"),
+            ("channels: 32", "channels: 40", "32 GroupNorm groups"),
             (
                 "learning_rate: 2.0e-3",
                 "learning_rate: -1.0",
                 "training.learning_rate",
             ),
-            ("window: 3", "window: 4", "model.window must be odd"),
-            ("heads: 4", "heads: 3", "model.heads"),
+            ("window: 3", "window: 4", "window (4) must be odd"),
+            ("heads: 4", "heads: 3", "multiple of heads (3)"),
         ];
         for (from, to, expected) in cases {
             assert!(TINY.contains(from), "tiny.yaml lacks `{from}`");

@@ -11,7 +11,6 @@ pub mod config;
 pub mod data;
 pub mod error;
 pub mod export;
-pub mod foot_contact;
 pub mod loss;
 pub mod loss_log;
 pub mod loss_plot;

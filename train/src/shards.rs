@@ -5,19 +5,18 @@ use burn::module::{Module, ModuleMapper, ModuleVisitor, Param};
 use burn::optim::GradientsParams;
 use burn::tensor::{Device, Distribution, Tensor};
 
-use crate::loss::LossTerms;
+use crate::loss::x0_loss;
 use crate::model::QnaUnet;
 use crate::model::dropout::DropoutKey;
 
 /// The batch's mean loss and its gradients (none when the loss is not finite), computed in
-/// `shards` shards on as many threads. The loss is the x0 MSE plus the weighted `terms`.
+/// `shards` shards on as many threads. The loss is the x0 MSE.
 pub(crate) fn sharded_gradients(
     model: &QnaUnet,
     x_t: Tensor<3>,
     t: Tensor<1>,
     x0: Tensor<3>,
     shards: usize,
-    terms: &LossTerms,
 ) -> (f64, Option<GradientsParams>) {
     let batch = x_t.dims()[0];
     let seed = dropout_seed(&x_t.device());
@@ -37,7 +36,7 @@ pub(crate) fn sharded_gradients(
             Some(key),
         );
         let target = x0.clone().narrow(0, first, len);
-        let loss = terms.loss(&prediction, &target, &timesteps);
+        let loss = x0_loss(&prediction, &target);
         let share = len as f64 / batch as f64;
         let value = f64::from(loss.clone().into_scalar::<f32>()) * share;
         if !value.is_finite() {
@@ -211,14 +210,8 @@ mod tests {
         );
         let gradients = |shards| {
             device.seed(9);
-            let (loss, grads) = sharded_gradients(
-                &model,
-                x_t.clone(),
-                t.clone(),
-                x0.clone(),
-                shards,
-                &LossTerms::default(),
-            );
+            let (loss, grads) =
+                sharded_gradients(&model, x_t.clone(), t.clone(), x0.clone(), shards);
             (loss, grads.expect("finite loss"))
         };
         let (whole_loss, whole) = gradients(1);

@@ -16,8 +16,6 @@ use crate::clip_data::ClipData;
 use crate::config::TrainConfig;
 use crate::data::make_batch;
 use crate::error::{TrainError, io};
-use crate::foot_contact::FootContact;
-use crate::loss::LossTerms;
 use crate::loss_log::LossLog;
 use crate::model::{QnaUnet, on_cpu};
 use crate::recovery::{NonFinite, RecoveryEvent, RecoveryRecord};
@@ -108,8 +106,6 @@ pub struct Trainer {
     session_start: Instant,
     elapsed_before: f64,
     last_checkpoint: Option<PathBuf>,
-    /// The foot-contact term of the loss, when its weight is not 0 and the clip has contacts.
-    foot_contact: Option<FootContact>,
     /// Steps (1-based) whose gradients tests turn into NaN, once each.
     injected_faults: BTreeSet<u64>,
 }
@@ -147,7 +143,7 @@ pub fn new_optimizer(config: &TrainConfig) -> ModuleOptimizer {
 /// summed gradients are those of the whole batch's mean loss; GroupNorm's statistics are per
 /// item and the dropout masks are keyed by item, so nothing else depends on the split, which
 /// is fixed for a given thread count (same seed and `--threads`, same run). The loss is the
-/// x0 MSE plus the weighted `terms`.
+/// x0 MSE.
 pub fn optimisation_step(
     model: QnaUnet,
     optimizer: &mut ModuleOptimizer,
@@ -155,9 +151,8 @@ pub fn optimisation_step(
     t: Tensor<1>,
     x0: Tensor<3>,
     learning_rate: f64,
-    terms: &LossTerms,
 ) -> (QnaUnet, StepOutcome) {
-    step_with_fault(model, optimizer, (x_t, t, x0), learning_rate, terms, false)
+    step_with_fault(model, optimizer, (x_t, t, x0), learning_rate, false)
 }
 
 /// [`optimisation_step`], with the gradients poisoned first when `inject_fault` is set.
@@ -166,7 +161,6 @@ fn step_with_fault(
     optimizer: &mut ModuleOptimizer,
     (x_t, t, x0): (Tensor<3>, Tensor<1>, Tensor<3>),
     learning_rate: f64,
-    terms: &LossTerms,
     inject_fault: bool,
 ) -> (QnaUnet, StepOutcome) {
     // A GPU runs one batch best whole.
@@ -175,7 +169,7 @@ fn step_with_fault(
     } else {
         1
     };
-    let (loss, grads) = sharded_gradients(&model, x_t, t, x0, shards, terms);
+    let (loss, grads) = sharded_gradients(&model, x_t, t, x0, shards);
     let Some(mut grads) = grads else {
         let cause = NonFinite::Loss;
         return (model, StepOutcome::Skipped { loss, cause });
@@ -236,16 +230,6 @@ fn load_parts(
     Ok((model, average, optimizer))
 }
 
-/// The foot-contact term for `config` on `data`: none when its weight is 0 or the clip has no
-/// contact joint below its root.
-fn foot_contact_term(config: &TrainConfig, data: &ClipData) -> Option<FootContact> {
-    if config.training.foot_contact_weight > 0.0 {
-        FootContact::new(&data.facts.layout, &data.facts.normalizer)
-    } else {
-        None
-    }
-}
-
 /// The schedule of a configuration.
 fn schedule(config: &TrainConfig) -> Schedule {
     Schedule::cosine(config.diffusion.steps).expect("validated configuration has T >= 2")
@@ -293,7 +277,6 @@ impl Trainer {
             recovery: RecoveryRecord::default(),
             config: config.clone(),
         };
-        let foot_contact = foot_contact_term(&config, &data);
         Ok(Trainer {
             run: run.to_path_buf(),
             device,
@@ -308,7 +291,6 @@ impl Trainer {
             session_start: Instant::now(),
             elapsed_before: 0.0,
             last_checkpoint: None,
-            foot_contact,
             injected_faults: BTreeSet::new(),
         })
     }
@@ -368,7 +350,6 @@ impl Trainer {
         let log = LossLog::resume(&run.join(LOSS_LOG), state.step)?;
         let elapsed_before = state.elapsed_seconds;
         state.batch = Some(state.config.training.batch_shape(data.features.ncols()));
-        let foot_contact = foot_contact_term(&state.config, &data);
         Ok(Trainer {
             run: run.to_path_buf(),
             device,
@@ -383,7 +364,6 @@ impl Trainer {
             session_start: Instant::now(),
             elapsed_before,
             last_checkpoint: Some(dir),
-            foot_contact,
             injected_faults: BTreeSet::new(),
         })
     }
@@ -449,19 +429,12 @@ impl Trainer {
         let t = Tensor::<1>::from_data(TensorData::new(t, [batch.batch]), &self.device);
         let model = self.model.take().expect("model present between steps");
         let learning_rate = self.state.learning_rate;
-        let weight = config.training.foot_contact_weight;
-        let terms = LossTerms {
-            foot_contact: self.foot_contact.as_ref().map(|term| (term, weight)),
-            acceleration_weight: config.training.acceleration_weight,
-            acceleration_below_timestep: config.training.acceleration_below_timestep,
-        };
         let inject_fault = self.injected_faults.remove(&(step + 1));
         let (model, outcome) = step_with_fault(
             model,
             &mut self.optimizer,
             (noised, t, clean),
             learning_rate,
-            &terms,
             inject_fault,
         );
         let value = match outcome {

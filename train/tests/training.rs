@@ -430,7 +430,9 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        !out.status.success() && err.contains("--window 4: model.window must be odd"),
+        !out.status.success()
+            && err.contains("--window 4: model (channels")
+            && err.contains("window (4) must be odd"),
         "{err}"
     );
     let out = Command::new(bin)

@@ -7,18 +7,26 @@
 //! - [`spans`]: contact spans from labels (hysteresis, shortest span) and blend weights;
 //! - [`chain`]: which joints above a contact joint may turn;
 //! - [`ground`]: the ground level of a motion;
-//! - [`plant`]: the pass itself, on the inverse kinematics of [`crate::motion::ik`];
-//! - `stance`: the root's horizontal travel with the feet in contact, before the legs turn.
+//! - [`options`]: what the pass is asked, must keep, and reports;
+//! - [`plant`]: the pass itself, phase by phase ([`plant_feet`]);
+//! - `stance`: the root's horizontal travel with the feet in contact, before the legs turn;
+//! - `targets`: where each contact point should be, frame by frame;
+//! - `solve`: each frame's legs turned by [`least_turn`](crate::motion::ik::least_turn), and
+//!   the lift that keeps the motion above the ground.
 
 pub mod chain;
 pub mod ground;
+pub mod options;
 pub mod plant;
+mod solve;
 pub mod spans;
 mod stance;
+mod targets;
 
 pub use chain::{LegChain, leg_chain};
 pub use ground::{GROUND_PERCENTILE, ground_level};
-pub use plant::{Anchor, Kept, LegSolver, PlantOptions, PlantStats, plant_feet};
+pub use options::{Anchor, Kept, PlantOptions, PlantStats};
+pub use plant::plant_feet;
 pub use spans::{CONTACT_OFF, CONTACT_ON, contact_spans};
 
 /// What happens to the feet of generated motion.
