@@ -59,10 +59,10 @@ pub(crate) unsafe fn poses_in(
     let layout = &model.metadata().layout;
     let joints = layout.skeleton.len();
     let frames = poses.frames;
-    if frames == 0 || frames > sinmdm::tasks::MAX_FRAMES {
+    if frames == 0 || frames > sinmdm::limits::MAX_SAMPLE_FRAMES {
         return Err(Failure::invalid(format!(
             "{argument}.frames must be between 1 and {}, got {frames}",
-            sinmdm::tasks::MAX_FRAMES
+            sinmdm::limits::MAX_SAMPLE_FRAMES
         )));
     }
     let roots = unsafe { slice_arg(poses.root_positions, 3 * frames, "root_positions") }?;

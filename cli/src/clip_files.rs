@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use clap::Args;
 use sinmdm::bvh::to_bvh_string;
 use sinmdm::files::write_atomically;
 use sinmdm::motion::{ChannelClip, LocalMotion, UpAxis};
@@ -146,4 +147,17 @@ pub fn write_motion_file(
     };
     write_atomically(path, to_bvh_string(&motion.to_channels()).as_bytes())
         .with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// `--up`: the up axis of a clip the command reads.
+#[derive(Debug, Clone, Args)]
+pub struct ClipUpArg {
+    /// The clip's up axis: x, y, z, -x, -y or -z (default: read from the motion; for a
+    /// reference or content clip, the model's own when the motion does not say clearly).
+    #[arg(long, value_name = "AXIS")]
+    pub up: Option<UpAxis>,
+    /// The animation of a glTF clip (or stack of an FBX clip) to read, by name or index (default:
+    /// the first).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub clip_anim: Option<String>,
 }

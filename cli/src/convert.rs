@@ -30,7 +30,7 @@ pub struct ConvertArgs {
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     #[command(flatten)]
-    pub read: crate::sampling::ClipUpArg,
+    pub read: crate::clip_files::ClipUpArg,
     /// Metres per file unit, for glTF output (default: from the skeleton's height).
     #[arg(long, value_name = "METRES")]
     pub unit_scale: Option<f64>,

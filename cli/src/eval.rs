@@ -38,7 +38,7 @@ pub struct EvalArgs {
     #[arg(long, value_name = "CLIP.bvh|CLIP.glb")]
     clip: PathBuf,
     #[command(flatten)]
-    up: crate::sampling::ClipUpArg,
+    up: crate::clip_files::ClipUpArg,
     /// Samples to generate (one batched run).
     #[arg(long, default_value_t = 20)]
     samples: usize,

@@ -9,7 +9,7 @@ use ndarray::Axis;
 
 use crate::sampling::reference_features;
 use sinmdm::features_file::write_features;
-use sinmdm::model_file::ModelMetadata;
+use sinmdm::model_file::{MetadataError, ModelMetadata};
 use sinmdm::{Model, ModelError, ModelOptions};
 
 pub(crate) const INFO_EXAMPLES: &str = "Examples:
@@ -41,7 +41,7 @@ pub struct EncodeArgs {
     #[arg(short, long, value_name = "OUT.json")]
     pub output: PathBuf,
     #[command(flatten)]
-    pub up: crate::sampling::ClipUpArg,
+    pub up: crate::clip_files::ClipUpArg,
 }
 
 /// A readable summary of a model's metadata.
@@ -148,9 +148,9 @@ pub(crate) fn info(args: &InfoArgs) -> Result<()> {
     };
     match Model::open(&args.model, &ModelOptions { threads: Some(1) }) {
         Ok(model) => show(model.metadata()),
-        Err(ModelError::Invalid {
+        Err(ModelError::Metadata(MetadataError::Invalid {
             problems, metadata, ..
-        }) => {
+        })) => {
             // Show what the file holds, then why it cannot be used.
             show(&metadata)?;
             eprintln!("{}: the metadata breaks these rules:", args.model.display());

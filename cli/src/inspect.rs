@@ -43,7 +43,7 @@ pub struct InspectArgs {
     #[arg(long, default_value_t = ContactConfig::default().speed_threshold)]
     pub contact_speed: f64,
     #[command(flatten)]
-    pub up: crate::sampling::ClipUpArg,
+    pub up: crate::clip_files::ClipUpArg,
 }
 
 /// A plain-words guess of the file's length unit from the skeleton height.

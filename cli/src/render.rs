@@ -43,7 +43,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 8)]
     pub sheet_frames: usize,
     #[command(flatten)]
-    pub up: crate::sampling::ClipUpArg,
+    pub up: crate::clip_files::ClipUpArg,
 }
 
 /// Writes `figures` as a GIF or PNG chosen by the extension of `path`.

@@ -9,15 +9,15 @@ use clap::Args;
 use ndarray::Array2;
 
 use sinmdm::features_file::write_features;
+use sinmdm::limits::MAX_SAMPLES;
 use sinmdm::motion::encode_for_model;
-use sinmdm::motion::up::UpAxis;
-use sinmdm::tasks::MAX_COUNT;
 use sinmdm::{Feet, Generated, Method, Plan, Request, Span, Task};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_render::{Camera, Figure};
 
 use crate::clip_files::{
-    GltfPlacement, is_gltf, metres_per_unit, named_samples, read_motion_file, write_motion_file,
+    ClipUpArg, GltfPlacement, is_gltf, metres_per_unit, named_samples, read_motion_file,
+    write_motion_file,
 };
 use crate::render::write_picture;
 use sinmdm_formats::gltf::splice_into_character;
@@ -266,19 +266,6 @@ pub fn parse_span(text: &str, fps: f64, frames: usize) -> Result<Span> {
     Ok(Span::new(start, end))
 }
 
-/// `--up`: the up axis of a clip the command reads.
-#[derive(Debug, Clone, Args)]
-pub struct ClipUpArg {
-    /// The clip's up axis: x, y, z, -x, -y or -z (default: read from the motion; for a
-    /// reference or content clip, the model's own when the motion does not say clearly).
-    #[arg(long, value_name = "AXIS")]
-    pub up: Option<UpAxis>,
-    /// The animation of a glTF clip (or stack of an FBX clip) to read, by name or index (default:
-    /// the first).
-    #[arg(long, value_name = "NAME|INDEX")]
-    pub clip_anim: Option<String>,
-}
-
 /// Reads a clip (BVH, glTF or FBX) of the model's skeleton as raw features in the model's layout
 /// ([`encode_for_model`]), saying so when the clip was turned into the model's up convention.
 pub fn reference_features(model: &Model, clip: &Path, read: &ClipUpArg) -> Result<Array2<f32>> {
@@ -343,9 +330,9 @@ pub fn check_writable(paths: &[PathBuf]) -> Result<()> {
 /// progress bar, and writes the motions (BVH files, one glTF file, or the character's GLB with
 /// them appended), the features JSON and the picture, each atomically.
 pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Generated> {
-    if !(1..=MAX_COUNT).contains(&args.count) {
+    if !(1..=MAX_SAMPLES).contains(&args.count) {
         bail!(
-            "--count must be between 1 and {MAX_COUNT}, got {}",
+            "--count must be between 1 and {MAX_SAMPLES}, got {}",
             args.count
         );
     }

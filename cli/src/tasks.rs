@@ -5,9 +5,8 @@ use std::path::PathBuf;
 use anyhow::{Result, bail};
 use clap::Args;
 
-use crate::sampling::{
-    ClipUpArg, SamplingArgs, parse_position, parse_span, reference_features, run_task,
-};
+use crate::clip_files::ClipUpArg;
+use crate::sampling::{SamplingArgs, parse_position, parse_span, reference_features, run_task};
 use sinmdm::tasks::{
     EXPAND_RAMP, HARMONIZE_FACTOR, HARMONIZE_FREE_SHARE, INBETWEEN_RAMP, Task, joints_by_name,
     subtree,

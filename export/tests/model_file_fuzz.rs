@@ -17,7 +17,7 @@ use onnx_protobuf::ModelProto;
 use protobuf::Message;
 use serde_json::Value;
 use sinmdm::diffusion::noise::mix;
-use sinmdm::model_file::METADATA_KEY;
+use sinmdm::model_file::{METADATA_KEY, MetadataError};
 use sinmdm::{Model, ModelError, ModelOptions, Request, Task};
 
 /// Records the largest single allocation of the process.
@@ -254,10 +254,10 @@ struct Tally {
 fn kind(e: &ModelError) -> &'static str {
     match e {
         ModelError::NotOnnx { .. } => "not loadable ONNX",
-        ModelError::NoMetadata { .. } => "no metadata",
-        ModelError::SchemaVersion { .. } => "schema version",
-        ModelError::BadMetadata { .. } => "unreadable metadata",
-        ModelError::Invalid { .. } => "metadata breaks a rule",
+        ModelError::Metadata(MetadataError::NoMetadata { .. }) => "no metadata",
+        ModelError::Metadata(MetadataError::SchemaVersion { .. }) => "schema version",
+        ModelError::Metadata(MetadataError::BadMetadata { .. }) => "unreadable metadata",
+        ModelError::Metadata(MetadataError::Invalid { .. }) => "metadata breaks a rule",
         ModelError::BadGraph { .. } => "graph interface",
         ModelError::Run { .. } => "failed to run",
         _ => "other",
@@ -272,7 +272,7 @@ fn try_mutant(bytes: &[u8]) -> Result<Option<&'static str>, String> {
         Ok(m) => m,
         Err(e) => {
             match &e {
-                ModelError::Invalid { problems, .. } => {
+                ModelError::Metadata(MetadataError::Invalid { problems, .. }) => {
                     let fields = ["network", "diffusion", "layout", "normalizer", "training"];
                     if let Some(p) = problems
                         .iter()
@@ -281,7 +281,7 @@ fn try_mutant(bytes: &[u8]) -> Result<Option<&'static str>, String> {
                         return Err(format!("a problem that names no field: {p}"));
                     }
                 }
-                ModelError::BadMetadata { message, .. }
+                ModelError::Metadata(MetadataError::BadMetadata { message, .. })
                     if !(message.contains("at field")
                         || message.contains("no 'sinmdm.metadata'")) =>
                 {

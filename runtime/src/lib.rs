@@ -34,9 +34,9 @@
 //! ```
 //!
 //! The modules hold the rest: [`motion`] (skeletons, rotations, the feature vector),
-//! [`bvh`] (files), [`diffusion`] (schedule, portable noise, sampler), [`tasks`] (task
-//! limits, spans, masks), [`model_file`] (the metadata schema) and [`network`] (the contract
-//! between training, export and this runtime).
+//! [`bvh`] (files), [`diffusion`] (schedule, portable noise, sampler), [`tasks`] (spans,
+//! masks), [`model_file`] (the metadata schema), [`network`] (the contract between training,
+//! export and this runtime) and [`limits`] (every bound on what the engine is given).
 
 #![warn(missing_docs)]
 
@@ -47,6 +47,7 @@ pub mod diffusion;
 pub mod features_file;
 #[doc(hidden)]
 pub mod files;
+pub mod limits;
 mod model;
 pub mod model_file;
 pub mod motion;

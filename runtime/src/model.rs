@@ -9,7 +9,7 @@ use ort::session::builder::GraphOptimizationLevel;
 use ort::value::Tensor;
 use thiserror::Error;
 
-use crate::model_file::{ModelMetadata, SCHEMA_KEY, SCHEMA_VERSION, parse_metadata};
+use crate::model_file::{MetadataError, ModelMetadata, parse_metadata};
 use crate::network::{INPUT_FEATURES, INPUT_STEP, OUTPUT_FEATURES};
 use crate::onnxruntime::{self, RuntimeLibraryError};
 
@@ -38,43 +38,9 @@ pub enum ModelError {
         /// What onnxruntime said.
         message: String,
     },
-    /// A valid ONNX file without our metadata.
-    #[error(
-        "'{path}' has no sinmdm metadata (no '{SCHEMA_KEY}' entry in metadata_props): it was not written by sinmdm-export"
-    )]
-    NoMetadata {
-        /// The model file.
-        path: PathBuf,
-    },
-    /// Our metadata, but a schema version this runtime does not read.
-    #[error(
-        "'{path}' carries sinmdm metadata schema '{found}'; this runtime reads schema {SCHEMA_VERSION}"
-    )]
-    SchemaVersion {
-        /// The model file.
-        path: PathBuf,
-        /// The version in the file.
-        found: String,
-    },
-    /// The metadata is present but incomplete or malformed.
-    #[error("'{path}' has invalid sinmdm metadata: {message}")]
-    BadMetadata {
-        /// The model file.
-        path: PathBuf,
-        /// What is wrong, naming the field.
-        message: String,
-    },
-    /// Metadata that breaks the rules of [`crate::model_file::problems`]: every problem, each
-    /// naming its field, and the metadata as read (to show what is readable).
-    #[error("'{path}' has invalid sinmdm metadata: {}", problems.join("; "))]
-    Invalid {
-        /// The model file.
-        path: PathBuf,
-        /// Every problem found, each naming the field and its value.
-        problems: Vec<String>,
-        /// The metadata as read.
-        metadata: Box<ModelMetadata>,
-    },
+    /// The file's sinmdm metadata is missing, of another schema, malformed or breaks a rule.
+    #[error(transparent)]
+    Metadata(#[from] MetadataError),
     /// The graph's inputs or outputs are not the contract's.
     #[error("'{path}' does not have the denoiser's interface: {message}")]
     BadGraph {

@@ -3,17 +3,13 @@
 
 use serde::{Deserialize, Serialize};
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 mod json_path;
 mod validate;
 
-pub use validate::{
-    MAX_DIFFUSION_STEPS, MAX_FEATURES, MAX_FPS, MAX_JOINTS, MAX_NAME_BYTES, MAX_NETWORK_CHANNELS,
-    MAX_WINDOW, problems,
-};
+pub use validate::problems;
 
-use crate::model::ModelError;
 use crate::motion::{FeatureLayout, Normalizer};
 use crate::network::NetworkShape;
 
@@ -132,21 +128,63 @@ impl NetworkFacts {
     }
 }
 
+/// Why a model file's metadata cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum MetadataError {
+    /// A valid ONNX file without our metadata.
+    #[error(
+        "'{path}' has no sinmdm metadata (no '{SCHEMA_KEY}' entry in metadata_props): it was not written by sinmdm-export"
+    )]
+    NoMetadata {
+        /// The model file.
+        path: PathBuf,
+    },
+    /// Our metadata, but a schema version this runtime does not read.
+    #[error(
+        "'{path}' carries sinmdm metadata schema '{found}'; this runtime reads schema {SCHEMA_VERSION}"
+    )]
+    SchemaVersion {
+        /// The model file.
+        path: PathBuf,
+        /// The version in the file.
+        found: String,
+    },
+    /// The metadata is present but incomplete or malformed.
+    #[error("'{path}' has invalid sinmdm metadata: {message}")]
+    BadMetadata {
+        /// The model file.
+        path: PathBuf,
+        /// What is wrong, naming the field.
+        message: String,
+    },
+    /// Metadata that breaks the rules of [`crate::model_file::problems`]: every problem, each
+    /// naming its field, and the metadata as read (to show what is readable).
+    #[error("'{path}' has invalid sinmdm metadata: {}", problems.join("; "))]
+    Invalid {
+        /// The model file.
+        path: PathBuf,
+        /// Every problem found, each naming the field and its value.
+        problems: Vec<String>,
+        /// The metadata as read.
+        metadata: Box<ModelMetadata>,
+    },
+}
+
 /// Reads and checks the metadata entries of a model, given a lookup of `metadata_props`.
 pub fn parse_metadata(
     path: &Path,
     lookup: impl Fn(&str) -> Option<String>,
-) -> Result<ModelMetadata, ModelError> {
-    let schema = lookup(SCHEMA_KEY).ok_or_else(|| ModelError::NoMetadata {
+) -> Result<ModelMetadata, MetadataError> {
+    let schema = lookup(SCHEMA_KEY).ok_or_else(|| MetadataError::NoMetadata {
         path: path.to_path_buf(),
     })?;
     if schema.trim() != SCHEMA_VERSION.to_string() {
-        return Err(ModelError::SchemaVersion {
+        return Err(MetadataError::SchemaVersion {
             path: path.to_path_buf(),
             found: schema,
         });
     }
-    let bad = |message: String| ModelError::BadMetadata {
+    let bad = |message: String| MetadataError::BadMetadata {
         path: path.to_path_buf(),
         message,
     };
@@ -162,7 +200,7 @@ pub fn parse_metadata(
     })?;
     let problems = validate::problems(&metadata);
     if !problems.is_empty() {
-        return Err(ModelError::Invalid {
+        return Err(MetadataError::Invalid {
             path: path.to_path_buf(),
             problems,
             metadata: Box::new(metadata),

@@ -6,23 +6,12 @@
 use std::collections::HashSet;
 
 use super::{ModelMetadata, PREDICTION, SCHEDULE};
+use crate::limits::{
+    MAX_DIFFUSION_STEPS, MAX_FEATURES, MAX_FPS, MAX_JOINTS, MAX_NAME_BYTES, MAX_NETWORK_CHANNELS,
+    MAX_SAMPLE_FRAMES, MAX_WINDOW,
+};
 use crate::motion::math::{self, Mat3};
 use crate::motion::skeleton::{Channel, Skeleton};
-
-/// Most joints a model's skeleton may have.
-pub const MAX_JOINTS: usize = 4096;
-/// Longest joint name, in bytes.
-pub const MAX_NAME_BYTES: usize = 256;
-/// Most feature rows F.
-pub const MAX_FEATURES: usize = 6 * MAX_JOINTS + 3 * MAX_JOINTS;
-/// Most channels C.
-pub const MAX_NETWORK_CHANNELS: usize = 8192;
-/// Widest QnA window, in frames.
-pub const MAX_WINDOW: usize = 255;
-/// Most diffusion steps T (the schedule holds a few f64 per step).
-pub const MAX_DIFFUSION_STEPS: usize = 100_000;
-/// Highest frame rate.
-pub const MAX_FPS: f64 = 10_000.0;
 
 /// Every problem of `m`, each naming the field and the value; empty when the metadata is sound.
 pub fn problems(m: &ModelMetadata) -> Vec<String> {
@@ -46,11 +35,10 @@ pub fn problems(m: &ModelMetadata) -> Vec<String> {
             d.schedule, d.prediction
         ));
     }
-    if m.training.clip_frames > crate::tasks::MAX_FRAMES {
+    if m.training.clip_frames > MAX_SAMPLE_FRAMES {
         p.add(format!(
             "training.clip_frames is {}; the most a model can make is {} frames",
-            m.training.clip_frames,
-            crate::tasks::MAX_FRAMES
+            m.training.clip_frames, MAX_SAMPLE_FRAMES
         ));
     }
     p.0
@@ -238,6 +226,13 @@ fn network_and_normalizer(p: &mut Problems, m: &ModelMetadata) {
     }
     if let Err(e) = net.shape().check() {
         p.add(format!("network: {e}"));
+    } else if net.receptive_field != net.shape().receptive_field() {
+        p.add(format!(
+            "network.receptive_field is {} but a window of {} makes it {}",
+            net.receptive_field,
+            net.window,
+            net.shape().receptive_field()
+        ));
     }
     let norm = &m.normalizer;
     if norm.mean.len() != net.features || norm.std.len() != net.features {

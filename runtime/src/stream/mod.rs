@@ -22,12 +22,13 @@ use ndarray::{Array2, Axis, s};
 
 use crate::diffusion::sampler::{Denoiser, Guidance, Inpainting, Sampler};
 use crate::diffusion::{Method, Schedule};
+use crate::limits::MAX_SAMPLE_FRAMES;
 use crate::model_file::ModelMetadata;
 use crate::motion::feet::{Anchor, Feet, Kept, PlantOptions, plant_feet};
 use crate::motion::math::{self, Mat3, Vec3};
 use crate::motion::{FeatureMatrix, LocalMotion, MotionError, Pose, decode, poses};
 use crate::tasks::mask::soft_mask;
-use crate::tasks::{INBETWEEN_RAMP, MAX_FRAMES, TaskError};
+use crate::tasks::{INBETWEEN_RAMP, TaskError};
 use blocks::{BlockSizes, block_seed};
 use guide::Guide;
 
@@ -160,9 +161,9 @@ impl Stream {
             ));
         }
         let window = context.saturating_add(ramp).saturating_add(block);
-        if window > MAX_FRAMES {
+        if window > MAX_SAMPLE_FRAMES {
             return bad(format!(
-                "a window of {window} frames is beyond the limit of {MAX_FRAMES}"
+                "a window of {window} frames is beyond the limit of {MAX_SAMPLE_FRAMES}"
             ));
         }
         if let Some(problem) = options.method.problem() {
@@ -253,10 +254,10 @@ impl Stream {
     where
         TaskError: From<D::Error>,
     {
-        if frames > MAX_FRAMES {
+        if frames > MAX_SAMPLE_FRAMES {
             return Err(TaskError::Length {
                 frames,
-                reason: format!("one chunk holds at most {MAX_FRAMES} frames"),
+                reason: format!("one chunk holds at most {MAX_SAMPLE_FRAMES} frames"),
             });
         }
         while self.ready.len() < frames {

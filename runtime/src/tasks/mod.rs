@@ -25,13 +25,7 @@ pub use joints::{joints_by_name, subtree};
 pub use mask::Span;
 pub use plan::{Plan, plan, run};
 
-/// The longest sample a task makes, in frames (55 minutes at 30 fps).
-pub const MAX_FRAMES: usize = 100_000;
-/// The largest crowd one run makes.
-pub const MAX_COUNT: usize = 1024;
-/// The largest working set one run may need, in f32 values (1 GiB): `count x frames x` the
-/// larger of `F + 8 C` (the network's layers) and `12 x joints` (the decoded motion).
-pub const MAX_VALUES: usize = 1 << 28;
+pub use crate::limits::{MAX_RUN_VALUES, MAX_SAMPLE_FRAMES, MAX_SAMPLES};
 /// Default soft border of in-betweening and composition spans, in frames.
 pub const INBETWEEN_RAMP: usize = 10;
 /// Default soft border of expansion, in frames.
@@ -73,7 +67,7 @@ pub enum TaskError {
         reason: String,
     },
     /// A crowd of zero or beyond the limit.
-    #[error("the number of samples must be between 1 and {MAX_COUNT}, got {0}")]
+    #[error("the number of samples must be between 1 and {MAX_SAMPLES}, got {0}")]
     Count(usize),
     /// A batch too large to hold.
     #[error(

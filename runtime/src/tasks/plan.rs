@@ -7,9 +7,10 @@ use ndarray::Array2;
 
 use super::Generated;
 use super::mask::{Span, covered, soft_mask};
-use super::{MAX_COUNT, MAX_FRAMES, MAX_VALUES, Request, Task, TaskError};
+use super::{Request, Task, TaskError};
 use crate::diffusion::sampler::{Denoiser, Guidance, Harmonization, Inpainting, Sampler};
 use crate::diffusion::{Method, SamplerError, Schedule};
+use crate::limits::{MAX_RUN_VALUES, MAX_SAMPLE_FRAMES, MAX_SAMPLES};
 use crate::model::Model;
 use crate::model_file::ModelMetadata;
 use crate::motion::feet::{Feet, Kept};
@@ -193,10 +194,10 @@ fn check_length(frames: usize) -> Result<(), TaskError> {
             reason: "ask for at least one frame".into(),
         });
     }
-    if frames > MAX_FRAMES {
+    if frames > MAX_SAMPLE_FRAMES {
         return Err(TaskError::Length {
             frames,
-            reason: format!("the limit is {MAX_FRAMES} frames per sample"),
+            reason: format!("the limit is {MAX_SAMPLE_FRAMES} frames per sample"),
         });
     }
     Ok(())
@@ -230,7 +231,7 @@ fn frame_mask(features: usize, weights: &[f32], rows: Option<&[usize]>) -> Array
 /// Checks a request against a model and builds its sampling plan.
 pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskError> {
     let f = metadata.network.features;
-    if request.count == 0 || request.count > MAX_COUNT {
+    if request.count == 0 || request.count > MAX_SAMPLES {
         return Err(TaskError::Count(request.count));
     }
     if let Some(problem) = request.method.problem() {
@@ -382,7 +383,7 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
         .count
         .saturating_mul(per_frame)
         .saturating_mul(frames);
-    if values > MAX_VALUES {
+    if values > MAX_RUN_VALUES {
         return Err(TaskError::TooLarge {
             count: request.count,
             frames,

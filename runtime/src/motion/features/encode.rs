@@ -5,6 +5,7 @@ use ndarray::Array2;
 use super::FeatureMatrix;
 use super::error::MotionError;
 use super::layout::{FeatureLayout, RootFeatures};
+use crate::limits::MAX_ENCODED_FRAMES;
 use crate::motion::clip::{ChannelClip, LocalMotion};
 use crate::motion::contacts::{ContactConfig, choose_contact_joints, label_contacts};
 use crate::motion::feet::ground_level;
@@ -52,9 +53,6 @@ pub struct EncodedClip {
     pub in_place: bool,
 }
 
-/// The longest feature sequence `encode` makes (over nine hours at 30 fps).
-pub const MAX_FRAMES: usize = 1_000_000;
-
 /// Relative change under which a channel counts as constant.
 const CONSTANT_TOLERANCE: f64 = 1e-9;
 
@@ -88,15 +86,15 @@ fn motion_root(skeleton: &Skeleton, varying_position: &[bool]) -> usize {
     }
 }
 
-/// Refuses a resampling to `fps` that would make more than [`MAX_FRAMES`] frames.
+/// Refuses a resampling to `fps` that would make more than [`MAX_ENCODED_FRAMES`] frames.
 fn check_resampled_length(clip: &ChannelClip, fps: f64) -> Result<(), MotionError> {
     let resampled = (clip.frame_count() as f64 - 1.0) * fps / clip.fps + 1.0;
-    if resampled.is_nan() || resampled > MAX_FRAMES as f64 {
+    if resampled.is_nan() || resampled > MAX_ENCODED_FRAMES as f64 {
         return Err(MotionError::TooManyFrames {
             frames: clip.frame_count(),
             from_fps: clip.fps,
             to_fps: fps,
-            limit: MAX_FRAMES,
+            limit: MAX_ENCODED_FRAMES,
         });
     }
     Ok(())

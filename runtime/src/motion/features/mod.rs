@@ -28,7 +28,7 @@ mod layout;
 mod reference;
 
 pub use decode::decode;
-pub use encode::{EncodeOptions, EncodedClip, MAX_FRAMES, encode, encode_for, encode_motion};
+pub use encode::{EncodeOptions, EncodedClip, encode, encode_for, encode_motion};
 pub use error::MotionError;
 pub use layout::{Column, ColumnKind, FeatureLayout, RootFeatures};
 pub use reference::{ClipForModel, encode_for_model};
