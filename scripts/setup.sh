@@ -47,6 +47,11 @@ if [ -z "$lib" ]; then
   exit 1
 fi
 echo "setup: onnxruntime library at $lib"
+# The Python reference (python/), installed in editable mode so its sources are what runs.
+if ! .venv/bin/python -c "import sinmdm_reference" 2>/dev/null; then
+  echo "setup: installing the Python reference (python/) in editable mode"
+  .venv/bin/python -m pip install --quiet --disable-pip-version-check --no-deps -e python
+fi
 
 # The independent glTF readers the tests run under node (the Khronos validator, three.js),
 # pinned by tests/node/package-lock.json.

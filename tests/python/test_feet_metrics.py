@@ -1,5 +1,5 @@
 """`sinmdm eval`'s feet and smoothness figures (SPEC section 9) against the numpy reference in
-`scripts/sinmdm_reference/feet.py`, on positions computed here in numpy from the BVH files of the
+`python/sinmdm_reference/feet.py`, on positions computed here in numpy from the BVH files of the
 same samples (written by `sinmdm generate`) and of the clip; the joints of that numpy forward
 kinematics are checked against an independent reader (bvhio) first."""
 
@@ -12,8 +12,7 @@ import onnx
 
 from conftest import ROOT, SINMDM, bvhio_joint_positions
 
-sys.path.insert(0, str(ROOT / "scripts"))
-from sinmdm_reference import feet  # noqa: E402
+from sinmdm_reference import feet
 
 MODEL = ROOT / "tests" / "data" / "models" / "walk_tiny.onnx"
 WALK = ROOT / "tests" / "data" / "bvh" / "human_walk_cmu_131_01.bvh"

@@ -7,8 +7,7 @@ import numpy as np
 
 from conftest import ROOT
 
-sys.path.insert(0, str(ROOT / "scripts"))
-from sinmdm_reference import noise, schedule  # noqa: E402
+from sinmdm_reference import noise, schedule
 
 
 def test_noise_matches_the_published_values():

@@ -1,4 +1,4 @@
-"""The Rust runtime (`sinmdm`) and the Python reference (`scripts/sinmdm_reference`, numpy +
+"""The Rust runtime (`sinmdm`) and the Python reference (`python/sinmdm_reference`, numpy +
 onnxruntime) give the same features for the same model, seed and arguments, task by task (and
 for a stream); and the
 command line refuses bad input with a clear message and no output file."""
@@ -40,7 +40,7 @@ def rust(*args):
 
 def python(*args):
     done = subprocess.run([sys.executable, "-m", "sinmdm_reference", *map(str, args)],
-                          capture_output=True, text=True, cwd=ROOT / "scripts")
+                          capture_output=True, text=True)
     return done
 
 

@@ -8,14 +8,14 @@
 # also scored with seeds 1-4 and the table gives the mean of the five and its standard error
 # beside seed 0's figures.
 #
-# Usage: scripts/train_table.sh [OUT_DIR] [SHARED_BVH_DIR]
+# Usage: scripts/lab/train_table.sh [OUT_DIR] [SHARED_BVH_DIR]
 #   OUT_DIR         runs, models and eval JSON (default out/train_table); finished runs are kept
 #                   and not trained again, an interrupted one resumes
 #   SHARED_BVH_DIR  the shared clip folder, if you have it: adds the MANN dog walk (60 fps,
 #                   learned at 30 fps and at its own rate) and the zombie walk
 # Pause any other training or benchmark while this runs: the times are wall-clock on this machine.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 out=${1:-out/train_table}
 shared=${2:-}
 mkdir -p "$out"

@@ -8,7 +8,7 @@ reference sizes, the way `cargo bench -p sinmdm-train --bench train_step` does (
 timed steps after two warm-up steps). Run both back to back.
 
 Needs PyTorch, which the project does not install: `pip install torch` in any environment, then
-`python scripts/bench_train_pytorch.py [--threads 2]`.
+`python scripts/lab/bench_train_pytorch.py [--threads 2]`.
 """
 
 import argparse

@@ -2,9 +2,9 @@
 # Scores sampling methods and step counts against 1 000 ancestral steps with `sinmdm eval`
 # (20 samples of twice the clip's length, seed 0) on the shipped models, and prints one
 # Markdown table per model: coverage, global diversity, jitter and seconds per sample.
-# Usage: scripts/sampler_table.sh [OUT_DIR]   (the JSON of every run is kept there)
+# Usage: scripts/lab/sampler_table.sh [OUT_DIR]   (the JSON of every run is kept there)
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 out=${1:-out/sampler_table}
 mkdir -p "$out"
 sinmdm=target/release/sinmdm

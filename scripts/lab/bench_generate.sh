@@ -2,10 +2,10 @@
 # Whole-process time of the default sampling: `sinmdm generate --count 20` of 498-frame samples
 # (twice the walk clip) with the default sampler and steps, planted feet and BVH output
 # included, ROUNDS times; prints every round, the median and the median per sample.
-# Usage: scripts/bench_generate.sh [MODEL.onnx] [ROUNDS] [extra sinmdm generate arguments...]
+# Usage: scripts/lab/bench_generate.sh [MODEL.onnx] [ROUNDS] [extra sinmdm generate arguments...]
 # Pause any training while this runs: this machine has two cores.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 model=${1:-onnx-models/human_walk_cmu.onnx}
 rounds=${2:-5}
 shift $(( $# > 2 ? 2 : $# ))

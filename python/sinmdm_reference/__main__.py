@@ -114,9 +114,9 @@ def main(argv=None):
         else:
             ref = reference(args.content)
             frames, harmonization = tasks.plan_harmonize(model, ref, args.factor, args.free_share)
-        if not 1 <= args.count <= tasks.MAX_COUNT:
-            raise tasks.TaskError(f"--count must be between 1 and {tasks.MAX_COUNT}")
-        if not 1 <= frames <= tasks.MAX_FRAMES:
+        if not 1 <= args.count <= tasks.MAX_SAMPLES:
+            raise tasks.TaskError(f"--count must be between 1 and {tasks.MAX_SAMPLES}")
+        if not 1 <= frames <= tasks.MAX_SAMPLE_FRAMES:
             raise tasks.TaskError(f"a sample of {frames} frames is not possible")
         schedule = tasks.schedule_for(model, _steps(args.steps))
         x = sample(model, schedule, args.count, frames, args.seed, inpainting, harmonization, method=method)

@@ -1,8 +1,8 @@
 """Writes a shipped model's card (onnx-models/NAME.md) from its training run and `sinmdm eval`.
 
 Usage (from the repository root, after training with the default configuration):
-    python3 scripts/model_card.py NAME CLIP.bvh RUN_DIR
-    python3 scripts/model_card.py NAME CLIP.bvh    # the same model, only its evaluation anew
+    python3 scripts/lab/model_card.py NAME CLIP.bvh RUN_DIR
+    python3 scripts/lab/model_card.py NAME CLIP.bvh    # the same model, only its evaluation anew
 
 It copies nothing: put the run's model at onnx-models/NAME.onnx first. The card's clip line and
 its hand-written sections (those before "## Evaluation") are kept from the card it replaces;
