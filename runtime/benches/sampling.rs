@@ -10,7 +10,7 @@ use ndarray::{Array3, ArrayView3};
 use ort::session::Session;
 use ort::value::Tensor;
 use sinmdm::diffusion::Schedule;
-use sinmdm::diffusion::sampler::{Denoiser, Guidance, sample};
+use sinmdm::diffusion::sampler::{Denoiser, Guidance, Sampler};
 use sinmdm::network::{INPUT_FEATURES, INPUT_STEP, OUTPUT_FEATURES};
 use sinmdm::{Model, ModelOptions};
 
@@ -33,7 +33,7 @@ struct BareSession {
 impl BareSession {
     fn open(path: &str, threads: usize, b: usize, f: usize, n: usize) -> BareSession {
         let rt = sinmdm::init_onnxruntime().expect("onnxruntime");
-        let session = Session::builder(&rt.environment)
+        let session = Session::builder(rt.environment())
             .and_then(|s| Ok(s.with_intra_threads(threads)?))
             .and_then(|s| Ok(s.with_intra_op_spinning(false)?))
             .and_then(|mut s| s.commit_from_file(path))
@@ -161,20 +161,15 @@ fn main() {
             };
             let mut bare_total = 0.0;
             let start = Instant::now();
-            let out = sample(
-                &mut timed,
-                &schedule,
-                batch,
-                frames,
-                1,
-                &Guidance::default(),
-                &mut |_, _| {
-                    let entered = Instant::now();
-                    bare_session.call();
-                    bare_total += entered.elapsed().as_secs_f64();
-                },
-            )
-            .unwrap();
+            let guidance = Guidance::default();
+            let mut sampler = Sampler::new(&schedule, &guidance, batch, f, frames, 1).unwrap();
+            while !sampler.is_finished() {
+                sampler.step(&mut timed).unwrap();
+                let entered = Instant::now();
+                bare_session.call();
+                bare_total += entered.elapsed().as_secs_f64();
+            }
+            let out = sampler.into_sample();
             let total = start.elapsed().as_secs_f64() - bare_total;
             std::hint::black_box(out[[0, 0, 0]]);
             bares.push(bare_total / steps as f64);

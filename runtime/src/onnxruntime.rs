@@ -134,8 +134,18 @@ fn locate_in(
 pub struct OnnxRuntime {
     /// The shared library that was loaded.
     pub path: PathBuf,
-    /// The onnxruntime environment (one per process).
-    pub environment: ort::environment::Environment,
+    /// The onnxruntime environment (one per process); kept private so that `ort`'s release
+    /// candidate stays out of the engine API.
+    pub(crate) environment: ort::environment::Environment,
+}
+
+impl OnnxRuntime {
+    /// The onnxruntime environment, for the project's own tests and benchmarks that open
+    /// sessions beside the runtime's (not part of the engine API).
+    #[doc(hidden)]
+    pub fn environment(&self) -> &ort::environment::Environment {
+        &self.environment
+    }
 }
 
 impl std::fmt::Debug for OnnxRuntime {

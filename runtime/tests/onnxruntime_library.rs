@@ -35,5 +35,5 @@ fn onnxruntime_from_the_project_venv_loads() {
         "{e:?}"
     );
     // The library answers: a session builder needs the live onnxruntime API.
-    ort::session::Session::builder(&runtime.environment).expect("onnxruntime did not answer");
+    ort::session::Session::builder(runtime.environment()).expect("onnxruntime did not answer");
 }

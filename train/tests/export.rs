@@ -81,7 +81,7 @@ fn onnxruntime_matches_burn_for_any_batch_and_length() {
     let file = run.join("model.onnx");
     export_model(&model, &state, &file).unwrap();
     let rt = sinmdm::init_onnxruntime().expect("run scripts/setup.sh first");
-    let mut session = Session::builder(&rt.environment)
+    let mut session = Session::builder(rt.environment())
         .unwrap()
         .commit_from_file(&file)
         .unwrap();

@@ -15,6 +15,6 @@ pub use method::Method;
 /// 5 % of all 1 000 on coverage and global diversity (`docs/SAMPLERS.md`) at half the cost of 100.
 pub const DEFAULT_STEPS: usize = 50;
 pub use sampler::{
-    Denoiser, Guidance, Harmonization, Inpainting, Sampler, SamplerError, StepError, sample,
+    Denoiser, Guidance, Harmonization, Inpainting, Sampler, SamplerError, StepError,
 };
 pub use schedule::{DEFAULT_DIFFUSION_STEPS, Schedule, ScheduleError};

@@ -294,22 +294,3 @@ pub enum StepError<E> {
     #[error("the denoiser failed")]
     Denoiser(E),
 }
-
-/// Runs the whole sampling loop for `batch` samples of `frames` frames; returns normalised
-/// features `[B, F, N]`. `progress` is called after each step with (steps done, steps in all).
-pub fn sample<D: Denoiser>(
-    denoiser: &mut D,
-    schedule: &Schedule,
-    batch: usize,
-    frames: usize,
-    seed: u64,
-    guidance: &Guidance,
-    progress: &mut dyn FnMut(usize, usize),
-) -> Result<Array3<f32>, StepError<D::Error>> {
-    let mut sampler = Sampler::new(schedule, guidance, batch, denoiser.features(), frames, seed)?;
-    while !sampler.is_finished() {
-        sampler.step(denoiser)?;
-        progress(sampler.done(), sampler.steps());
-    }
-    Ok(sampler.into_sample())
-}
