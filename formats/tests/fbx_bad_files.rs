@@ -9,7 +9,7 @@ use sinmdm_formats::fbx::read_fbx;
 use sinmdm_formats::{AnimationChoice, ReadOptions, read_clip};
 
 mod common;
-use common::{fbx_fixture, root};
+use common::{Rng, fbx_fixture, root};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("sinmdm-bad-fbx-{}", std::process::id()));
@@ -156,23 +156,6 @@ fn each_kind_of_problem_is_named() {
         "{message}"
     );
     std::fs::remove_file(path).unwrap();
-}
-
-/// A small deterministic generator (SplitMix64).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
 }
 
 /// `bytes` with a few random edits: bytes overwritten, a run deleted, or the tail cut off.

@@ -12,6 +12,9 @@ use sinmdm_formats::ReadOptions;
 use sinmdm_formats::gltf::container::{Asset, glb_bytes, parse_glb};
 use sinmdm_formats::gltf::{GltfWriteOptions, gltf_document, read_gltf};
 
+mod common;
+use common::Rng;
+
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -156,23 +159,6 @@ fn each_problem_is_named_with_the_file_and_the_part() {
         "{message}"
     );
     std::fs::remove_file(path).unwrap();
-}
-
-/// A small deterministic generator (SplitMix64).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
 }
 
 /// Every path to a value inside `value`.

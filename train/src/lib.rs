@@ -17,8 +17,11 @@ pub mod loss_plot;
 pub mod memory;
 pub mod model;
 pub mod motion_span;
+pub mod pace;
 pub mod recovery;
+pub mod run_folder;
 mod shards;
+pub mod step;
 pub mod trainer;
 pub mod weight_average;
 

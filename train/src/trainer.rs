@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use burn::module::Module;
-use burn::optim::{AdamWConfig, ModuleOptimizer};
+use burn::optim::ModuleOptimizer;
 use burn::tensor::{Device, Tensor, TensorData};
 
 use sinmdm::diffusion::Schedule;
@@ -17,39 +17,15 @@ use crate::config::TrainConfig;
 use crate::data::make_batch;
 use crate::error::{TrainError, io};
 use crate::loss_log::LossLog;
-use crate::model::{QnaUnet, on_cpu};
+use crate::model::QnaUnet;
+pub use crate::pace::{StepReport, seconds_per_step};
 use crate::recovery::{NonFinite, RecoveryEvent, RecoveryRecord};
-use crate::shards::{gradients_are_finite, poison_first_gradient, sharded_gradients};
+use crate::run_folder::clip_copy;
+pub use crate::run_folder::{CLIP_COPY, CONFIG_COPY, LOSS_LOG, saved_clip};
+use crate::step::step_with_fault;
+pub use crate::step::{StepOutcome, new_optimizer, optimisation_step};
 use crate::weight_average::WeightAverage;
 
-/// Copy of the clip inside the run folder, so a run resumes without the original file: this
-/// name with the clip's own extension (`clip.bvh`, `clip.glb`, `clip.gltf`).
-pub const CLIP_COPY: &str = "clip";
-/// The extensions a clip copy may have.
-const CLIP_EXTENSIONS: [&str; 4] = ["bvh", "glb", "gltf", "fbx"];
-
-/// The clip copy in run folder `run` for a clip at `clip` (its extension kept, lower-case).
-fn clip_copy(run: &Path, clip: &Path) -> PathBuf {
-    let extension = clip
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .filter(|e| CLIP_EXTENSIONS.contains(&e.as_str()))
-        .unwrap_or_else(|| "bvh".into());
-    run.join(format!("{CLIP_COPY}.{extension}"))
-}
-
-/// The clip copy a run folder holds, if any.
-pub fn saved_clip(run: &Path) -> Option<PathBuf> {
-    CLIP_EXTENSIONS
-        .iter()
-        .map(|e| run.join(format!("{CLIP_COPY}.{e}")))
-        .find(|p| p.is_file())
-}
-/// Copy of the configuration inside the run folder.
-pub const CONFIG_COPY: &str = "config.yaml";
-/// The loss log inside the run folder.
-pub const LOSS_LOG: &str = "loss.csv";
 /// Steps averaged into `recent_loss`.
 const RECENT_STEPS: usize = 100;
 
@@ -60,35 +36,6 @@ pub enum RunEnd {
     Finished(PathBuf),
     /// The stop flag was raised; a checkpoint of the last completed step is at the path.
     Interrupted(PathBuf),
-}
-
-/// What the loop reports after each step.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepReport {
-    /// Steps completed.
-    pub step: u64,
-    /// Steps configured.
-    pub total: u64,
-    /// This step's loss.
-    pub loss: f64,
-    /// Mean loss over the last 100 steps.
-    pub recent_loss: f64,
-    /// Learning rate used by this step.
-    pub learning_rate: f64,
-    /// Seconds of training so far, earlier sessions of a resumed run included.
-    pub seconds: f64,
-    /// What the trainer did about a non-finite step, when this step was one.
-    pub event: Option<RecoveryEvent>,
-}
-
-impl StepReport {
-    /// Seconds the remaining steps should take at the run's mean pace so far.
-    pub fn seconds_left(&self) -> f64 {
-        if self.step == 0 {
-            return 0.0;
-        }
-        self.seconds / self.step as f64 * self.total.saturating_sub(self.step) as f64
-    }
 }
 
 /// A training run in a run folder.
@@ -108,83 +55,6 @@ pub struct Trainer {
     last_checkpoint: Option<PathBuf>,
     /// Steps (1-based) whose gradients tests turn into NaN, once each.
     injected_faults: BTreeSet<u64>,
-}
-
-/// How one optimiser step ended.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum StepOutcome {
-    /// The model was updated; the batch's loss.
-    Updated(f64),
-    /// Nothing was changed: the loss or a gradient was not finite.
-    Skipped {
-        /// The batch's loss (finite when a gradient was the problem).
-        loss: f64,
-        /// What was not finite.
-        cause: NonFinite,
-    },
-}
-
-/// The optimiser of a configuration (AdamW, epsilon 1e-8 as in PyTorch).
-pub fn new_optimizer(config: &TrainConfig) -> ModuleOptimizer {
-    AdamWConfig::new()
-        .with_weight_decay(config.training.weight_decay as f32)
-        .with_epsilon(1e-8)
-        .init()
-}
-
-/// One AdamW step on the x0-prediction MSE of `model` for the batch `(x_t, t) -> x0`. Returns
-/// the updated model and the loss; when the loss or any gradient is not finite the model comes
-/// back unchanged (and the optimiser's state too), and the outcome says which.
-///
-/// The batch is cut into as many shards as rayon has threads (at least one item each), whose
-/// forward and backward passes run in parallel on their own threads. burn-flex runs element-wise
-/// operations on one thread, so this is what puts the other cores to work outside the matrix
-/// products (1.3-1.6x on 2 cores). Each shard's loss is weighted by its share of the batch, so the
-/// summed gradients are those of the whole batch's mean loss; GroupNorm's statistics are per
-/// item and the dropout masks are keyed by item, so nothing else depends on the split, which
-/// is fixed for a given thread count (same seed and `--threads`, same run). The loss is the
-/// x0 MSE.
-pub fn optimisation_step(
-    model: QnaUnet,
-    optimizer: &mut ModuleOptimizer,
-    x_t: Tensor<3>,
-    t: Tensor<1>,
-    x0: Tensor<3>,
-    learning_rate: f64,
-) -> (QnaUnet, StepOutcome) {
-    step_with_fault(model, optimizer, (x_t, t, x0), learning_rate, false)
-}
-
-/// [`optimisation_step`], with the gradients poisoned first when `inject_fault` is set.
-fn step_with_fault(
-    model: QnaUnet,
-    optimizer: &mut ModuleOptimizer,
-    (x_t, t, x0): (Tensor<3>, Tensor<1>, Tensor<3>),
-    learning_rate: f64,
-    inject_fault: bool,
-) -> (QnaUnet, StepOutcome) {
-    // A GPU runs one batch best whole.
-    let shards = if on_cpu(&x_t.device()) {
-        rayon::current_num_threads()
-    } else {
-        1
-    };
-    let (loss, grads) = sharded_gradients(&model, x_t, t, x0, shards);
-    let Some(mut grads) = grads else {
-        let cause = NonFinite::Loss;
-        return (model, StepOutcome::Skipped { loss, cause });
-    };
-    if inject_fault {
-        poison_first_gradient(&model, &mut grads);
-    }
-    if !gradients_are_finite(&model, &grads) {
-        let cause = NonFinite::Gradient;
-        return (model, StepOutcome::Skipped { loss, cause });
-    }
-    (
-        optimizer.step(learning_rate, model, grads),
-        StepOutcome::Updated(loss),
-    )
 }
 
 /// A new network, its weight average and optimiser for `config`, drawn from the run's seed.
@@ -236,6 +106,35 @@ fn schedule(config: &TrainConfig) -> Schedule {
 }
 
 impl Trainer {
+    /// A trainer of the run in `run` from its parts, its state and its open loss log;
+    /// `last_checkpoint` is the one it resumed from.
+    fn assemble(
+        run: &Path,
+        device: Device,
+        (model, average, optimizer): (QnaUnet, Option<WeightAverage>, ModuleOptimizer),
+        clip: ClipData,
+        state: CheckpointState,
+        log: LossLog,
+        last_checkpoint: Option<PathBuf>,
+    ) -> Trainer {
+        Trainer {
+            run: run.to_path_buf(),
+            device,
+            model: Some(model),
+            average,
+            optimizer,
+            schedule: schedule(&state.config),
+            clip,
+            elapsed_before: state.elapsed_seconds,
+            state,
+            recent: VecDeque::new(),
+            log,
+            session_start: Instant::now(),
+            last_checkpoint,
+            injected_faults: BTreeSet::new(),
+        }
+    }
+
     /// Starts a new run of `config` on `clip` in the folder `run` (created if needed; it must
     /// not already hold a run).
     pub fn start(
@@ -277,22 +176,10 @@ impl Trainer {
             recovery: RecoveryRecord::default(),
             config: config.clone(),
         };
-        Ok(Trainer {
-            run: run.to_path_buf(),
-            device,
-            model: Some(model),
-            average,
-            optimizer,
-            schedule: schedule(&config),
-            clip: data,
-            state,
-            recent: VecDeque::new(),
-            log,
-            session_start: Instant::now(),
-            elapsed_before: 0.0,
-            last_checkpoint: None,
-            injected_faults: BTreeSet::new(),
-        })
+        let parts = (model, average, optimizer);
+        Ok(Trainer::assemble(
+            run, device, parts, data, state, log, None,
+        ))
     }
 
     /// Continues the run in `run` from its newest checkpoint. A `config`, when given, must
@@ -348,24 +235,17 @@ impl Trainer {
         }
         let (model, average, optimizer) = load_parts(&dir, &state, &device)?;
         let log = LossLog::resume(&run.join(LOSS_LOG), state.step)?;
-        let elapsed_before = state.elapsed_seconds;
         state.batch = Some(state.config.training.batch_shape(data.features.ncols()));
-        Ok(Trainer {
-            run: run.to_path_buf(),
+        let parts = (model, average, optimizer);
+        Ok(Trainer::assemble(
+            run,
             device,
-            model: Some(model),
-            average,
-            optimizer,
-            schedule: schedule(&state.config),
-            clip: data,
+            parts,
+            data,
             state,
-            recent: VecDeque::new(),
             log,
-            session_start: Instant::now(),
-            elapsed_before,
-            last_checkpoint: Some(dir),
-            injected_faults: BTreeSet::new(),
-        })
+            Some(dir),
+        ))
     }
 
     /// The checkpoint state as of now.
@@ -612,62 +492,5 @@ impl Trainer {
     /// The loss log's path.
     pub fn loss_log(&self) -> &Path {
         self.log.path()
-    }
-}
-
-/// Seconds one optimiser step of `config` on `clip` takes on `device`: the mean of `steps`
-/// timed steps (after two untimed ones) of a throw-away run in a temporary folder. The mean,
-/// not the median: each step stretches the clip by its own random factor, and a budget is
-/// spent on the sum of the steps, slow ones included. This is what a time budget
-/// (`sinmdm-train --minutes`) turns into a step count.
-pub fn seconds_per_step(
-    clip: &Path,
-    config: &TrainConfig,
-    device: Device,
-    steps: u64,
-) -> Result<f64, TrainError> {
-    let folder = std::env::temp_dir().join(format!("sinmdm-timing-probe-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&folder);
-    let mut probe_config = config.clone();
-    probe_config.training.steps = steps + 2;
-    probe_config.training.warmup_steps = 0;
-    let measured = (|| {
-        let mut trainer = Trainer::start(clip, probe_config, &folder, device)?;
-        let mut times = Vec::new();
-        for i in 0..steps + 2 {
-            let begun = Instant::now();
-            trainer.step()?;
-            if i >= 2 {
-                times.push(begun.elapsed().as_secs_f64());
-            }
-        }
-        Ok(times.iter().sum::<f64>() / times.len().max(1) as f64)
-    })();
-    let _ = std::fs::remove_dir_all(&folder);
-    measured
-}
-
-#[cfg(test)]
-mod tests {
-    use super::StepReport;
-
-    fn report(step: u64, total: u64, seconds: f64) -> StepReport {
-        StepReport {
-            step,
-            total,
-            loss: 0.1,
-            recent_loss: 0.1,
-            learning_rate: 1e-4,
-            seconds,
-            event: None,
-        }
-    }
-
-    #[test]
-    fn time_left_follows_the_mean_pace() {
-        // 100 steps in 60 s: 300 more take 180 s.
-        assert_eq!(report(100, 400, 60.0).seconds_left(), 180.0);
-        assert_eq!(report(400, 400, 240.0).seconds_left(), 0.0);
-        assert_eq!(report(0, 400, 0.0).seconds_left(), 0.0);
     }
 }

@@ -7,6 +7,8 @@ use sinmdm::network::{FIXED_RECEPTIVE_HALF_WIDTH, QNA_BLOCKS};
 
 use crate::error::TrainError;
 
+mod validate;
+
 /// A whole training configuration (`configs/*.yaml`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -235,105 +237,6 @@ impl TrainConfig {
         config.validate()?;
         Ok(config)
     }
-
-    /// Checks every value; the error names the key.
-    pub fn validate(&self) -> Result<(), String> {
-        let m = &self.model;
-        let t = &self.training;
-        let positive = [
-            ("model.channels", m.channels as f64),
-            ("model.heads", m.heads as f64),
-            ("model.window", m.window as f64),
-            ("training.steps", t.steps as f64),
-            ("training.batch_size", t.batch_size as f64),
-            ("training.learning_rate", t.learning_rate),
-            ("training.lr_decay", t.lr_decay),
-            ("training.resample_min", t.resample_min),
-            ("training.resample_max", t.resample_max),
-            ("training.checkpoint_every", t.checkpoint_every as f64),
-            ("data.contact_speed", self.data.contact_speed),
-        ];
-        for (key, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(format!("{key} must be a positive number, got {value}"));
-            }
-        }
-        // The network contract's shape rules, named by the config's keys.
-        let shape = sinmdm::network::NetworkShape {
-            features: 1,
-            channels: m.channels,
-            heads: m.heads,
-            window: m.window,
-        };
-        if let Err(rule) = shape.check() {
-            return Err(format!(
-                "model (channels {}, heads {}, window {}): {rule}",
-                m.channels, m.heads, m.window
-            ));
-        }
-        if !(0.0..1.0).contains(&m.dropout) {
-            return Err(format!(
-                "model.dropout must be in [0, 1), got {}",
-                m.dropout
-            ));
-        }
-        if self.diffusion.steps < 2 {
-            return Err(format!(
-                "diffusion.steps must be at least 2, got {}",
-                self.diffusion.steps
-            ));
-        }
-        if t.lr_decay > 1.0 {
-            return Err(format!(
-                "training.lr_decay must be at most 1, got {}",
-                t.lr_decay
-            ));
-        }
-        if let Some(d) = t.ema_decay
-            && !(d > 0.0 && d < 1.0)
-        {
-            return Err(format!(
-                "training.ema_decay must be between 0 and 1 (exclusive) or null, got {d}"
-            ));
-        }
-        if t.warmup_steps > 0 && t.lr_schedule != LrSchedule::Cosine {
-            return Err("training.warmup_steps applies to lr_schedule: cosine only".into());
-        }
-        if t.warmup_steps >= t.steps {
-            return Err(format!(
-                "training.warmup_steps ({}) must be fewer than training.steps ({})",
-                t.warmup_steps, t.steps
-            ));
-        }
-        if !(t.weight_decay.is_finite() && t.weight_decay >= 0.0) {
-            return Err(format!(
-                "training.weight_decay must be zero or positive, got {}",
-                t.weight_decay
-            ));
-        }
-        if t.resample_min > t.resample_max {
-            return Err(format!(
-                "training.resample_min ({}) must not exceed training.resample_max ({})",
-                t.resample_min, t.resample_max
-            ));
-        }
-        if let Some(w) = t.frames_per_step
-            && w < m.receptive_field()
-        {
-            return Err(format!(
-                "training.frames_per_step must be at least the receptive field ({} frames), got {w}",
-                m.receptive_field()
-            ));
-        }
-        if let Some(fps) = self.data.fps
-            && !(fps.is_finite() && fps > 0.0)
-        {
-            return Err(format!(
-                "data.fps must be a positive number or null, got {fps}"
-            ));
-        }
-        Ok(())
-    }
 }
 
 impl ModelConfig {
@@ -408,19 +311,19 @@ fn first_difference(
 mod tests {
     use super::*;
 
-    const TINY: &str = include_str!("../../configs/tiny.yaml");
+    const TINY: &str = include_str!("../../../configs/tiny.yaml");
 
     #[test]
     fn shipped_configs_parse() {
         for text in [
             TINY,
-            include_str!("../../configs/cpu.yaml"),
-            include_str!("../../configs/paper.yaml"),
-            include_str!("../../configs/default.yaml"),
+            include_str!("../../../configs/cpu.yaml"),
+            include_str!("../../../configs/paper.yaml"),
+            include_str!("../../../configs/default.yaml"),
         ] {
             TrainConfig::parse(text).unwrap();
         }
-        let paper = TrainConfig::parse(include_str!("../../configs/paper.yaml")).unwrap();
+        let paper = TrainConfig::parse(include_str!("../../../configs/paper.yaml")).unwrap();
         assert_eq!(paper.model.channels, 256);
         assert_eq!(paper.training.batch_size, 64);
         assert_eq!(paper.training.steps, 60_000);
@@ -429,7 +332,7 @@ mod tests {
 
     #[test]
     fn frames_per_step_sets_items_and_window_from_the_clip_length() {
-        let default = TrainConfig::parse(include_str!("../../configs/default.yaml")).unwrap();
+        let default = TrainConfig::parse(include_str!("../../../configs/default.yaml")).unwrap();
         let t = &default.training;
         assert_eq!(t.frames_per_step, Some(1024));
         // 1024 / 249 = 4.1; 1024 / 302 = 3.4; 1024 / 527 = 1.9; 1024 / 1054 = 0.97 is one item,
@@ -459,7 +362,7 @@ mod tests {
 
     #[test]
     fn frames_per_step_covers_the_receptive_field_and_lost_knobs_are_refused() {
-        let text = include_str!("../../configs/default.yaml");
+        let text = include_str!("../../../configs/default.yaml");
         // The knobs that lost their experiments are gone, and a config that still sets one is
         // told so by name.
         for knob in [
@@ -486,7 +389,7 @@ mod tests {
 
     #[test]
     fn the_cosine_schedule_warms_up_then_falls_to_zero() {
-        let mut t = TrainConfig::parse(include_str!("../../configs/default.yaml"))
+        let mut t = TrainConfig::parse(include_str!("../../../configs/default.yaml"))
             .unwrap()
             .training;
         t.steps = 1100;
@@ -531,7 +434,7 @@ mod tests {
                 "unknown variant `linear`",
             ),
         ];
-        let default = include_str!("../../configs/default.yaml");
+        let default = include_str!("../../../configs/default.yaml");
         for (from, to, expected) in cases {
             assert!(default.contains(from), "default.yaml lacks `{from}`");
             let err = TrainConfig::parse(&default.replacen(from, to, 1)).unwrap_err();
@@ -574,7 +477,7 @@ mod tests {
 
     #[test]
     fn a_window_that_follows_the_frame_rate_widens_with_it() {
-        let default = TrainConfig::parse(include_str!("../../configs/default.yaml")).unwrap();
+        let default = TrainConfig::parse(include_str!("../../../configs/default.yaml")).unwrap();
         assert!(default.model.window_follows_fps);
         assert_eq!(default.model.window, 3);
         let window = |fps| default.at_fps(fps).model.window;
@@ -603,7 +506,7 @@ mod tests {
         // A resume that asks for the default again resolves it the same way: no difference.
         assert_eq!(resolved.resume_difference(&default.at_fps(60.0)), None);
         // Off (the paper's configs): the window is the one written, at any frame rate.
-        let paper = TrainConfig::parse(include_str!("../../configs/paper.yaml")).unwrap();
+        let paper = TrainConfig::parse(include_str!("../../../configs/paper.yaml")).unwrap();
         assert!(!paper.model.window_follows_fps);
         assert_eq!(paper.at_fps(120.0).model.window, 3);
         // The saved YAML records the flag only when it is on.
@@ -618,7 +521,7 @@ mod tests {
 
     #[test]
     fn resume_compares_every_setting_but_the_step_counts() {
-        let saved = TrainConfig::parse(include_str!("../../configs/tiny.yaml")).unwrap();
+        let saved = TrainConfig::parse(include_str!("../../../configs/tiny.yaml")).unwrap();
         let mut asked = saved.clone();
         asked.training.steps += 100;
         asked.training.checkpoint_every += 1;
