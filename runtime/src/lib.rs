@@ -33,15 +33,18 @@
 //! # }
 //! ```
 //!
-//! The modules hold the rest: [`motion`] (skeletons, rotations, the feature vector),
-//! [`bvh`] (files), [`diffusion`] (schedule, portable noise, sampler), [`tasks`] (spans,
-//! masks), [`model_file`] (the metadata schema), [`network`] (the contract between training,
-//! export and this runtime) and [`limits`] (every bound on what the engine is given).
+//! Besides this page: [`bvh`] (BVH files in and out), [`model_file`] (the metadata a model file
+//! carries) and [`limits`] (every bound on what the engine is given).
 
 #![warn(missing_docs)]
 
+// The documented surface is this page, [`bvh`], [`limits`] and [`model_file`]. The other
+// modules are the plumbing that the project's other crates (training, export, formats, the
+// command line, the C ABI) and its tests build on: public so they can, hidden from the
+// documentation so an engine programmer is not asked to read them.
 #[cfg(feature = "bvh")]
 pub mod bvh;
+#[doc(hidden)]
 pub mod diffusion;
 #[doc(hidden)]
 pub mod features_file;
@@ -50,17 +53,22 @@ pub mod files;
 pub mod limits;
 mod model;
 pub mod model_file;
+#[doc(hidden)]
 pub mod motion;
+#[doc(hidden)]
 pub mod network;
 mod onnxruntime;
+#[doc(hidden)]
 pub mod stream;
+#[doc(hidden)]
 pub mod tasks;
 
-pub use diffusion::{DEFAULT_STEPS, Denoiser, Method, Sampler, SamplerError};
+pub use diffusion::{DEFAULT_STEPS, Denoiser, Method, Sampler, SamplerError, StepError};
 pub use model::{Model, ModelError, ModelOptions};
 pub use model_file::ModelMetadata;
 pub use motion::{
-    Feet, Joint, Pose, Quaternion, Skeleton, UpAxis, features_from_poses, motion_from_poses,
+    Channel, FeatureLayout, Feet, Joint, LocalMotion, Pose, Quaternion, Skeleton, UpAxis,
+    features_from_poses, motion_from_poses,
 };
 pub use onnxruntime::{
     ONNXRUNTIME_VERSION, OnnxRuntime, RuntimeLibraryError, init as init_onnxruntime,

@@ -1,5 +1,5 @@
 //! Ancestral DDPM sampling (SPEC section 4) with the two kinds of guidance of section 5
-//! ([`Guidance`]), one step at a time ([`Sampler`]) or in one call ([`sample`]).
+//! ([`Guidance`]), one step at a time ([`Sampler`]); `Plan::run` steps one to the end.
 //!
 //! One sampling run, with `S` kept steps and schedule index `k` running from `S - 1` down to 0
 //! (`step = S - 1 - k` counts the steps done):
@@ -81,7 +81,7 @@ pub enum SamplerError {
 
 /// A sampling run in progress: noise drawn, steps taken one at a time by [`Sampler::step`].
 ///
-/// Stepping to the end gives exactly what [`sample`] gives (it is the same code), so a caller
+/// Stepping to the end gives exactly what `Plan::run` gives (it is the same code), so a caller
 /// can spread a run over frames of a game, report progress or stop early.
 pub struct Sampler<'a> {
     schedule: &'a Schedule,
