@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use sinmdm::motion::up::{choose_up, to_canonical};
+use sinmdm::motion::up::to_canonical;
+use sinmdm::motion::up_detect::choose_up;
 use sinmdm::motion::{UpAxis, global_poses, skeleton_height};
 
 use crate::clip_files::{

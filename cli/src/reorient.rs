@@ -9,7 +9,8 @@ use sinmdm::bvh::write_bvh;
 
 use crate::clip_files::read_motion_file;
 use sinmdm::motion::math;
-use sinmdm::motion::up::{UP, UpAxis, detect_up, reorient, reorient_problem};
+use sinmdm::motion::up::{UP, UpAxis, reorient, reorient_problem};
+use sinmdm::motion::up_detect::detect_up;
 
 pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm reorient zup_clip.bvh --to y -o yup_clip.bvh         # for a Y-up engine

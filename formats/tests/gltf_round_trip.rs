@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use sinmdm::bvh::{parse_bvh, read_bvh, to_bvh_string};
 use sinmdm::motion::math::{self, Vec3};
-use sinmdm::motion::up::choose_up;
+use sinmdm::motion::up_detect::choose_up;
 use sinmdm::motion::{LocalMotion, UpAxis, global_poses, skeleton_height};
 use sinmdm_formats::ReadOptions;
 use sinmdm_formats::gltf::{GltfWriteOptions, read_gltf, write_gltf};

@@ -1,15 +1,7 @@
-//! How fast a run goes: what the loop reports after each step (with the time the rest should
-//! take), and the probe that turns a time budget into a step count.
+//! How fast a run goes: what the loop reports after each step, with the time the rest should
+//! take.
 
-use std::path::Path;
-use std::time::Instant;
-
-use burn::tensor::Device;
-
-use crate::config::TrainConfig;
-use crate::error::TrainError;
 use crate::recovery::RecoveryEvent;
-use crate::trainer::Trainer;
 
 /// What the loop reports after each step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,38 +30,6 @@ impl StepReport {
         }
         self.seconds / self.step as f64 * self.total.saturating_sub(self.step) as f64
     }
-}
-
-/// Seconds one optimiser step of `config` on `clip` takes on `device`: the mean of `steps`
-/// timed steps (after two untimed ones) of a throw-away run in a temporary folder. The mean,
-/// not the median: each step stretches the clip by its own random factor, and a budget is
-/// spent on the sum of the steps, slow ones included. This is what a time budget
-/// (`sinmdm-train --minutes`) turns into a step count.
-pub fn seconds_per_step(
-    clip: &Path,
-    config: &TrainConfig,
-    device: Device,
-    steps: u64,
-) -> Result<f64, TrainError> {
-    let folder = std::env::temp_dir().join(format!("sinmdm-timing-probe-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&folder);
-    let mut probe_config = config.clone();
-    probe_config.training.steps = steps + 2;
-    probe_config.training.warmup_steps = 0;
-    let measured = (|| {
-        let mut trainer = Trainer::start(clip, probe_config, &folder, device)?;
-        let mut times = Vec::new();
-        for i in 0..steps + 2 {
-            let begun = Instant::now();
-            trainer.step()?;
-            if i >= 2 {
-                times.push(begun.elapsed().as_secs_f64());
-            }
-        }
-        Ok(times.iter().sum::<f64>() / times.len().max(1) as f64)
-    })();
-    let _ = std::fs::remove_dir_all(&folder);
-    measured
 }
 
 #[cfg(test)]

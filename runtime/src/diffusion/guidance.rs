@@ -3,7 +3,7 @@
 
 use ndarray::{Array2, Array3, ArrayView3, Axis, Zip};
 
-use super::sampler::SamplerError;
+use super::error::SamplerError;
 
 /// Keep parts of a clean reference: `x0 <- x0 (1 - M) + y M` at every step.
 #[derive(Debug, Clone, PartialEq)]

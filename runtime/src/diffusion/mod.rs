@@ -1,6 +1,7 @@
 //! The diffusion process shared by training and sampling: the schedule, the portable noise, the
 //! guidance of the tasks and the sampler.
 
+mod error;
 mod guidance;
 pub mod method;
 pub mod noise;

@@ -21,6 +21,7 @@
 use ndarray::{Array3, ArrayView3, Zip};
 use thiserror::Error;
 
+pub use super::error::SamplerError;
 pub use super::guidance::{Guidance, Harmonization, Inpainting, downsample, low_pass, upsample};
 use super::method::Method;
 use super::noise::{HARMONIZE_STREAM_BASE, INITIAL_NOISE_STREAM};
@@ -36,47 +37,6 @@ pub trait Denoiser {
     /// Predicted clean features `[B, F, N]` from noisy `x_t` `[B, F, N]` at original timesteps
     /// `t` (one per batch row).
     fn denoise(&mut self, x_t: ArrayView3<'_, f32>, t: &[i64]) -> Result<Array3<f32>, Self::Error>;
-}
-
-/// A sampling run that cannot be set up as asked.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
-pub enum SamplerError {
-    /// No samples or no frames.
-    #[error(
-        "a sampling run needs at least one sample of at least one frame, got {batch} x {frames}"
-    )]
-    Empty {
-        /// Samples asked for.
-        batch: usize,
-        /// Frames asked for.
-        frames: usize,
-    },
-    /// A guidance array whose shape is not the sample's `[F, N]`.
-    #[error("the {what} is {got:?}, the samples are [{features}, {frames}] (feature rows, frames)")]
-    Shape {
-        /// Which array.
-        what: &'static str,
-        /// Its `[rows, frames]`.
-        got: (usize, usize),
-        /// F of the run.
-        features: usize,
-        /// N of the run.
-        frames: usize,
-    },
-    /// A harmonization low-pass factor of 0.
-    #[error("the harmonization down-sampling factor must be at least 1")]
-    ZeroFactor,
-    /// A sampling method with a setting out of range.
-    #[error("{0}")]
-    Method(String),
-    /// A denoiser whose feature rows are not the run's.
-    #[error("the denoiser has {denoiser} feature rows, the run {run}")]
-    Features {
-        /// F of the denoiser.
-        denoiser: usize,
-        /// F of the run.
-        run: usize,
-    },
 }
 
 /// A sampling run in progress: noise drawn, steps taken one at a time by [`Sampler::step`].

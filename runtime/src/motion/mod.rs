@@ -6,6 +6,7 @@ pub mod contacts;
 pub mod features;
 pub mod feet;
 pub mod fk;
+pub mod ground;
 pub mod ik;
 pub mod math;
 pub mod normalize;
@@ -14,6 +15,7 @@ pub mod resample;
 pub mod rotation;
 pub mod skeleton;
 pub mod up;
+pub mod up_detect;
 
 pub use clip::{ChannelClip, LocalMotion, fps_from_frame_time};
 pub use contacts::ContactConfig;
@@ -26,4 +28,5 @@ pub use fk::{GlobalPose, global_pose, global_poses, max_position_error, skeleton
 pub use normalize::Normalizer;
 pub use pose::{Pose, Quaternion, features_from_poses, motion_from_poses, poses};
 pub use skeleton::{Axis, Channel, Joint, Skeleton};
-pub use up::{Confidence, UpAxis, UpDetection, detect_up};
+pub use up::UpAxis;
+pub use up_detect::{Confidence, UpDetection, choose_up, detect_up};

@@ -8,13 +8,14 @@ use super::layout::{FeatureLayout, RootFeatures};
 use crate::limits::MAX_ENCODED_FRAMES;
 use crate::motion::clip::{ChannelClip, LocalMotion};
 use crate::motion::contacts::{ContactConfig, choose_contact_joints, label_contacts};
-use crate::motion::feet::ground_level;
 use crate::motion::fk::{global_pose, global_poses, skeleton_height};
+use crate::motion::ground::ground_level;
 use crate::motion::math::{self, IDENTITY, Vec3};
 use crate::motion::resample::resample;
 use crate::motion::rotation::mat_to_6d;
 use crate::motion::skeleton::{Axis, Channel, Skeleton};
-use crate::motion::up::{UP, UpAxis, UpDetection, choose_up, to_canonical};
+use crate::motion::up::{UP, UpAxis, to_canonical};
+use crate::motion::up_detect::{UpDetection, choose_up};
 
 /// How a clip becomes features.
 #[derive(Debug, Clone, PartialEq)]
@@ -23,7 +24,7 @@ pub struct EncodeOptions {
     pub fps: Option<f64>,
     /// Contact joints and threshold.
     pub contacts: ContactConfig,
-    /// The clip's up axis; `None` detects it from the motion ([`crate::motion::up::detect_up`]).
+    /// The clip's up axis; `None` detects it from the motion ([`crate::motion::up_detect::detect_up`]).
     pub up: Option<UpAxis>,
 }
 

@@ -91,7 +91,7 @@ pub struct FeatureLayout {
     #[serde(default)]
     pub up: UpAxis,
     /// The clip's ground level: a canonical-frame height in file units, where its contact
-    /// points rest ([`crate::motion::feet::ground_level`]). Model files written before the
+    /// points rest ([`crate::motion::ground::ground_level`]). Model files written before the
     /// field existed lack it; foot planting then reads the ground from the motion it plants.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ground: Option<f64>,

@@ -7,7 +7,8 @@ use super::error::MotionError;
 use super::layout::FeatureLayout;
 use crate::motion::clip::ChannelClip;
 use crate::motion::math;
-use crate::motion::up::{Confidence, UpAxis, detect_up, reorient, reorient_problem};
+use crate::motion::up::{UpAxis, reorient, reorient_problem};
+use crate::motion::up_detect::{Confidence, detect_up};
 
 /// A clip encoded for a model, and how its up axis was settled.
 #[derive(Debug, Clone, PartialEq)]

@@ -6,7 +6,6 @@
 //!
 //! - [`spans`]: contact spans from labels (hysteresis, shortest span) and blend weights;
 //! - [`chain`]: which joints above a contact joint may turn;
-//! - [`ground`]: the ground level of a motion;
 //! - [`options`]: what the pass is asked, must keep, and reports;
 //! - [`plant`]: the pass itself, phase by phase ([`plant_feet`]);
 //! - `stance`: the root's horizontal travel with the feet in contact, before the legs turn;
@@ -15,7 +14,6 @@
 //!   the lift that keeps the motion above the ground.
 
 pub mod chain;
-pub mod ground;
 pub mod options;
 pub mod plant;
 mod solve;
@@ -23,8 +21,8 @@ pub mod spans;
 mod stance;
 mod targets;
 
+pub use crate::motion::ground::{GROUND_PERCENTILE, ground_level};
 pub use chain::{LegChain, leg_chain};
-pub use ground::{GROUND_PERCENTILE, ground_level};
 pub use options::{Anchor, Kept, PlantOptions, PlantStats};
 pub use plant::plant_feet;
 pub use spans::{CONTACT_OFF, CONTACT_ON, contact_spans};

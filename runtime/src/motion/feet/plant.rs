@@ -5,7 +5,6 @@
 use std::ops::Range;
 
 use super::chain::{LegChain, leg_chain};
-use super::ground::ground_level;
 use super::options::{Kept, PlantOptions, PlantStats};
 use super::solve::{Wanted, lowest, smooth_upper_envelope, solve_frame};
 use super::spans::contact_spans;
@@ -14,6 +13,7 @@ use super::targets::{ChainTrack, chain_targets, grow_spans};
 use crate::motion::clip::LocalMotion;
 use crate::motion::features::{FeatureLayout, MotionError};
 use crate::motion::fk::{GlobalPose, global_pose, global_poses};
+use crate::motion::ground::ground_level;
 use crate::motion::math::{self, Vec3};
 use crate::motion::up::{UP, height_of, horizontal, to_canonical, to_file};
 

@@ -236,11 +236,8 @@ pub fn reorient_problem(skeleton: &Skeleton) -> Option<String> {
     })
 }
 
-mod detect;
-
-pub use detect::{
-    Confidence, MIN_ALIGNMENT, MIN_FRAMES, MIN_STRENGTH, UpDetection, choose_up, detect_up,
-};
+// Detecting the up axis from a motion lives beside this module (`super::up_detect`): it needs
+// forward kinematics and contacts, which need this module's frame.
 
 #[cfg(test)]
 mod tests {

@@ -3,12 +3,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::UpAxis;
 use crate::motion::clip::LocalMotion;
 use crate::motion::contacts::travelling_root;
 use crate::motion::fk::global_poses;
 use crate::motion::math::{self, Vec3};
 use crate::motion::skeleton::Skeleton;
+use crate::motion::up::UpAxis;
 
 /// How sure [`detect_up`] is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
