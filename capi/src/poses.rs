@@ -74,7 +74,6 @@ pub(crate) unsafe fn poses_in(
     };
     Ok((0..frames)
         .map(|f| Pose {
-            root_position: [roots[3 * f], roots[3 * f + 1], roots[3 * f + 2]],
             rotations: (0..joints)
                 .map(|j| {
                     let q = &rotations[4 * (f * joints + j)..][..4];
@@ -86,8 +85,13 @@ pub(crate) unsafe fn poses_in(
                     }
                 })
                 .collect(),
+            // The root's translation is its position (the C arrays keep it apart, so that the
+            // translations may be left out).
             translations: (0..joints)
                 .map(|j| match translations {
+                    _ if layout.skeleton.joints[j].parent.is_none() => {
+                        [roots[3 * f], roots[3 * f + 1], roots[3 * f + 2]]
+                    }
                     Some(t) => {
                         let t = &t[3 * (f * joints + j)..][..3];
                         [t[0], t[1], t[2]]
@@ -155,7 +159,7 @@ pub(crate) unsafe fn poses_out(
 ) -> Result<(), Failure> {
     let (roots, rotations, translations) = unsafe { pose_slices(buffers, poses.len(), joints) }?;
     for (f, pose) in poses.iter().enumerate() {
-        roots[3 * f..3 * f + 3].copy_from_slice(&pose.root_position);
+        roots[3 * f..3 * f + 3].copy_from_slice(&pose.root_position());
         for (j, q) in pose.rotations.iter().enumerate() {
             rotations[4 * (f * joints + j)..][..4].copy_from_slice(&[q.x, q.y, q.z, q.w]);
         }

@@ -111,7 +111,7 @@ fn engine_poses_rebuild_the_decoded_skeleton() {
             positions.push(p);
             rotations.push(r);
         }
-        let root = pose.root_position.map(f64::from);
+        let root = pose.root_position().map(f64::from);
         let file_root = original[4 * f].joints[0];
         assert!(
             math::norm(math::sub(root, file_root)) < 1e-4 * height,

@@ -73,7 +73,7 @@ pub fn hex(values: impl IntoIterator<Item = f32>) -> String {
 pub fn pose_lines(label: &str, poses: &[Pose], out: &mut BTreeMap<String, String>) {
     out.insert(
         format!("{label}.root"),
-        hex(poses.iter().flat_map(|p| p.root_position)),
+        hex(poses.iter().flat_map(|p| p.root_position())),
     );
     out.insert(
         format!("{label}.rotations"),

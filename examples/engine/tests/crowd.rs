@@ -27,7 +27,7 @@ fn a_crowd_from_the_shipped_fox_model_has_a_pose_per_frame_and_joint() {
                 let norm = (q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w).sqrt();
                 assert!((norm - 1.0).abs() < 1e-4, "a rotation of norm {norm}");
             }
-            assert!(pose.root_position.iter().all(|v| v.is_finite()));
+            assert!(pose.root_position().iter().all(|v| v.is_finite()));
         }
     }
     // Different seeds within the crowd: the characters move differently.

@@ -25,13 +25,19 @@ pub struct Quaternion {
 /// [`super::FeatureLayout::up`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pose {
-    /// World position of the root joint.
-    pub root_position: [f32; 3],
     /// Local rotation of every joint relative to its parent.
     pub rotations: Vec<Quaternion>,
     /// Local translation of every joint from its parent (the OFFSET, or the animated position
-    /// where a joint has position channels).
+    /// where a joint has position channels); the root joint's is its world position.
     pub translations: Vec<[f32; 3]>,
+}
+
+impl Pose {
+    /// World position of the root joint: its translation. A model's skeleton has its root first
+    /// (model files are checked for it), so this is `translations[0]`; zeros for an empty pose.
+    pub fn root_position(&self) -> [f32; 3] {
+        self.translations.first().copied().unwrap_or([0.0; 3])
+    }
 }
 
 /// One [`Pose`] per frame.
@@ -42,7 +48,6 @@ pub fn poses(motion: &LocalMotion) -> Vec<Pose> {
         .map(|f| {
             let range = f * joints..(f + 1) * joints;
             Pose {
-                root_position: narrow(motion.translations[f * joints]),
                 rotations: motion.rotations[range.clone()]
                     .iter()
                     .map(|m| {
@@ -66,7 +71,7 @@ pub fn poses(motion: &LocalMotion) -> Vec<Pose> {
 
 /// The inverse of [`poses`]: engine poses of `skeleton` at `fps` as a motion, to give a model as
 /// a reference or content (poses in, the same layout the runtime returns). Quaternions are
-/// normalised; the root joint's translation is [`Pose::root_position`]. Poses whose joint
+/// normalised; the root joint's translation is its world position. Poses whose joint
 /// counts differ from the skeleton's, zero quaternions and non-finite numbers are refused,
 /// naming the frame.
 pub fn motion_from_poses(
@@ -93,9 +98,6 @@ pub fn motion_from_poses(
                 pose.translations.len()
             )));
         }
-        if !pose.root_position.iter().all(|v| v.is_finite()) {
-            return Err(bad("the root position is not finite".into()));
-        }
         for (j, q) in pose.rotations.iter().enumerate() {
             let q = [q.w, q.x, q.y, q.z].map(f64::from);
             let length = q.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -114,8 +116,7 @@ pub fn motion_from_poses(
                     skeleton.joints[j].name
                 )));
             }
-            let root = skeleton.joints[j].parent.is_none();
-            translations.push(wide(if root { pose.root_position } else { *t }));
+            translations.push(wide(*t));
         }
     }
     Ok(LocalMotion {
