@@ -231,3 +231,70 @@ fn a_run_keeps_its_fbx_clip_and_resumes_from_it() {
     assert!(matches!(end, sinmdm_train::RunEnd::Finished(_)), "{end:?}");
     std::fs::remove_dir_all(&run).unwrap();
 }
+
+#[test]
+fn a_clip_with_a_one_axis_hinge_trains_exports_and_opens() {
+    // The walk with its left knee a hinge: one rotation channel (the knee's own bend, X), as
+    // some rigs write their knees and elbows. The reader takes it, so the whole path must.
+    let mut clip = read_bvh(root().join("tests/data/bvh/human_walk_cmu_131_01.bvh")).unwrap();
+    let knee = clip
+        .skeleton
+        .joints
+        .iter()
+        .position(|j| j.name == "LeftKnee")
+        .unwrap();
+    let width = clip.skeleton.channel_count();
+    let first: usize = clip.skeleton.joints[..knee]
+        .iter()
+        .map(|j| j.channels.len())
+        .sum();
+    let channels = clip.skeleton.joints[knee].channels.clone();
+    let keep = channels
+        .iter()
+        .position(|c| *c == sinmdm::motion::Channel::parse("Xrotation").unwrap())
+        .unwrap();
+    let values: Vec<f64> = clip
+        .values
+        .chunks(width)
+        .flat_map(|row| {
+            let mut row = row.to_vec();
+            let kept = row[first + keep];
+            row.splice(first..first + channels.len(), [kept]);
+            row
+        })
+        .collect();
+    clip.skeleton.joints[knee].channels = vec![channels[keep]];
+    clip.values = values;
+    let file = common::scratch("formats", "hinge.bvh");
+    std::fs::write(&file, sinmdm::bvh::to_bvh_string(&clip)).unwrap();
+
+    let mut config = tiny();
+    config.training.steps = 2;
+    config.training.checkpoint_every = 2;
+    let run = common::scratch("formats", "hinge_run");
+    let mut trainer = Trainer::start(&file, config, &run, Device::flex().autodiff()).unwrap();
+    let end = trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
+    let sinmdm_train::RunEnd::Finished(checkpoint) = end else {
+        panic!("{end:?}");
+    };
+    let model_file = run.join("hinge.onnx");
+    sinmdm_train::export::export_checkpoint(&checkpoint, &model_file).unwrap();
+    sinmdm::init_onnxruntime().expect("run scripts/setup.sh first");
+    let mut model = sinmdm::Model::open(&model_file, &sinmdm::ModelOptions::default()).unwrap();
+    let request = sinmdm::Request {
+        task: sinmdm::Task::Generate { frames: 40 },
+        count: 1,
+        seed: 1,
+        steps: Some(3),
+        feet: sinmdm::Feet::Planted,
+        method: Default::default(),
+    };
+    let generated = sinmdm::run(&mut model, &request, &mut |_, _| {
+        std::ops::ControlFlow::Continue(())
+    })
+    .unwrap();
+    let motion = generated.motion(0).unwrap();
+    assert_eq!(motion.skeleton.joints[knee].channels.len(), 1);
+    std::fs::remove_dir_all(&run).unwrap();
+    std::fs::remove_file(&file).unwrap();
+}

@@ -1,4 +1,5 @@
-//! A strict BVH reader: any joint may have 3 or 6 channels in any order, CRLF or LF line ends,
+//! A strict BVH reader: any joint may have 1 to 6 distinct channels in any order (a one-axis
+//! hinge, three rotations, positions and rotations), CRLF or LF line ends,
 //! End Sites anywhere; every problem is reported with its line, never with a panic.
 
 use std::collections::HashMap;

@@ -107,9 +107,11 @@ fn skeleton(p: &mut Problems, s: &Skeleton) {
         let positions = joint.position_axes();
         let distinct =
             |axes: &[crate::motion::Axis]| axes.iter().collect::<HashSet<_>>().len() == axes.len();
-        if !(rotations.is_empty() || rotations.len() == 3) || !distinct(&rotations) {
+        // One to three rotation axes, as the BVH reader takes them (a hinge with one axis is
+        // common); its rotation is learnt in 6D and decoded onto its axes.
+        if rotations.len() > 3 || !distinct(&rotations) {
             p.add(format!(
-                "{field}.channels has rotations {rotations:?}; a joint has none or three distinct axes"
+                "{field}.channels has rotations {rotations:?}; a joint has up to three distinct axes"
             ));
         }
         if !distinct(&positions) {
@@ -170,7 +172,7 @@ fn layout(p: &mut Problems, m: &ModelMetadata) {
         let field = format!("layout.rotation_joints[{i}]");
         if j >= n {
             p.add(format!("{field} is {j}; the skeleton has {n} joints"));
-        } else if joints[j].rotation_order().len() != 3 {
+        } else if joints[j].rotation_order().is_empty() {
             p.add(format!(
                 "{field} is joint '{}', which has no rotation channels",
                 joints[j].name
