@@ -331,7 +331,7 @@ mod tests {
     /// A turn by `angle` about `axis` (unit).
     fn turn(axis: Vec3, angle: f64) -> Mat3 {
         let (s, c) = (angle / 2.0).sin_cos();
-        math::mat_from_quat_wxyz([c, axis[0] * s, axis[1] * s, axis[2] * s])
+        math::mat_from_quat([axis[0] * s, axis[1] * s, axis[2] * s, c])
     }
 
     #[test]
@@ -386,7 +386,7 @@ mod tests {
     fn a_still_only_child_leaf_becomes_its_parents_end_site() {
         // Root, a turning child, and a leaf under it that never moves.
         let frames = 3;
-        let turn = |a: f64| math::mat_from_quat_wxyz([(a / 2.0).cos(), 0.0, 0.0, (a / 2.0).sin()]);
+        let turn = |a: f64| math::mat_from_quat([0.0, 0.0, (a / 2.0).sin(), (a / 2.0).cos()]);
         let mut rotations = Vec::new();
         let mut translations = Vec::new();
         for f in 0..frames {

@@ -4,7 +4,7 @@
 mod common;
 
 use sinmdm::bvh::read_bvh;
-use sinmdm::motion::math::{self, mat_from_quat_wxyz};
+use sinmdm::motion::math::{self, mat_from_quat};
 use sinmdm::motion::{
     ColumnKind, EncodeOptions, FeatureLayout, Normalizer, decode, encode, global_poses, poses,
 };
@@ -99,7 +99,7 @@ fn engine_poses_rebuild_the_decoded_skeleton() {
         let mut rotations = Vec::new();
         for (j, joint) in skeleton.joints.iter().enumerate() {
             let q = pose.rotations[j];
-            let local = mat_from_quat_wxyz([q.w, q.x, q.y, q.z].map(f64::from));
+            let local = mat_from_quat([q.x, q.y, q.z, q.w].map(f64::from));
             let t = pose.translations[j].map(f64::from);
             let (p, r) = match joint.parent {
                 None => (t, local),

@@ -45,7 +45,7 @@ pub(super) struct Trs {
 
 /// `[x, y, z, w]` to a rotation matrix.
 pub(super) fn rotation_of(q: [f64; 4]) -> Mat3 {
-    math::mat_from_quat_wxyz([q[3], q[0], q[1], q[2]])
+    math::mat_from_quat(q)
 }
 
 pub(super) fn numbers<const N: usize>(value: Option<&Value>) -> Option<[f64; N]> {

@@ -164,8 +164,7 @@ fn proxy_mesh(binary: &mut Binary, root_position: Vec3) -> Value {
 /// A rotation as glTF's unit quaternion `[x, y, z, w]`, on the same side as `previous` (so
 /// interpolating consecutive keys takes the short way).
 pub(super) fn quaternion_xyzw(m: &Mat3, previous: Option<[f64; 4]>) -> [f64; 4] {
-    let [w, x, y, z] = math::quat_wxyz_from_mat(m);
-    let q = [x, y, z, w];
+    let q = math::quat_from_mat(m);
     match previous {
         Some(p) if p.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>() < 0.0 => {
             [-q[0], -q[1], -q[2], -q[3]]

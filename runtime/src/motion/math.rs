@@ -1,15 +1,16 @@
 //! Small fixed-size linear algebra in `f64`: 3-vectors, row-major 3x3 matrices and unit quaternions.
 //!
 //! Conventions used everywhere in the crate: column vectors, so a point `p` in a child's frame is
-//! `R * p` in its parent's frame; matrices are row-major (`m[row][col]`); quaternions are `[w, x, y, z]`.
+//! `R * p` in its parent's frame; matrices are row-major (`m[row][col]`); quaternions are
+//! `[x, y, z, w]` (scalar last), the order of the engine's `Quaternion` and of glTF.
 
 /// A 3-vector.
 pub type Vec3 = [f64; 3];
 /// A row-major 3x3 matrix (`m[row][col]`).
 pub type Mat3 = [[f64; 3]; 3];
-/// A unit quaternion with its components in the order `[w, x, y, z]` (scalar first), as the
-/// name says; engine poses use [`super::pose::Quaternion`] with named fields instead.
-pub type QuatWxyz = [f64; 4];
+/// A unit quaternion `[x, y, z, w]` (scalar last): one order from the sampler to the engine's
+/// [`super::pose::Quaternion`] and glTF files.
+pub type Quat = [f64; 4];
 
 /// The identity matrix.
 pub const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
@@ -95,9 +96,10 @@ pub fn axis_rotation(axis: usize, radians: f64) -> Mat3 {
 
 /// The unit quaternion of a rotation matrix (Shepperd's method: the largest diagonal term picks
 /// the numerically stable branch). The result has `w >= 0`.
-pub fn quat_wxyz_from_mat(m: &Mat3) -> QuatWxyz {
+pub fn quat_from_mat(m: &Mat3) -> Quat {
     let trace = m[0][0] + m[1][1] + m[2][2];
-    let q = if trace > 0.0 {
+    // Worked out scalar first, as Shepperd writes it.
+    let [w, x, y, z] = if trace > 0.0 {
         let s = (trace + 1.0).sqrt() * 2.0;
         [
             0.25 * s,
@@ -130,8 +132,8 @@ pub fn quat_wxyz_from_mat(m: &Mat3) -> QuatWxyz {
             0.25 * s,
         ]
     };
-    let q = quat_normalize(q);
-    if q[0] < 0.0 {
+    let q = quat_normalize([x, y, z, w]);
+    if q[3] < 0.0 {
         [-q[0], -q[1], -q[2], -q[3]]
     } else {
         q
@@ -139,8 +141,8 @@ pub fn quat_wxyz_from_mat(m: &Mat3) -> QuatWxyz {
 }
 
 /// The rotation matrix of a (not necessarily unit) quaternion.
-pub fn mat_from_quat_wxyz(q: QuatWxyz) -> Mat3 {
-    let [w, x, y, z] = quat_normalize(q);
+pub fn mat_from_quat(q: Quat) -> Mat3 {
+    let [x, y, z, w] = quat_normalize(q);
     [
         [
             1.0 - 2.0 * (y * y + z * z),
@@ -161,18 +163,19 @@ pub fn mat_from_quat_wxyz(q: QuatWxyz) -> Mat3 {
 }
 
 /// `q / |q|` (identity for a zero quaternion).
-pub fn quat_normalize(q: QuatWxyz) -> QuatWxyz {
-    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+pub fn quat_normalize(q: Quat) -> Quat {
+    // Summed scalar first, so lengths round as they always have.
+    let n = (q[3] * q[3] + q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
     if n > 1e-12 {
         [q[0] / n, q[1] / n, q[2] / n, q[3] / n]
     } else {
-        [1.0, 0.0, 0.0, 0.0]
+        [0.0, 0.0, 0.0, 1.0]
     }
 }
 
 /// Spherical linear interpolation from `a` (at `t = 0`) to `b` (at `t = 1`) along the shorter arc.
-pub fn slerp(a: QuatWxyz, b: QuatWxyz, t: f64) -> QuatWxyz {
-    let mut cos = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+pub fn slerp(a: Quat, b: Quat, t: f64) -> Quat {
+    let mut cos = a[3] * b[3] + a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let b = if cos < 0.0 {
         cos = -cos;
         [-b[0], -b[1], -b[2], -b[3]]
@@ -230,10 +233,10 @@ mod tests {
 
     #[test]
     fn quaternion_of_axis_rotation_is_half_angle() {
-        // Rotation by theta about Z is (cos(theta/2), 0, 0, sin(theta/2)).
+        // Rotation by theta about Z is (0, 0, sin(theta/2), cos(theta/2)).
         let theta = 1.234_f64;
-        let q = quat_wxyz_from_mat(&axis_rotation(2, theta));
-        let expected = [(theta / 2.0).cos(), 0.0, 0.0, (theta / 2.0).sin()];
+        let q = quat_from_mat(&axis_rotation(2, theta));
+        let expected = [0.0, 0.0, (theta / 2.0).sin(), (theta / 2.0).cos()];
         for i in 0..4 {
             assert!((q[i] - expected[i]).abs() < 1e-12, "{q:?} vs {expected:?}");
         }
@@ -248,7 +251,7 @@ mod tests {
                     &axis_rotation(axis, angle),
                     &axis_rotation((axis + 1) % 3, 0.2),
                 );
-                let back = mat_from_quat_wxyz(quat_wxyz_from_mat(&m));
+                let back = mat_from_quat(quat_from_mat(&m));
                 assert!(mat_max_abs_diff(&m, &back) < 1e-12);
             }
         }
@@ -256,9 +259,9 @@ mod tests {
 
     #[test]
     fn slerp_halfway_is_half_the_angle() {
-        let a = quat_wxyz_from_mat(&IDENTITY);
-        let b = quat_wxyz_from_mat(&axis_rotation(1, 1.0));
-        let mid = mat_from_quat_wxyz(slerp(a, b, 0.5));
+        let a = quat_from_mat(&IDENTITY);
+        let b = quat_from_mat(&axis_rotation(1, 1.0));
+        let mid = mat_from_quat(slerp(a, b, 0.5));
         assert!(mat_max_abs_diff(&mid, &axis_rotation(1, 0.5)) < 1e-12);
     }
 }

@@ -3,7 +3,7 @@
 
 use super::clip::LocalMotion;
 use super::features::{FeatureLayout, FeatureMatrix, MotionError, encode_motion};
-use super::math::{mat_from_quat_wxyz, quat_wxyz_from_mat};
+use super::math::{mat_from_quat, quat_from_mat};
 use super::skeleton::Skeleton;
 
 /// A unit quaternion with named components (`w` the scalar part), laid out `x, y, z, w` in
@@ -51,7 +51,7 @@ pub fn poses(motion: &LocalMotion) -> Vec<Pose> {
                 rotations: motion.rotations[range.clone()]
                     .iter()
                     .map(|m| {
-                        let [w, x, y, z] = quat_wxyz_from_mat(m);
+                        let [x, y, z, w] = quat_from_mat(m);
                         Quaternion {
                             x: x as f32,
                             y: y as f32,
@@ -99,15 +99,16 @@ pub fn motion_from_poses(
             )));
         }
         for (j, q) in pose.rotations.iter().enumerate() {
-            let q = [q.w, q.x, q.y, q.z].map(f64::from);
-            let length = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let q = [q.x, q.y, q.z, q.w].map(f64::from);
+            // Summed scalar first, so lengths round as they always have.
+            let length = (q[3] * q[3] + q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
             if !(length.is_finite() && length > 1e-6) {
                 return Err(bad(format!(
-                    "joint {j} ('{}') has a rotation that is not a unit quaternion ({q:?}, w first)",
+                    "joint {j} ('{}') has a rotation that is not a unit quaternion ({q:?}, x y z w)",
                     skeleton.joints[j].name
                 )));
             }
-            rotations.push(mat_from_quat_wxyz(q.map(|v| v / length)));
+            rotations.push(mat_from_quat(q.map(|v| v / length)));
         }
         for (j, t) in pose.translations.iter().enumerate() {
             if !t.iter().all(|v| v.is_finite()) {

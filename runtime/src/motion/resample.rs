@@ -38,9 +38,9 @@ pub fn resample(motion: &LocalMotion, to_fps: f64) -> LocalMotion {
             rotations.push(if w == 0.0 {
                 motion.rotations[a]
             } else {
-                let qa = math::quat_wxyz_from_mat(&motion.rotations[a]);
-                let qb = math::quat_wxyz_from_mat(&motion.rotations[b]);
-                math::mat_from_quat_wxyz(math::slerp(qa, qb, w))
+                let qa = math::quat_from_mat(&motion.rotations[a]);
+                let qb = math::quat_from_mat(&motion.rotations[b]);
+                math::mat_from_quat(math::slerp(qa, qb, w))
             });
         }
     }
