@@ -311,10 +311,7 @@ fn spliced_animation(
     }
     let poses = global_poses(&canonical);
     let frames = motion.frame_count();
-    let times: Vec<f32> = (0..frames)
-        .map(|f| (f as f64 / motion.fps) as f32)
-        .collect();
-    let input = binary.accessor(&times, "SCALAR", 1, true);
+    let input = binary.key_times(frames, motion.fps);
     let mut samplers = Vec::new();
     let mut channels = Vec::new();
     for (j, joint) in motion.skeleton.joints.iter().enumerate() {

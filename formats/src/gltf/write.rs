@@ -73,6 +73,13 @@ impl Binary {
         self.base.1 + self.views.len() - 1
     }
 
+    /// Appends the key times of `frames` frames at `fps` (seconds from 0, with their bounds, as
+    /// glTF asks of an animation's input) as an accessor; returns its index.
+    pub(super) fn key_times(&mut self, frames: usize, fps: f64) -> usize {
+        let times: Vec<f32> = (0..frames).map(|f| (f as f64 / fps) as f32).collect();
+        self.accessor(&times, "SCALAR", 1, true)
+    }
+
     /// Appends `values` as an accessor of `kind` (`SCALAR`, `VEC3`, `VEC4`, `MAT4`) with
     /// `width` floats per element, with its min and max when `bounds` is set; returns its index.
     pub(super) fn accessor(
@@ -303,10 +310,7 @@ pub fn gltf_document(
             ));
         }
         let canonical = up::to_canonical(motion, options.up);
-        let times: Vec<f32> = (0..frames)
-            .map(|f| (f as f64 / motion.fps) as f32)
-            .collect();
-        let input = binary.accessor(&times, "SCALAR", 1, true);
+        let input = binary.key_times(frames, motion.fps);
         let mut samplers = Vec::new();
         let mut channels = Vec::new();
         for (j, &(rotates, moves)) in animated.iter().enumerate() {
