@@ -6,6 +6,9 @@
 /// minutes at 30 fps). Also the longest clip a model file may say it learnt, since a model's
 /// default sample is as long as its clip.
 pub const MAX_SAMPLE_FRAMES: usize = 100_000;
+/// The widest soft border of a task's kept spans, in frames: a border wider than the longest
+/// sample would only ever be cut short.
+pub const MAX_RAMP_FRAMES: usize = MAX_SAMPLE_FRAMES;
 /// The largest crowd one run makes.
 pub const MAX_SAMPLES: usize = 1024;
 /// The largest working set one run may need, in f32 values (1 GiB): `samples x frames x` the

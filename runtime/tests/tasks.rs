@@ -345,6 +345,53 @@ fn bad_requests_are_refused_with_what_is_wrong() {
         matches!(e, TaskError::JointIndex { index: 999, .. }),
         "{e:?}"
     );
+    // Sizes at the edge of usize are refused, never wrapped round or panicked on.
+    for (prefix, suffix) in [
+        (usize::MAX, 0),
+        (usize::MAX - 29, 0),
+        (0, usize::MAX),
+        (1, usize::MAX - 100),
+    ] {
+        let e = plan_error(
+            Task::Expand {
+                reference: reference.clone(),
+                prefix,
+                suffix,
+                ramp: 6,
+            },
+            1,
+            Some(10),
+        );
+        assert!(
+            matches!(e, TaskError::Length { .. }),
+            "{prefix} {suffix}: {e:?}"
+        );
+        assert!(message(e).contains("the limit is"));
+    }
+    for task in [
+        Task::Expand {
+            reference: reference.clone(),
+            prefix: 10,
+            suffix: 0,
+            ramp: usize::MAX,
+        },
+        Task::Inbetween {
+            reference: reference.clone(),
+            keep: vec![Span::new(0, 40)],
+            ramp: usize::MAX,
+        },
+        Task::Compose {
+            reference: reference.clone(),
+            joints: vec![1],
+            root: false,
+            spans: vec![],
+            ramp: sinmdm::limits::MAX_RAMP_FRAMES + 1,
+        },
+    ] {
+        let e = plan_error(task, 1, Some(10));
+        assert!(matches!(e, TaskError::Ramp(_)), "{e:?}");
+        assert!(message(e).contains("soft border"));
+    }
 }
 
 #[test]

@@ -124,6 +124,11 @@ pub enum TaskError {
         /// Rows given.
         got: usize,
     },
+    /// A soft border wider than any sample can be.
+    #[error(
+        "a soft border (ramp) of {0} frames is wider than the longest sample, {MAX_SAMPLE_FRAMES} frames"
+    )]
+    Ramp(usize),
     /// A harmonization factor or free share out of range.
     #[error("{0}")]
     Harmonization(String),

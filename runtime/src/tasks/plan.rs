@@ -10,7 +10,7 @@ use super::mask::{Span, covered, soft_mask};
 use super::{Request, Task, TaskError};
 use crate::diffusion::sampler::{Denoiser, Guidance, Harmonization, Inpainting, Sampler};
 use crate::diffusion::{Method, SamplerError, Schedule};
-use crate::limits::{MAX_RUN_VALUES, MAX_SAMPLE_FRAMES, MAX_SAMPLES};
+use crate::limits::{MAX_RAMP_FRAMES, MAX_RUN_VALUES, MAX_SAMPLE_FRAMES, MAX_SAMPLES};
 use crate::model::Model;
 use crate::model_file::ModelMetadata;
 use crate::motion::feet::{Feet, Kept};
@@ -187,6 +187,13 @@ fn check_spans(spans: &[Span], frames: usize) -> Result<Vec<Span>, TaskError> {
     Ok(sorted)
 }
 
+fn check_ramp(ramp: usize) -> Result<usize, TaskError> {
+    if ramp > MAX_RAMP_FRAMES {
+        return Err(TaskError::Ramp(ramp));
+    }
+    Ok(ramp)
+}
+
 fn check_length(frames: usize) -> Result<(), TaskError> {
     if frames == 0 {
         return Err(TaskError::Length {
@@ -255,8 +262,9 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
                     "in-betweening needs at least one span of the reference to keep".into(),
                 ));
             }
+            let ramp = check_ramp(*ramp)?;
             let keep = check_spans(keep, n)?;
-            let weights = soft_mask(&covered(n, &keep), *ramp);
+            let weights = soft_mask(&covered(n, &keep), ramp);
             let mask = frame_mask(f, &weights, None);
             (
                 n,
@@ -273,19 +281,24 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
             ramp,
         } => {
             let y = normalized(metadata, reference)?;
-            if prefix + suffix == 0 {
+            if *prefix == 0 && *suffix == 0 {
                 return Err(TaskError::NothingToDo(
                     "expansion needs a prefix or a suffix of at least one frame".into(),
                 ));
             }
-            let n = prefix + y.ncols() + suffix;
+            // Checked: a prefix or suffix near usize::MAX must be refused, not wrap around.
+            let n = prefix
+                .checked_add(y.ncols())
+                .and_then(|n| n.checked_add(*suffix))
+                .unwrap_or(usize::MAX);
             check_length(n)?;
+            let ramp = check_ramp(*ramp)?;
             let mut padded = Array2::<f32>::zeros((f, n));
             padded
                 .slice_mut(ndarray::s![.., *prefix..prefix + y.ncols()])
                 .assign(&y);
             let keep = covered(n, &[Span::new(*prefix, prefix + y.ncols())]);
-            let mask = frame_mask(f, &soft_mask(&keep, *ramp), None);
+            let mask = frame_mask(f, &soft_mask(&keep, ramp), None);
             (
                 n,
                 Guidance {
@@ -306,6 +319,7 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
         } => {
             let y = normalized(metadata, reference)?;
             let n = y.ncols();
+            let ramp = check_ramp(*ramp)?;
             let layout = &metadata.layout;
             if let Some(&index) = joints.iter().find(|&&j| j >= layout.skeleton.len()) {
                 return Err(TaskError::JointIndex {
@@ -331,7 +345,7 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
                 vec![1.0; n]
             } else {
                 let spans = check_spans(spans, n)?;
-                soft_mask(&covered(n, &spans), *ramp)
+                soft_mask(&covered(n, &spans), ramp)
             };
             let mask = frame_mask(f, &weights, Some(&rows));
             (
