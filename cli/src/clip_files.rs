@@ -17,6 +17,15 @@ use sinmdm_formats::{
 /// or FBX file's animations by name or index (default: the first), and which one was read is said when the
 /// file holds several.
 pub fn read_motion_file(path: &Path, animation: Option<&str>) -> Result<ChannelClip> {
+    Ok(read_motion_file_and_source(path, animation)?.0)
+}
+
+/// [`read_motion_file`], with what the file held besides (its animations), read in the same
+/// pass.
+pub fn read_motion_file_and_source(
+    path: &Path,
+    animation: Option<&str>,
+) -> Result<(ChannelClip, sinmdm_formats::ClipSource)> {
     let options = ReadOptions {
         animation: animation.map(AnimationChoice::parse),
         fps: None,
@@ -39,7 +48,7 @@ pub fn read_motion_file(path: &Path, animation: Option<&str>) -> Result<ChannelC
             source.animations.len()
         );
     }
-    Ok(clip)
+    Ok((clip, source))
 }
 
 /// `'Walk' (#0)` or `#0`.

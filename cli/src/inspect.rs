@@ -8,7 +8,7 @@ use clap::Args;
 
 use sinmdm::bvh::write_bvh;
 
-use crate::clip_files::read_motion_file;
+use crate::clip_files::read_motion_file_and_source;
 use sinmdm::files::write_atomically;
 use sinmdm::motion::up::{UP, file_axis_name};
 use sinmdm::motion::{
@@ -64,11 +64,12 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     {
         bail!("--fps must be a positive number, got {fps}");
     }
-    let clip = read_motion_file(&args.clip, args.up.clip_anim.as_deref())?;
-    let animations = sinmdm_formats::list_animations(&args.clip)?;
+    // The file is read once: its animations come with the clip.
+    let (clip, source) = read_motion_file_and_source(&args.clip, args.up.clip_anim.as_deref())?;
+    let animations = &source.animations;
     if !animations.is_empty() {
         println!("animations {}", animations.len());
-        for a in &animations {
+        for a in animations {
             println!(
                 "  {} {:.2} s",
                 crate::clip_files::describe_animation(a),
