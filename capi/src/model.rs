@@ -153,7 +153,7 @@ pub unsafe extern "C" fn sinmdm_model_info(
             contact_joints: metadata.layout.contact_joints.len(),
             fps: model.fps(),
             skeleton_height: metadata.layout.skeleton_height,
-            up: up.direction(),
+            up: up.direction().0,
             clip_frames: model.clip_frames(),
             receptive_field: metadata.network.receptive_field,
             diffusion_steps: metadata.diffusion.steps,

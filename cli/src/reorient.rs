@@ -60,10 +60,7 @@ pub(crate) fn run(args: &ReorientArgs) -> Result<()> {
     };
     let to = args.to.unwrap_or(from);
     let turn = math::axis_rotation(UP, args.turn.to_radians());
-    let rotation = math::mat_mul(
-        &to.file_from_canonical(),
-        &math::mat_mul(&turn, &from.canonical_from_file()),
-    );
+    let rotation = to.file_from_canonical() * (turn * from.canonical_from_file());
     write_bvh(&args.output, &reorient(&motion, &rotation).to_channels())?;
     eprintln!(
         "wrote {} ({from}-up -> {to}-up, turned {} degrees)",

@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 use sinmdm::motion::feet::ground_level;
-use sinmdm::motion::math::{self, Vec3};
+use sinmdm::motion::math::Vec3;
 use sinmdm::motion::up::{height_of, horizontal, to_canonical};
 use sinmdm::motion::{FeatureLayout, GlobalPose, LocalMotion, global_poses};
 
@@ -83,7 +83,7 @@ impl FeetReference {
             let points: Vec<Vec3> = poses.iter().map(|p| p.contact_point(joint)).collect();
             let speed: Vec<f64> = points
                 .windows(2)
-                .map(|w| math::norm(horizontal(math::sub(w[1], w[0]))) * fps)
+                .map(|w| horizontal(w[1] - w[0]).norm() * fps)
                 .collect();
             let on_ground = |i: usize| height_of(points[i]) - self.ground < GROUND_BAND * h;
             for i in 0..pairs {
@@ -116,11 +116,8 @@ fn jitter(poses: &[GlobalPose], h: f64, fps: f64) -> f64 {
     let mut count = 0usize;
     for w in poses.windows(3) {
         for j in 0..w[1].joints.len() {
-            let a = math::add(
-                math::sub(w[2].joints[j], w[1].joints[j]),
-                math::sub(w[0].joints[j], w[1].joints[j]),
-            );
-            sum += math::norm(a);
+            let a = (w[2].joints[j] - w[1].joints[j]) + (w[0].joints[j] - w[1].joints[j]);
+            sum += a.norm();
             count += 1;
         }
     }

@@ -15,7 +15,7 @@
 
 use std::path::Path;
 
-use sinmdm::motion::math::{self, Mat3, Vec3};
+use sinmdm::motion::math::{Mat3, Vec3};
 use sinmdm::motion::{ChannelClip, fps_from_frame_time};
 
 use crate::animation::{
@@ -214,13 +214,15 @@ fn decompose(m: &ufbx::Matrix) -> Option<(Mat3, Vec3, f64)> {
         [m.m01, m.m11, m.m21],
         [m.m02, m.m12, m.m22],
     ];
-    let scales = columns.map(math::norm);
+    let scales = columns.map(|c| Vec3(c).norm());
     let s = scales[0];
     if !(s > 1e-12 && scales.iter().all(|v| (v - s).abs() <= SCALE_TOLERANCE * s)) {
         return None;
     }
-    let rotation: Mat3 = std::array::from_fn(|r| std::array::from_fn(|c| columns[c][r] / s));
-    Some((rotation, [m.m03, m.m13, m.m23], s))
+    let rotation: Mat3 = Mat3(std::array::from_fn(|r| {
+        std::array::from_fn(|c| columns[c][r] / s)
+    }));
+    Some((rotation, Vec3([m.m03, m.m13, m.m23]), s))
 }
 
 /// A bone's world transform in the file's rest pose: the bind pose it belongs to, else its
@@ -278,10 +280,10 @@ fn local_transforms(
                         ),
                     ));
                 }
-                let inverse = math::transpose(&parent_rotation);
+                let inverse = parent_rotation.transpose();
                 (
-                    math::mat_mul(&inverse, &rotation),
-                    math::mat_vec(&inverse, math::sub(position, parent_position)),
+                    (inverse * rotation),
+                    (inverse * (position - parent_position)),
                 )
             }
         });

@@ -75,7 +75,7 @@ impl SampledJoints {
         let mut rest_world: Vec<Mat3> = Vec::with_capacity(joints);
         for j in 0..joints {
             let world = match self.parents[j] {
-                Some(p) => math::mat_mul(&rest_world[p], &self.rest_rotations[j]),
+                Some(p) => rest_world[p] * self.rest_rotations[j],
                 None => self.rest_rotations[j],
             };
             rest_world.push(world);
@@ -83,17 +83,17 @@ impl SampledJoints {
         // An End Site hangs in its joint's frame.
         for (recorded, turn) in self.recorded.iter_mut().zip(&rest_world) {
             if let Some(end) = &mut recorded.end_site {
-                *end = math::mat_vec(turn, *end);
+                *end = turn * *end;
             }
         }
         for f in 0..self.frames {
             for j in 0..joints {
                 let k = f * joints + j;
                 let parent = self.parents[j].map_or(math::IDENTITY, |p| rest_world[p]);
-                let turned = math::mat_mul(&parent, &self.rotations[k]);
-                self.rotations[k] = math::mat_mul(&turned, &math::transpose(&rest_world[j]));
+                let turned = parent * self.rotations[k];
+                self.rotations[k] = turned * rest_world[j].transpose();
                 if self.parents[j].is_some() {
-                    self.translations[k] = math::mat_vec(&parent, self.translations[k]);
+                    self.translations[k] = parent * self.translations[k];
                 }
             }
         }
@@ -158,7 +158,7 @@ fn turns_and_moves(
     for f in 1..frames {
         let k = f * joints + j;
         turns = turns.max(math::mat_max_abs_diff(&rotations[k], &r0));
-        moves = moves.max(math::norm(math::sub(translations[k], t0)));
+        moves = moves.max((translations[k] - t0).norm());
     }
     (turns > STILL_TURN, moves > STILL_SHARE * reach)
 }
@@ -170,7 +170,7 @@ fn reach(translations: &[Vec3], parents: &[Option<usize>]) -> f64 {
         .iter()
         .zip(translations)
         .filter(|(parent, _)| parent.is_some())
-        .map(|(_, t)| math::norm(*t))
+        .map(|(_, t)| t.norm())
         .fold(1e-12, f64::max)
 }
 
@@ -339,22 +339,22 @@ mod tests {
         // A chain of three joints whose rest frames are turned every which way, in two frames:
         // the rest pose itself and a bent pose.
         let rest = vec![
-            turn([0.0, 0.0, 1.0], 0.7),
-            turn([1.0, 0.0, 0.0], -1.1),
-            turn([0.0, 1.0, 0.0], 2.0),
+            turn(Vec3::new(0.0, 0.0, 1.0), 0.7),
+            turn(Vec3::new(1.0, 0.0, 0.0), -1.1),
+            turn(Vec3::new(0.0, 1.0, 0.0), 2.0),
         ];
-        let bend = turn([0.6, 0.0, 0.8], 0.5);
-        let offsets = [[0.1, 0.9, 0.2], [0.0, 0.5, 0.1], [0.3, 0.4, 0.0]];
+        let bend = turn(Vec3::new(0.6, 0.0, 0.8), 0.5);
+        let offsets = [[0.1, 0.9, 0.2], [0.0, 0.5, 0.1], [0.3, 0.4, 0.0]].map(Vec3);
         let mut rotations = rest.clone();
-        rotations.extend([rest[0], math::mat_mul(&rest[1], &bend), rest[2]]);
+        rotations.extend([rest[0], rest[1] * bend, rest[2]]);
         let translations: Vec<Vec3> = offsets.iter().chain(&offsets).copied().collect();
         let world = |rotations: &[Mat3], translations: &[Vec3]| -> Vec<Vec3> {
             let mut out = Vec::new();
             for f in 0..2 {
-                let (mut r, mut p) = (math::IDENTITY, [0.0; 3]);
+                let (mut r, mut p) = (math::IDENTITY, Vec3::ZERO);
                 for j in 0..3 {
-                    p = math::add(p, math::mat_vec(&r, translations[3 * f + j]));
-                    r = math::mat_mul(&r, &rotations[3 * f + j]);
+                    p += r * translations[3 * f + j];
+                    r = r * rotations[3 * f + j];
                     out.push(p);
                 }
             }
@@ -374,7 +374,7 @@ mod tests {
         sampled.line_up_frames_at_rest();
         let after = world(&sampled.rotations, &sampled.translations);
         for (a, b) in before.iter().zip(&after) {
-            assert!(math::norm(math::sub(*a, *b)) < 1e-12, "{a:?} {b:?}");
+            assert!((*a - *b).norm() < 1e-12, "{a:?} {b:?}");
         }
         for j in 0..3 {
             assert!(math::mat_max_abs_diff(&sampled.rotations[j], &math::IDENTITY) < 1e-12);
@@ -391,7 +391,7 @@ mod tests {
         let mut translations = Vec::new();
         for f in 0..frames {
             rotations.extend([math::IDENTITY, turn(0.1 * f as f64), math::IDENTITY]);
-            translations.extend([[0.0, 1.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.25, 0.0]]);
+            translations.extend([[0.0, 1.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.25, 0.0]].map(Vec3));
         }
         let motion = SampledJoints {
             names: unique_names(["root", "knee", "toe_end"].map(|s| Some(s.to_string()))),
@@ -405,7 +405,10 @@ mod tests {
         }
         .into_motion();
         assert_eq!(motion.skeleton.len(), 2);
-        assert_eq!(motion.skeleton.joints[1].end_site, Some([0.0, 0.25, 0.0]));
+        assert_eq!(
+            motion.skeleton.joints[1].end_site,
+            Some(Vec3::new(0.0, 0.25, 0.0))
+        );
         assert_eq!(motion.rotations.len(), 2 * frames);
     }
 }

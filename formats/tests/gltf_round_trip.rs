@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use sinmdm::bvh::{parse_bvh, read_bvh, to_bvh_string};
-use sinmdm::motion::math::{self, Vec3};
+use sinmdm::motion::math::Vec3;
 use sinmdm::motion::up_detect::choose_up;
 use sinmdm::motion::{LocalMotion, UpAxis, global_poses, skeleton_height};
 use sinmdm_formats::ReadOptions;
@@ -66,7 +66,7 @@ fn worst_distance(a: &[Vec<Vec3>], b: &[Vec<Vec3>]) -> f64 {
     for (fa, fb) in a.iter().zip(b) {
         assert_eq!(fa.len(), fb.len(), "point counts differ");
         for (p, q) in fa.iter().zip(fb) {
-            worst = worst.max(math::norm(math::sub(*p, *q)));
+            worst = worst.max((*p - *q).norm());
         }
     }
     worst
@@ -91,12 +91,7 @@ fn bvh_to_gltf_and_back_keeps_every_joint_where_it_was() {
         let turn = up.canonical_from_file();
         let expected: Vec<Vec<Vec3>> = positions(&source)
             .into_iter()
-            .map(|frame| {
-                frame
-                    .into_iter()
-                    .map(|p| math::scale(math::mat_vec(&turn, p), unit))
-                    .collect()
-            })
+            .map(|frame| frame.into_iter().map(|p| (turn * p) * unit).collect())
             .collect();
         let tolerance = 1e-5 * height * unit;
         for extension in ["glb", "gltf"] {
@@ -178,7 +173,7 @@ fn a_crowd_is_one_file_with_one_animation_each() {
         assert_eq!(clip.frame_count(), motion.frame_count());
         let expected: Vec<Vec<Vec3>> = positions(motion)
             .into_iter()
-            .map(|f| f.into_iter().map(|p| math::scale(p, 0.05)).collect())
+            .map(|f| f.into_iter().map(|p| p * 0.05).collect())
             .collect();
         let worst = worst_distance(&expected, &positions(&clip.to_local()));
         assert!(worst < 1e-5, "{name}: {worst}");

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 use sinmdm::bvh::read_bvh;
-use sinmdm::motion::math;
+use sinmdm::motion::math::Vec3;
 use sinmdm::motion::{LocalMotion, UpAxis};
 use sinmdm_formats::gltf::container::parse_glb;
 use sinmdm_formats::gltf::{read_gltf, splice_into_character};
@@ -26,7 +26,7 @@ fn character() -> PathBuf {
 }
 
 /// World positions by joint name of animation `which` of `file`, every frame.
-fn played(file: &Path, which: AnimationChoice) -> Vec<Vec<(String, [f64; 3])>> {
+fn played(file: &Path, which: AnimationChoice) -> Vec<Vec<(String, Vec3)>> {
     let options = ReadOptions {
         animation: Some(which),
         fps: None,
@@ -35,14 +35,14 @@ fn played(file: &Path, which: AnimationChoice) -> Vec<Vec<(String, [f64; 3])>> {
 }
 
 /// The largest distance between same-named joints of two plays, and the figure's height.
-fn worst_distance(a: &[Vec<(String, [f64; 3])>], b: &[Vec<(String, [f64; 3])>]) -> (f64, f64) {
+fn worst_distance(a: &[Vec<(String, Vec3)>], b: &[Vec<(String, Vec3)>]) -> (f64, f64) {
     assert_eq!(a.len(), b.len(), "frame counts differ");
     let mut worst = 0.0f64;
     let (mut low, mut high) = (f64::MAX, f64::MIN);
     for (fa, fb) in a.iter().zip(b) {
         for (name, p) in fa {
             let (_, q) = fb.iter().find(|(n, _)| n == name).expect("same joints");
-            worst = worst.max(math::norm(math::sub(*p, *q)));
+            worst = worst.max((*p - *q).norm());
             low = low.min(q[1]);
             high = high.max(q[1]);
         }
@@ -69,11 +69,11 @@ fn a_spliced_walk_moves_the_character_as_blenders_own_animation_does() {
     // The same walk in other units (a model trained on it in metres, say): scaled back.
     let mut small = walk.clone();
     for joint in &mut small.skeleton.joints {
-        joint.offset = math::scale(joint.offset, 0.01);
-        joint.end_site = joint.end_site.map(|e| math::scale(e, 0.01));
+        joint.offset = joint.offset * 0.01;
+        joint.end_site = joint.end_site.map(|e| e * 0.01);
     }
     for t in &mut small.translations {
-        *t = math::scale(*t, 0.01);
+        *t = *t * 0.01;
     }
     let report =
         splice_into_character(&character(), &out, &[("copy".into(), &walk)], UpAxis::PosY).unwrap();
@@ -158,7 +158,7 @@ fn a_skeleton_the_character_lacks_is_refused_by_name() {
     // Bones that point elsewhere: the fox's motion on the walk's names.
     let mut bent = the_walk();
     for joint in &mut bent.skeleton.joints {
-        joint.offset = [joint.offset[2], joint.offset[0], -joint.offset[1]];
+        joint.offset = Vec3::new(joint.offset[2], joint.offset[0], -joint.offset[1]);
     }
     let err = splice_into_character(
         &character(),

@@ -6,7 +6,7 @@
 
 use super::canvas::{Canvas, Rgb};
 use sinmdm::motion::contacts::{choose_contact_joints, label_contacts, travelling_root};
-use sinmdm::motion::math::{Vec3, dot, sub};
+use sinmdm::motion::math::Vec3;
 use sinmdm::motion::up::{GROUND_PLANE, UpAxis, height_of, on_ground, to_canonical};
 use sinmdm::motion::{GlobalPose, LocalMotion, global_poses, skeleton_height};
 
@@ -132,18 +132,14 @@ impl Default for RenderOptions {
 /// from the front left and slightly above.
 fn view_axes() -> (Vec3, Vec3) {
     let (azimuth, elevation) = (35f64.to_radians(), 15f64.to_radians());
-    let right = [azimuth.cos(), 0.0, -azimuth.sin()];
-    let forward = [
+    let right = Vec3::new(azimuth.cos(), 0.0, -azimuth.sin());
+    let forward = Vec3::new(
         azimuth.sin() * elevation.cos(),
         -elevation.sin(),
         azimuth.cos() * elevation.cos(),
-    ];
-    // up = forward x right: perpendicular to both, with a positive Y component.
-    let up = [
-        forward[1] * right[2] - forward[2] * right[1],
-        forward[2] * right[0] - forward[0] * right[2],
-        forward[0] * right[1] - forward[1] * right[0],
-    ];
+    );
+    // Perpendicular to both, with a positive Y component.
+    let up = forward.cross(right);
     (right, up)
 }
 
@@ -158,10 +154,10 @@ struct Projection {
 
 impl Projection {
     fn to_screen(&self, p: Vec3) -> (f64, f64) {
-        let d = sub(p, self.centre);
+        let d = p - self.centre;
         (
-            self.origin.0 + dot(d, self.right) * self.scale,
-            self.origin.1 - dot(d, self.up) * self.scale,
+            self.origin.0 + d.dot(self.right) * self.scale,
+            self.origin.1 - d.dot(self.up) * self.scale,
         )
     }
 }
@@ -191,7 +187,7 @@ fn projection(figure: &Figure, frame: usize, options: &RenderOptions) -> Project
             for (i, axis) in GROUND_PLANE.into_iter().enumerate() {
                 centre[axis] = (lo[i] + hi[i]) / 2.0;
             }
-            let centre = on_ground(centre, figure.ground);
+            let centre = on_ground(Vec3(centre), figure.ground);
             let extent = (hi[0] - lo[0]).hypot(hi[1] - lo[1]) + figure.height;
             Projection {
                 centre,
@@ -214,13 +210,13 @@ fn draw_grid(canvas: &mut Canvas, figure: &Figure, view: &Projection) {
         let o = i as f64 * step;
         let span = reach as f64 * step;
         let (a, b) = (
-            view.to_screen([cx + o, y, cz - span]),
-            view.to_screen([cx + o, y, cz + span]),
+            view.to_screen(Vec3([cx + o, y, cz - span])),
+            view.to_screen(Vec3([cx + o, y, cz + span])),
         );
         canvas.line(a.0, a.1, b.0, b.1, 1.0, GRID);
         let (a, b) = (
-            view.to_screen([cx - span, y, cz + o]),
-            view.to_screen([cx + span, y, cz + o]),
+            view.to_screen(Vec3([cx - span, y, cz + o])),
+            view.to_screen(Vec3([cx + span, y, cz + o])),
         );
         canvas.line(a.0, a.1, b.0, b.1, 1.0, GRID);
     }

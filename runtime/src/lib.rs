@@ -3,7 +3,7 @@
 //! The engine runtime of sinmdm-rs: a model trained on one motion clip (a `.onnx` file written
 //! by `sinmdm-export`) generates new motion of any length, crowds, in-betweens, expansions,
 //! body-part composition and style transfer, through onnxruntime. Its dependencies are `ort`,
-//! `ndarray`, `serde` and `thiserror`; BVH reading and writing is the default feature `bvh`.
+//! `ndarray`, `serde`, `serde_json` and `thiserror`; BVH reading and writing is the default feature `bvh`.
 //!
 //! The engine path is the items on this page: open a [`Model`], look at its [`Skeleton`], make
 //! a [`Request`] of a [`Task`], [`run`] it (or [`plan`] it and step a [`Sampler`] yourself),

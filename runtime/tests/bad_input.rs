@@ -15,7 +15,10 @@ fn the_valid_base_clip_parses() {
     let clip = parse_bvh(VALID, "clip.bvh").unwrap();
     assert_eq!(clip.frame_count(), 2);
     assert_eq!(clip.fps, 30.0);
-    assert_eq!(clip.skeleton.joints[1].end_site, Some([0.0, 5.0, 0.0]));
+    assert_eq!(
+        clip.skeleton.joints[1].end_site,
+        Some(sinmdm::motion::math::Vec3::new(0.0, 5.0, 0.0))
+    );
 }
 
 #[test]

@@ -21,7 +21,7 @@ const FRAMES: usize = 40;
 /// The labelled contact span.
 const SPAN: std::ops::Range<usize> = 10..30;
 
-fn joint(name: &str, parent: Option<usize>, offset: Vec3, end_site: Option<Vec3>) -> Joint {
+fn joint(name: &str, parent: Option<usize>, offset: [f64; 3], end_site: Option<[f64; 3]>) -> Joint {
     let mut channels = vec![
         Channel::Rotation(Axis::Z),
         Channel::Rotation(Axis::X),
@@ -33,9 +33,9 @@ fn joint(name: &str, parent: Option<usize>, offset: Vec3, end_site: Option<Vec3>
     Joint {
         name: name.into(),
         parent,
-        offset,
+        offset: Vec3(offset),
         channels,
-        end_site,
+        end_site: end_site.map(Vec3),
     }
 }
 
@@ -69,13 +69,16 @@ fn sliding_leg() -> (FeatureLayout, LocalMotion) {
             axis_rotation(0, -bend / 2.0),
             math::IDENTITY,
         ]);
-        translations.extend([
-            [0.0, 0.75, 0.3 * t],
-            [0.1, 0.0, 0.0],
-            [0.0, -0.45, 0.0],
-            [0.0, -0.45, 0.0],
-            [0.0, 0.5, 0.0],
-        ]);
+        translations.extend(
+            [
+                [0.0, 0.75, 0.3 * t],
+                [0.1, 0.0, 0.0],
+                [0.0, -0.45, 0.0],
+                [0.0, -0.45, 0.0],
+                [0.0, 0.5, 0.0],
+            ]
+            .map(Vec3),
+        );
     }
     let motion = LocalMotion {
         skeleton: skeleton.clone(),
@@ -124,7 +127,7 @@ fn options() -> PlantOptions {
 }
 
 fn distance(a: Vec3, b: Vec3) -> f64 {
-    math::norm(math::sub(a, b))
+    (a - b).norm()
 }
 
 fn bone_lengths(pose: &GlobalPose, motion: &LocalMotion) -> Vec<f64> {
@@ -173,7 +176,7 @@ fn sliding_foot_is_held(options: &PlantOptions) {
             assert!((x - y).abs() < 1e-9, "a bone changed length: {x} -> {y}");
         }
         // The spine is the network's: it keeps its place on the hips ...
-        let spine = |p: &GlobalPose| math::sub(p.joints[4], p.joints[0]);
+        let spine = |p: &GlobalPose| p.joints[4] - p.joints[0];
         assert!(distance(spine(b), spine(a)) < 1e-12);
         // ... and the hips keep their height; they move along the ground only to travel with
         // the stance foot, and not at all when told not to.
@@ -204,8 +207,8 @@ fn sliding_foot_is_held(options: &PlantOptions) {
         assert!(distance(after[f].contact_point(3), before[f].contact_point(3)) < 1e-12);
     }
     for f in SPAN.end + blend + 1..FRAMES {
-        let moved = math::sub(after[f].contact_point(3), before[f].contact_point(3));
-        let travel = math::sub(after[f].joints[0], before[f].joints[0]);
+        let moved = after[f].contact_point(3) - before[f].contact_point(3);
+        let travel = after[f].joints[0] - before[f].joints[0];
         assert!(distance(moved, travel) < 1e-12, "frame {f}");
     }
     assert_eq!(stats.spans, 1);

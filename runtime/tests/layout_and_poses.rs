@@ -4,7 +4,7 @@
 mod common;
 
 use sinmdm::bvh::read_bvh;
-use sinmdm::motion::math::{self, mat_from_quat};
+use sinmdm::motion::math::{Vec3, mat_from_quat};
 use sinmdm::motion::{
     ColumnKind, EncodeOptions, FeatureLayout, Normalizer, decode, encode, global_poses, poses,
 };
@@ -74,7 +74,7 @@ fn normalised_features_decode_after_denormalising() {
     let height = encoded.layout.skeleton_height;
     for (p, q) in a.iter().zip(&b) {
         for (x, y) in p.points().zip(q.points()) {
-            assert!(math::norm(math::sub(x, y)) < 1e-4 * height);
+            assert!((x - y).norm() < 1e-4 * height);
         }
     }
 }
@@ -95,30 +95,30 @@ fn engine_poses_rebuild_the_decoded_skeleton() {
     let skeleton = &motion.skeleton;
     for (f, (pose, want)) in frames.iter().zip(&reference).enumerate() {
         // Independent FK from the quaternions ([x, y, z, w]) and translations alone.
-        let mut positions: Vec<[f64; 3]> = Vec::new();
+        let mut positions: Vec<Vec3> = Vec::new();
         let mut rotations = Vec::new();
         for (j, joint) in skeleton.joints.iter().enumerate() {
             let q = pose.rotations[j];
             let local = mat_from_quat([q.x, q.y, q.z, q.w].map(f64::from));
-            let t = pose.translations[j].map(f64::from);
+            let t = Vec3(pose.translations[j].map(f64::from));
             let (p, r) = match joint.parent {
                 None => (t, local),
                 Some(parent) => (
-                    math::add(positions[parent], math::mat_vec(&rotations[parent], t)),
-                    math::mat_mul(&rotations[parent], &local),
+                    (positions[parent] + (rotations[parent] * t)),
+                    (rotations[parent] * local),
                 ),
             };
             positions.push(p);
             rotations.push(r);
         }
-        let root = pose.root_position().map(f64::from);
+        let root = Vec3(pose.root_position().map(f64::from));
         let file_root = original[4 * f].joints[0];
         assert!(
-            math::norm(math::sub(root, file_root)) < 1e-4 * height,
+            (root - file_root).norm() < 1e-4 * height,
             "frame {f}: root {root:?}, file {file_root:?}"
         );
         for (p, q) in positions.iter().zip(&want.joints) {
-            assert!(math::norm(math::sub(*p, *q)) < 1e-4 * encoded.layout.skeleton_height);
+            assert!((*p - *q).norm() < 1e-4 * encoded.layout.skeleton_height);
         }
     }
 }

@@ -69,7 +69,7 @@ fn the_root_travels_on_across_seams_without_jumps() {
     let chunk = stream.next(&mut model, 150).unwrap();
     let poses = global_poses(&chunk.motion);
     let joints = model.skeleton().len();
-    let root: Vec<[f64; 3]> = poses.iter().map(|p| p.joints[0]).collect();
+    let root: Vec<_> = poses.iter().map(|p| p.joints[0]).collect();
     let steps: Vec<f64> = root
         .windows(2)
         .map(|w| ((w[1][0] - w[0][0]).powi(2) + (w[1][2] - w[0][2]).powi(2)).sqrt())

@@ -6,7 +6,7 @@ mod common;
 
 use sinmdm::bvh::{parse_bvh, read_bvh, to_bvh_string};
 use sinmdm::motion::contacts::travelling_root;
-use sinmdm::motion::math::{self, Mat3};
+use sinmdm::motion::math::{self, Mat3, Vec3};
 use sinmdm::motion::up::{UP, UpAxis, reorient};
 use sinmdm::motion::{
     ChannelClip, ColumnKind, Confidence, EncodeOptions, EncodedClip, decode, detect_up, encode,
@@ -116,7 +116,7 @@ fn re_oriented_copies_are_detected_and_encode_to_the_same_features() {
             let start_b = encoded.layout.root.as_ref().map(|r| r.start_position);
             if let (Some(a), Some(b)) = (start_a, start_b) {
                 let h = original.layout.skeleton_height;
-                assert!(math::norm(math::sub(a, b)) < 1e-6 * h, "{a:?} {b:?}");
+                assert!((a - b).norm() < 1e-6 * h, "{a:?} {b:?}");
             }
             let h = original.layout.skeleton_height;
             assert!(
@@ -168,7 +168,7 @@ fn a_turn_about_up_changes_only_the_root_heading() {
                         let dz = original.features.row(i - axis.index() / 2 * 2 + 2);
                         let k = axis.index();
                         matches(&|f| {
-                            let v = math::mat_vec(&turn, [f64::from(dx[f]), 0.0, f64::from(dz[f])]);
+                            let v = turn * Vec3::new(f64::from(dx[f]), 0.0, f64::from(dz[f]));
                             v[k]
                         }) / layout.skeleton_height
                     }
@@ -363,7 +363,7 @@ fn in_container(clip: &ChannelClip, turn: &Mat3) -> ChannelClip {
     let mut joints = vec![Joint {
         name: "container".into(),
         parent: None,
-        offset: [0.0; 3],
+        offset: Vec3::ZERO,
         channels: vec![
             Channel::Rotation(Axis::Z),
             Channel::Rotation(Axis::X),
@@ -393,8 +393,8 @@ fn in_container(clip: &ChannelClip, turn: &Mat3) -> ChannelClip {
     let n = local.skeleton.len();
     for f in 0..local.frame_count() {
         let k = f * n + 1;
-        local.rotations[k] = math::mat_mul(turn, &local.rotations[k]);
-        local.translations[k] = math::mat_vec(turn, local.translations[k]);
+        local.rotations[k] = turn * local.rotations[k];
+        local.translations[k] = turn * local.translations[k];
     }
     through_file(&local.to_channels())
 }

@@ -18,18 +18,15 @@ pub(super) struct Similarity {
 impl Similarity {
     pub(super) const IDENTITY: Similarity = Similarity {
         rotation: math::IDENTITY,
-        translation: [0.0; 3],
+        translation: Vec3([0.0; 3]),
         scale: 1.0,
     };
 
     /// `self` after `inner`: `x -> self(inner(x))`.
     pub(super) fn then(&self, inner: &Similarity) -> Similarity {
         Similarity {
-            rotation: math::mat_mul(&self.rotation, &inner.rotation),
-            translation: math::add(
-                self.translation,
-                math::scale(math::mat_vec(&self.rotation, inner.translation), self.scale),
-            ),
+            rotation: (self.rotation * inner.rotation),
+            translation: (self.translation + ((self.rotation * inner.translation) * self.scale)),
             scale: self.scale * inner.scale,
         }
     }
@@ -78,8 +75,8 @@ pub(super) fn node_trs(path: &Path, nodes: &[Value], index: usize) -> Result<Trs
         let m = numbers::<16>(Some(m))
             .ok_or_else(|| FormatError::bad(path, part(), "'matrix' is not 16 numbers".into()))?;
         // Column-major: column c is m[4c..4c+4].
-        let column = |c: usize| [m[4 * c], m[4 * c + 1], m[4 * c + 2]];
-        let scale = [column(0), column(1), column(2)].map(math::norm);
+        let column = |c: usize| Vec3::new(m[4 * c], m[4 * c + 1], m[4 * c + 2]);
+        let scale = Vec3::from_fn(|c| column(c).norm());
         if scale.iter().any(|&s| s < 1e-12) {
             return Err(FormatError::bad(
                 path,
@@ -87,8 +84,7 @@ pub(super) fn node_trs(path: &Path, nodes: &[Value], index: usize) -> Result<Trs
                 "'matrix' is singular".into(),
             ));
         }
-        let rotation: Mat3 =
-            std::array::from_fn(|r| std::array::from_fn(|c| column(c)[r] / scale[c]));
+        let rotation = Mat3::from_fn(|r, c| column(c)[r] / scale[c]);
         return Ok(Trs {
             translation: column(3),
             rotation,
@@ -108,9 +104,9 @@ pub(super) fn node_trs(path: &Path, nodes: &[Value], index: usize) -> Result<Trs
         None => invalid("scale").map(|()| [1.0; 3])?,
     };
     Ok(Trs {
-        translation,
+        translation: sinmdm::motion::math::Vec3(translation),
         rotation,
-        scale,
+        scale: sinmdm::motion::math::Vec3(scale),
     })
 }
 

@@ -18,7 +18,7 @@ use std::path::Path;
 
 use serde_json::Value;
 use sinmdm::motion::ChannelClip;
-use sinmdm::motion::math;
+use sinmdm::motion::math::{self, Vec3};
 
 use super::accessor::{field_usize, read_floats};
 use super::container::{Asset, read_asset};
@@ -125,9 +125,9 @@ fn sample_frames(
             for track in tracks.iter().filter(|track| track.joint == j) {
                 let v = track.sample(t, snap);
                 match track.property {
-                    Property::Translation => translation = [v[0], v[1], v[2]],
+                    Property::Translation => translation = Vec3::new(v[0], v[1], v[2]),
                     Property::Rotation => rotation = rotation_of(v),
-                    Property::Scale => scale = [v[0], v[1], v[2]],
+                    Property::Scale => scale = Vec3::new(v[0], v[1], v[2]),
                 }
             }
             if !unit_scale(scale) {
@@ -146,7 +146,7 @@ fn sample_frames(
             // Below the root, the nodes above it scale every translation.
             let factor = if j == 0 { 1.0 } else { unit };
             rotations.push(local.rotation);
-            translations.push(math::scale(local.translation, factor));
+            translations.push(local.translation * factor);
         }
     }
 
@@ -189,7 +189,7 @@ pub fn read_gltf(path: &Path, options: &ReadOptions) -> Result<GltfClip, FormatE
         .order
         .iter()
         .zip(&skin.pre)
-        .map(|(&n, pre)| math::mat_mul(&pre.rotation, &rest[n].rotation))
+        .map(|(&n, pre)| pre.rotation * rest[n].rotation)
         .collect();
     let motion = SampledJoints {
         names: unique_names(node_names(nodes, &skin.order)),

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde_json::Value;
 use sinmdm::motion::Channel;
-use sinmdm::motion::math::{self, Vec3};
+use sinmdm::motion::math::Vec3;
 
 use super::EXTRAS_KEY;
 use super::nodes::{Similarity, Trs, node_name, numbers, uniform};
@@ -201,6 +201,6 @@ fn recorded(node: &Value, unit: f64) -> (Option<Vec<Channel>>, Option<Vec3>) {
                 .collect::<Option<Vec<_>>>()
         })
         .filter(|channels| well_formed(channels));
-    let end = numbers::<3>(extras.and_then(|e| e.get("end_site"))).map(|e| math::scale(e, unit));
+    let end = numbers::<3>(extras.and_then(|e| e.get("end_site"))).map(|e| Vec3(e) * unit);
     (channels, end)
 }

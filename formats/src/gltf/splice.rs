@@ -92,11 +92,11 @@ fn global_rest(
 
 /// The angle between two vectors, in radians (0 when either is too short to have a direction).
 fn angle(a: Vec3, b: Vec3) -> f64 {
-    let (na, nb) = (math::norm(a), math::norm(b));
+    let (na, nb) = (a.norm(), b.norm());
     if na < 1e-12 || nb < 1e-12 {
         return 0.0;
     }
-    (math::dot(a, b) / (na * nb)).clamp(-1.0, 1.0).acos()
+    (a.dot(b) / (na * nb)).clamp(-1.0, 1.0).acos()
 }
 
 /// Splices `motions` (one skeleton, in their file's frame with up axis `up`) into the character
@@ -170,10 +170,10 @@ pub fn splice_into_character(
     let mut our_rest: Vec<(Mat3, Vec3)> = Vec::with_capacity(skeleton.len());
     for joint in &skeleton.joints {
         let g = match joint.parent {
-            None => (turn, math::mat_vec(&turn, joint.offset)),
+            None => (turn, (turn * joint.offset)),
             Some(p) => {
                 let (r, t) = our_rest[p];
-                (r, math::add(t, math::mat_vec(&r, joint.offset)))
+                (r, (t + (r * joint.offset)))
             }
         };
         our_rest.push(g);
@@ -184,7 +184,7 @@ pub fn splice_into_character(
     let longest = skeleton
         .joints
         .iter()
-        .map(|j| math::norm(j.offset))
+        .map(|j| j.offset.norm())
         .fold(0.0, f64::max);
     let mut ratios = Vec::new();
     let mut same_frames = true;
@@ -192,15 +192,15 @@ pub fn splice_into_character(
     let mut first_misfit = None;
     for (j, joint) in skeleton.joints.iter().enumerate() {
         let Some(p) = joint.parent else { continue };
-        let ours_world = math::sub(our_rest[j].1, our_rest[p].1);
-        let theirs_world = math::sub(rest[mapped[j]].translation, rest[mapped[p]].translation);
-        if math::norm(ours_world) <= 1e-3 * longest {
+        let ours_world = our_rest[j].1 - our_rest[p].1;
+        let theirs_world = rest[mapped[j]].translation - rest[mapped[p]].translation;
+        if ours_world.norm() <= 1e-3 * longest {
             continue;
         }
-        ratios.push(math::norm(theirs_world) / math::norm(ours_world));
+        ratios.push(theirs_world.norm() / ours_world.norm());
         // In the parent's frame: our offset, and the character's bone seen from the parent node.
         let parent_frame = rest[mapped[p]];
-        let theirs_local = math::mat_vec(&math::transpose(&parent_frame.rotation), theirs_world);
+        let theirs_local = parent_frame.rotation.transpose() * theirs_world;
         let fits_local = angle(joint.offset, theirs_local) <= DIRECTION_TOLERANCE;
         let fits_world = angle(ours_world, theirs_world) <= DIRECTION_TOLERANCE;
         same_frames &= fits_local;
@@ -232,7 +232,7 @@ pub fn splice_into_character(
             if same_frames {
                 math::IDENTITY
             } else {
-                math::mat_mul(&math::transpose(&our_rest[j].0), &rest[mapped[j]].rotation)
+                our_rest[j].0.transpose() * rest[mapped[j]].rotation
             }
         })
         .collect();
@@ -307,7 +307,7 @@ fn spliced_animation(
 ) -> Value {
     let mut canonical = up::to_canonical(motion, up_axis);
     for t in &mut canonical.translations {
-        *t = math::scale(*t, scale);
+        *t = *t * scale;
     }
     let poses = global_poses(&canonical);
     let frames = motion.frame_count();
@@ -324,27 +324,22 @@ fn spliced_animation(
         for pose in &poses {
             let parent_global = match anchor {
                 Some((k, p)) => Similarity {
-                    rotation: math::mat_mul(&pose.rotations[k], &offset_turn[k]),
+                    rotation: (pose.rotations[k] * offset_turn[k]),
                     translation: pose.joints[k],
                     scale: rest[p].scale,
                 }
                 .then(&fixed),
                 None => fixed,
             };
-            let inverse_parent = math::transpose(&parent_global.rotation);
-            let global_rotation = math::mat_mul(&pose.rotations[j], &offset_turn[j]);
-            let local_rotation = math::mat_mul(&inverse_parent, &global_rotation);
+            let inverse_parent = parent_global.rotation.transpose();
+            let global_rotation = pose.rotations[j] * offset_turn[j];
+            let local_rotation = inverse_parent * global_rotation;
             let q = quaternion_xyzw(&local_rotation, previous);
             previous = Some(q);
             rotations.extend(unit_f32(q));
             if moves {
-                let local = math::scale(
-                    math::mat_vec(
-                        &inverse_parent,
-                        math::sub(pose.joints[j], parent_global.translation),
-                    ),
-                    1.0 / parent_global.scale,
-                );
+                let local = (inverse_parent * (pose.joints[j] - parent_global.translation))
+                    * (1.0 / parent_global.scale);
                 translations.extend(local.map(|v| v as f32));
             }
         }
@@ -391,16 +386,11 @@ fn parent_frame(
 
 /// `local` as a transform relative to `above` (both global): `above^-1 local`.
 fn relative(above: &Similarity, local: &Similarity) -> Similarity {
-    let inverse_rotation = math::transpose(&above.rotation);
+    let inverse_rotation = above.rotation.transpose();
     Similarity {
-        rotation: math::mat_mul(&inverse_rotation, &local.rotation),
-        translation: math::scale(
-            math::mat_vec(
-                &inverse_rotation,
-                math::sub(local.translation, above.translation),
-            ),
-            1.0 / above.scale,
-        ),
+        rotation: (inverse_rotation * local.rotation),
+        translation: ((inverse_rotation * (local.translation - above.translation))
+            * (1.0 / above.scale)),
         scale: local.scale / above.scale,
     }
 }

@@ -196,9 +196,9 @@ fn rest_transforms(skeleton: &Skeleton, options: &GltfWriteOptions) -> Vec<(Mat3
         .joints
         .iter()
         .map(|joint| {
-            let offset = math::scale(joint.offset, options.metres_per_unit);
+            let offset = joint.offset * options.metres_per_unit;
             match joint.parent {
-                None => (turn, math::mat_vec(&turn, offset)),
+                None => (turn, (turn * offset)),
                 Some(_) => (math::IDENTITY, offset),
             }
         })
@@ -214,14 +214,14 @@ fn inverse_bind_matrices(skeleton: &Skeleton, rest: &[(Mat3, Vec3)]) -> Vec<f32>
             None => (*r, *t),
             Some(p) => {
                 let (pr, pt) = global[p];
-                (math::mat_mul(&pr, r), math::add(pt, math::mat_vec(&pr, *t)))
+                (pr * r, pt + pr * *t)
             }
         };
-        let inverse_rotation = math::transpose(&g.0);
-        let inverse_translation = math::scale(math::mat_vec(&inverse_rotation, g.1), -1.0);
+        let inverse_rotation = g.0.transpose();
+        let inverse_translation = (inverse_rotation * g.1) * (-1.0);
         // Column-major: the rotation's columns, then the translation, each with its fourth row.
         for column in 0..3 {
-            out.extend(inverse_rotation.iter().map(|row| row[column] as f32));
+            out.extend(inverse_rotation.column(column).map(|v| v as f32));
             out.push(0.0);
         }
         out.extend(inverse_translation.map(|v| v as f32));
@@ -286,7 +286,7 @@ pub fn gltf_document(
             let channels: Vec<String> = joint.channels.iter().map(|c| c.to_string()).collect();
             let mut extras = json!({ "channels": channels });
             if let Some(end) = joint.end_site {
-                extras["end_site"] = json!(math::scale(end, options.metres_per_unit));
+                extras["end_site"] = json!((end * options.metres_per_unit));
             }
             node["extras"] = json!({ EXTRAS_KEY: extras });
             node
@@ -332,11 +332,8 @@ pub fn gltf_document(
             if moves {
                 let values: Vec<f32> = (0..frames)
                     .flat_map(|f| {
-                        math::scale(
-                            canonical.translations[f * joints + j],
-                            options.metres_per_unit,
-                        )
-                        .map(|v| v as f32)
+                        (canonical.translations[f * joints + j] * options.metres_per_unit)
+                            .map(|v| v as f32)
                     })
                     .collect();
                 let output = binary.accessor(&values, "VEC3", 3, false);

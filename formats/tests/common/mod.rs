@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use sinmdm::motion::features::{EncodeOptions, FeatureLayout, encode};
-use sinmdm::motion::math;
+use sinmdm::motion::math::Vec3;
 use sinmdm::motion::{ChannelClip, LocalMotion, UpAxis, detect_up, global_poses};
 
 /// The repository root.
@@ -23,7 +23,7 @@ pub fn fixtures() -> PathBuf {
 }
 
 /// Every frame's joint positions by joint name.
-pub fn positions_by_name(motion: &LocalMotion) -> Vec<Vec<(String, [f64; 3])>> {
+pub fn positions_by_name(motion: &LocalMotion) -> Vec<Vec<(String, Vec3)>> {
     global_poses(motion)
         .iter()
         .map(|pose| {
@@ -86,7 +86,7 @@ pub fn worst_distance(got: &ChannelClip, expected: &ChannelClip) -> (f64, usize)
                 .iter()
                 .find(|(n, _)| n == name)
                 .unwrap_or_else(|| panic!("no joint {name} in the BVH"));
-            worst = worst.max(math::norm(math::sub(*p, *q)));
+            worst = worst.max((*p - *q).norm());
             compared += 1;
         }
     }
@@ -143,8 +143,8 @@ pub fn scaled(clip: &ChannelClip, factor: f64) -> ChannelClip {
     let mut out = clip.clone();
     let mut is_position = Vec::new();
     for joint in &mut out.skeleton.joints {
-        joint.offset = math::scale(joint.offset, factor);
-        joint.end_site = joint.end_site.map(|e| math::scale(e, factor));
+        joint.offset = joint.offset * factor;
+        joint.end_site = joint.end_site.map(|e| e * factor);
         is_position.extend(
             joint
                 .channels

@@ -273,7 +273,7 @@ impl<'a> Parser<'a> {
         joints.push(Joint {
             name,
             parent,
-            offset: [0.0; 3],
+            offset: Vec3::ZERO,
             channels: Vec::new(),
             end_site: None,
         });
@@ -285,7 +285,11 @@ impl<'a> Parser<'a> {
     }
 
     fn vec3(&mut self, what: &dyn Fn() -> String) -> Result<Vec3, BvhError> {
-        Ok([self.number(what)?, self.number(what)?, self.number(what)?])
+        Ok(Vec3::new(
+            self.number(what)?,
+            self.number(what)?,
+            self.number(what)?,
+        ))
     }
 
     fn channels(&mut self, joint: &str, line: usize) -> Result<Vec<Channel>, BvhError> {

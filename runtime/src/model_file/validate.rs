@@ -99,9 +99,9 @@ fn skeleton(p: &mut Problems, s: &Skeleton) {
             )),
             _ => {}
         }
-        p.finite(&format!("{field}.offset"), &joint.offset);
+        p.finite(&format!("{field}.offset"), &joint.offset.0);
         if let Some(end) = joint.end_site {
-            p.finite(&format!("{field}.end_site"), &end);
+            p.finite(&format!("{field}.end_site"), &end.0);
         }
         let rotations = joint.rotation_order();
         let positions = joint.position_axes();
@@ -143,7 +143,7 @@ fn layout(p: &mut Problems, m: &ModelMetadata) {
         ));
     }
     for (i, t) in l.rest_translations.iter().enumerate() {
-        p.finite(&format!("layout.rest_translations[{i}]"), t);
+        p.finite(&format!("layout.rest_translations[{i}]"), &t.0);
     }
     if let Some(root) = &l.root {
         if root.joint >= n {
@@ -159,7 +159,7 @@ fn layout(p: &mut Problems, m: &ModelMetadata) {
                 root.axes
             ));
         }
-        p.finite("layout.root.start_position", &root.start_position);
+        p.finite("layout.root.start_position", &root.start_position.0);
         if !is_rotation(&root.frame) {
             p.add(format!(
                 "layout.root.frame is {:?}; it must be a rotation matrix",
@@ -261,8 +261,8 @@ fn network_and_normalizer(p: &mut Problems, m: &ModelMetadata) {
 
 /// Whether `m` is a rotation: finite, orthonormal and right-handed, to 1e-6.
 fn is_rotation(m: &Mat3) -> bool {
-    let product = math::mat_mul(m, &math::transpose(m));
-    m.iter().flatten().all(|v| v.is_finite())
+    let product = m * m.transpose();
+    m.is_finite()
         && math::mat_max_abs_diff(&product, &math::IDENTITY) < 1e-6
-        && (math::dot(m[0], math::cross(m[1], m[2])) - 1.0).abs() < 1e-6
+        && (m.determinant() - 1.0).abs() < 1e-6
 }

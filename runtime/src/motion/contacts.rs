@@ -13,7 +13,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::fk::GlobalPose;
-use super::math::{self, Vec3};
+use super::math::Vec3;
 use super::skeleton::Skeleton;
 use super::up::{height_of, horizontal};
 
@@ -77,7 +77,7 @@ pub fn joint_speeds(positions: &[Vec3], fps: f64) -> Vec<f64> {
     (0..n)
         .map(|f| {
             let (a, b) = (f.saturating_sub(1), (f + 1).min(n - 1));
-            math::norm(math::sub(positions[b], positions[a])) * fps / (b - a) as f64
+            (positions[b] - positions[a]).norm() * fps / (b - a) as f64
         })
         .collect()
 }
@@ -126,9 +126,9 @@ pub fn travelling_root(skeleton: &Skeleton, poses: &[GlobalPose]) -> usize {
         let Some(first) = poses.first().map(|p| p.joints[joint]) else {
             return joint;
         };
-        let still = poses.iter().all(|p| {
-            math::norm(math::sub(p.joints[joint], first)) <= 1e-9 * (1.0 + math::norm(first))
-        });
+        let still = poses
+            .iter()
+            .all(|p| (p.joints[joint] - first).norm() <= 1e-9 * (1.0 + first.norm()));
         match skeleton.children(joint).as_slice() {
             [only] if still => joint = *only,
             _ => return joint,
@@ -153,12 +153,7 @@ pub fn is_in_place(
     }
     let span = one_second(fps).min(frames - 1);
     let travel: f64 = (0..frames - span)
-        .map(|f| {
-            math::norm(horizontal(math::sub(
-                poses[f + span].joints[root],
-                poses[f].joints[root],
-            )))
-        })
+        .map(|f| horizontal(poses[f + span].joints[root] - poses[f].joints[root]).norm())
         .sum::<f64>()
         / (frames - span) as f64
         * fps
@@ -167,7 +162,7 @@ pub fn is_in_place(
     for &joint in contact_joints {
         let relative: Vec<Vec3> = poses
             .iter()
-            .map(|p| horizontal(math::sub(p.contact_point(joint), p.joints[root])))
+            .map(|p| horizontal(p.contact_point(joint) - p.joints[root]))
             .collect();
         feet += joint_speeds(&relative, fps).iter().sum::<f64>() / frames as f64;
     }
@@ -177,7 +172,7 @@ pub fn is_in_place(
     }
     // Over a second: a treadmill drifts steadily, a dancer's lowest foot does not.
     let belt = belt_displacement(poses, contact_joints, fps, 1.0);
-    let belt_speed = belt.iter().map(|&v| math::norm(v)).sum::<f64>() / frames as f64 * fps;
+    let belt_speed = belt.iter().map(|&v| v.norm()).sum::<f64>() / frames as f64 * fps;
     belt_speed > IN_PLACE_MIN_BELT_RATIO * feet
 }
 
@@ -200,7 +195,7 @@ pub fn belt_displacement(
 ) -> Vec<Vec3> {
     let n = poses.len();
     if n < 2 || contact_joints.is_empty() {
-        return vec![[0.0; 3]; n];
+        return vec![Vec3::ZERO; n];
     }
     let lowest: Vec<Vec3> = (0..n)
         .map(|f| {
@@ -213,8 +208,8 @@ pub fn belt_displacement(
                         .total_cmp(&height_of(poses[f].contact_point(y)))
                 })
                 .unwrap_or(contact_joints[0]);
-            let step = math::sub(poses[b].contact_point(joint), poses[a].contact_point(joint));
-            horizontal(math::scale(step, 1.0 / (b - a) as f64))
+            let step = poses[b].contact_point(joint) - poses[a].contact_point(joint);
+            horizontal(step * (1.0 / (b - a) as f64))
         })
         .collect();
     let half = ((fps * window_seconds / 2.0).round() as usize).clamp(1, n);
@@ -222,8 +217,8 @@ pub fn belt_displacement(
     (0..n)
         .map(|f| {
             let (lo, hi) = (f.saturating_sub(half), f.saturating_add(half + 1).min(n));
-            let mut out = [0.0; 3];
-            for (c, value) in out.iter_mut().enumerate() {
+            let mut out = Vec3::ZERO;
+            for (c, value) in out.0.iter_mut().enumerate() {
                 window.clear();
                 window.extend(lowest[lo..hi].iter().map(|v| v[c]));
                 window.sort_by(f64::total_cmp);
@@ -270,10 +265,9 @@ pub fn label_contacts(
             let speeds = (0..n)
                 .map(|f| {
                     let (a, b) = (f.saturating_sub(1), (f + 1).min(n - 1));
-                    let step =
-                        math::sub(poses[b].contact_point(joint), poses[a].contact_point(joint));
-                    let relative = math::sub(step, math::scale(belt[f], (b - a) as f64));
-                    math::norm(relative) * fps / (b - a) as f64
+                    let step = poses[b].contact_point(joint) - poses[a].contact_point(joint);
+                    let relative = step - (belt[f] * ((b - a) as f64));
+                    relative.norm() * fps / (b - a) as f64
                 })
                 .collect();
             threshold(speeds, speed_threshold * height)
@@ -310,7 +304,7 @@ mod tests {
             if (10..20).contains(&f) {
                 x += 2.0 * height / 30.0;
             }
-            points.push(pose(&[[x, 0.0, 0.0]]));
+            points.push(pose(&[Vec3([x, 0.0, 0.0])]));
         }
         let labels = contact_labels(&points, 0, 30.0, height, 0.15);
         let expected: Vec<f32> = (0..30)
@@ -321,7 +315,7 @@ mod tests {
 
     #[test]
     fn speeds_use_central_differences() {
-        let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [3.0, 0.0, 0.0]];
+        let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [3.0, 0.0, 0.0]].map(Vec3);
         assert_eq!(joint_speeds(&positions, 10.0), vec![10.0, 15.0, 20.0]);
     }
 
@@ -331,7 +325,7 @@ mod tests {
         let joint = |name: &str, parent| Joint {
             name: name.into(),
             parent,
-            offset: [0.0; 3],
+            offset: Vec3([0.0; 3]),
             channels: vec![],
             end_site: None,
         };
@@ -343,7 +337,11 @@ mod tests {
                 joint("hand", Some(0)),
             ],
         };
-        let poses = vec![pose(&[[0.0, 1.0, 0.0], [0.0, 0.02, 0.0], [0.0, 1.4, 0.0]])];
+        let poses = vec![pose(&[
+            Vec3([0.0, 1.0, 0.0]),
+            Vec3([0.0, 0.02, 0.0]),
+            Vec3([0.0, 1.4, 0.0]),
+        ])];
         assert_eq!(choose_contact_joints(&skeleton, &poses, 1.4, 0.05), vec![1]);
     }
 }

@@ -1,7 +1,7 @@
 //! Forward kinematics: local transforms to global joint positions.
 
 use super::clip::LocalMotion;
-use super::math::{self, Mat3, Vec3};
+use super::math::{Mat3, Vec3};
 use super::up::height_of;
 
 /// Global positions of one frame: every joint, then every End Site (in joint order).
@@ -47,15 +47,12 @@ pub fn global_pose(motion: &LocalMotion, frame: usize) -> GlobalPose {
         let (position, rotation) = match joint.parent {
             None => (local_translation, *local_rotation),
             Some(p) => (
-                math::add(
-                    positions[p],
-                    math::mat_vec(&rotations[p], local_translation),
-                ),
-                math::mat_mul(&rotations[p], local_rotation),
+                (positions[p] + (rotations[p] * local_translation)),
+                (rotations[p] * local_rotation),
             ),
         };
         if let Some(end) = joint.end_site {
-            end_sites.push((j, math::add(position, math::mat_vec(&rotation, end))));
+            end_sites.push((j, (position + (rotation * end))));
         }
         positions.push(position);
         rotations.push(rotation);
@@ -105,7 +102,7 @@ pub fn max_position_error(a: &LocalMotion, b: &LocalMotion) -> Option<f64> {
         .iter()
         .zip(&global_poses(b))
         .flat_map(|(p, q)| p.points().zip(q.points()))
-        .map(|(p, q)| super::math::norm(super::math::sub(p, q)))
+        .map(|(p, q)| (p - q).norm())
         .fold(0.0, f64::max);
     Some(worst)
 }
@@ -134,23 +131,23 @@ mod tests {
                 Joint {
                     name: "root".into(),
                     parent: None,
-                    offset: [0.0; 3],
+                    offset: Vec3([0.0; 3]),
                     channels: root_channels,
                     end_site: None,
                 },
                 Joint {
                     name: "upper".into(),
                     parent: Some(0),
-                    offset: [0.0, 2.0, 0.0],
+                    offset: Vec3([0.0, 2.0, 0.0]),
                     channels: rot.clone(),
                     end_site: None,
                 },
                 Joint {
                     name: "lower".into(),
                     parent: Some(1),
-                    offset: [0.0, 3.0, 0.0],
+                    offset: Vec3([0.0, 3.0, 0.0]),
                     channels: rot,
-                    end_site: Some([0.0, 1.0, 0.0]),
+                    end_site: Some(Vec3([0.0, 1.0, 0.0])),
                 },
             ],
         }
@@ -172,18 +169,19 @@ mod tests {
                 axis_rotation(0, FRAC_PI_2),
                 crate::motion::math::IDENTITY,
             ],
-            translations: vec![[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 3.0, 0.0]],
+            translations: vec![
+                Vec3([1.0, 0.0, 0.0]),
+                Vec3([0.0, 2.0, 0.0]),
+                Vec3([0.0, 3.0, 0.0]),
+            ],
         };
         let pose = global_pose(&motion, 0);
         let expect = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [-1.0, 0.0, 3.0]];
         for (got, want) in pose.joints.iter().zip(expect) {
-            assert!(
-                math::norm(math::sub(*got, want)) < 1e-12,
-                "{got:?} vs {want:?}"
-            );
+            assert!(((*got) - Vec3(want)).norm() < 1e-12, "{got:?} vs {want:?}");
         }
         assert_eq!(pose.end_sites.len(), 1);
-        assert!(math::norm(math::sub(pose.end_sites[0].1, [-1.0, 0.0, 4.0])) < 1e-12);
+        assert!((pose.end_sites[0].1 - Vec3([-1.0, 0.0, 4.0])).norm() < 1e-12);
     }
 
     #[test]
@@ -193,7 +191,11 @@ mod tests {
             skeleton,
             fps: 30.0,
             rotations: vec![crate::motion::math::IDENTITY; 3],
-            translations: vec![[0.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 3.0, 0.0]],
+            translations: vec![
+                Vec3([0.0, 0.0, 0.0]),
+                Vec3([0.0, 2.0, 0.0]),
+                Vec3([0.0, 3.0, 0.0]),
+            ],
         };
         assert!((skeleton_height(&global_poses(&motion)) - 6.0).abs() < 1e-12);
     }

@@ -3,7 +3,7 @@
 //! as little as it can, in the model's own 6D representation, so that the chain's tip reaches a
 //! target. Only rotations change, so every bone keeps its length.
 
-use super::math::{self, Mat3, Vec3};
+use super::math::{Mat3, Vec3};
 use super::rotation::{mat_from_6d, mat_to_6d};
 
 /// A chain of joints described by rotations, for [`least_turn`]: its top joint's position and
@@ -32,49 +32,45 @@ impl TurnChain {
         let mut global = self.above;
         for (i, local) in locals.iter().enumerate() {
             if i > 0 {
-                at = math::add(at, math::mat_vec(&global, self.offsets[i - 1]));
+                at += global * self.offsets[i - 1];
             }
-            global = math::mat_mul(&global, local);
+            global = global * local;
             positions.push(at);
             globals.push(global);
         }
-        let tip = math::add(at, math::mat_vec(&global, self.tip));
+        let tip = at + (global * self.tip);
         (positions, globals, tip)
     }
 
     /// The chain's reach: its bones and the tip's lever, end to end.
     pub fn reach(&self) -> f64 {
-        self.offsets.iter().map(|&o| math::norm(o)).sum::<f64>() + math::norm(self.tip)
+        self.offsets.iter().map(|&o| o.norm()).sum::<f64>() + self.tip.norm()
     }
 }
 
 /// The rotation by `angle` radians about the unit vector `axis` (Rodrigues' formula).
 pub fn rotation_about(axis: Vec3, angle: f64) -> Mat3 {
     let (s, c) = angle.sin_cos();
-    let k: Mat3 = [
+    let k = Mat3([
         [0.0, -axis[2], axis[1]],
         [axis[2], 0.0, -axis[0]],
         [-axis[1], axis[0], 0.0],
-    ];
-    let k2 = math::mat_mul(&k, &k);
-    std::array::from_fn(|i| {
-        std::array::from_fn(|j| f64::from(u8::from(i == j)) + s * k[i][j] + (1.0 - c) * k2[i][j])
-    })
+    ]);
+    let k2 = k * k;
+    Mat3::from_fn(|i, j| f64::from(u8::from(i == j)) + s * k[i][j] + (1.0 - c) * k2[i][j])
 }
 
 /// Solves the symmetric positive definite 3 x 3 system `a x = b` (Cramer's rule); zeros when
 /// it is singular.
 fn solve3(a: &Mat3, b: Vec3) -> Vec3 {
-    let det = math::dot(a[0], math::cross(a[1], a[2]));
+    let det = a.determinant();
     if det.abs() <= f64::MIN_POSITIVE || !det.is_finite() {
-        return [0.0; 3];
+        return Vec3::ZERO;
     }
-    let column = |i: usize| -> Mat3 {
-        std::array::from_fn(|r| std::array::from_fn(|c| if c == i { b[r] } else { a[r][c] }))
-    };
-    std::array::from_fn(|i| {
+    let column = |i: usize| -> Mat3 { Mat3::from_fn(|r, c| if c == i { b[r] } else { a[r][c] }) };
+    Vec3::from_fn(|i| {
         let m = column(i);
-        math::dot(m[0], math::cross(m[1], m[2])) / det
+        m.determinant() / det
     })
 }
 
@@ -97,8 +93,8 @@ pub fn least_turn(
     let mut locals = chain.locals.clone();
     for _ in 0..iterations {
         let (positions, globals, tip) = chain.forward(&locals);
-        let error = math::sub(target, tip);
-        if math::norm(error) <= tolerance || !math::norm(error).is_finite() {
+        let error = target - tip;
+        if error.norm() <= tolerance || !error.norm().is_finite() {
             break;
         }
         // The tip moves by w x r for a turn w (world axis) at a joint r away: J = -[r]x. A turn
@@ -107,42 +103,37 @@ pub fn least_turn(
         // world frame, W = I + u u^T with u = G L2. The least weighted change is
         // w = W^-1 J^T y with (J W^-1 J^T + damping^2 I) y = e; W^-1 = I - u u^T / 2 and
         // J W^-1 J^T = |r|^2 I - r r^T - v v^T / 2 with v = r x u.
-        let levers: Vec<Vec3> = positions.iter().map(|&p| math::sub(tip, p)).collect();
+        let levers: Vec<Vec3> = positions.iter().map(|&p| tip - p).collect();
         let axes: Vec<Vec3> = globals
             .iter()
             .zip(&locals)
-            .map(|(g, l)| math::mat_vec(g, l[2]))
+            .map(|(g, l)| g * l.row(2))
             .collect();
-        let jjt: Mat3 = std::array::from_fn(|i| {
-            std::array::from_fn(|j| {
-                let diagonal = f64::from(u8::from(i == j));
-                levers
-                    .iter()
-                    .zip(&axes)
-                    .fold(diagonal * damping * damping, |sum, (r, u)| {
-                        let v = math::cross(*r, *u);
-                        sum + diagonal * math::dot(*r, *r) - r[i] * r[j] - 0.5 * v[i] * v[j]
-                    })
-            })
+        let jjt = Mat3::from_fn(|i, j| {
+            let diagonal = f64::from(u8::from(i == j));
+            levers
+                .iter()
+                .zip(&axes)
+                .fold(diagonal * damping * damping, |sum, (r, u)| {
+                    let v = r.cross(*u);
+                    sum + diagonal * r.dot(*r) - r[i] * r[j] - 0.5 * v[i] * v[j]
+                })
         });
         let y = solve3(&jjt, error);
         for (i, (r, u)) in levers.iter().zip(&axes).enumerate() {
-            let jty = math::cross(*r, y);
-            let turn = math::sub(jty, math::scale(*u, 0.5 * math::dot(*u, jty)));
-            let angle = math::norm(turn);
+            let jty = r.cross(y);
+            let turn = jty - (*u * (0.5 * u.dot(jty)));
+            let angle = turn.norm();
             if angle <= 0.0 || !angle.is_finite() {
                 continue;
             }
-            let world = rotation_about(
-                math::scale(turn, 1.0 / angle),
-                angle.min(MAX_TURN_PER_ITERATION),
-            );
+            let world = rotation_about(turn * (1.0 / angle), angle.min(MAX_TURN_PER_ITERATION));
             // The same turn in the joint's own frame: G' = W G = G (G^T W G).
             let g = &globals[i];
-            let in_joint = math::mat_mul(&math::transpose(g), &math::mat_mul(&world, g));
+            let in_joint = g.transpose() * (world * g);
             // Products of products drift from a rotation, and the drift feeds on itself
             // through the globals: back to the nearest rotation after every turn.
-            locals[i] = mat_from_6d(&mat_to_6d(&math::mat_mul(&locals[i], &in_joint)));
+            locals[i] = mat_from_6d(&mat_to_6d(&(locals[i] * in_joint)));
         }
     }
     locals
@@ -151,22 +142,20 @@ pub fn least_turn(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::motion::math;
 
     fn distance(a: Vec3, b: Vec3) -> f64 {
-        math::norm(math::sub(a, b))
+        (a - b).norm()
     }
 
     /// A dog's hind leg as rotations: hip, knee, hock, paw, each bent a little about its own
     /// axes, and a toe tip below the paw.
     fn hind_leg() -> TurnChain {
         let turn = |x: f64, y: f64, z: f64| {
-            math::mat_mul(
-                &math::axis_rotation(0, x),
-                &math::mat_mul(&math::axis_rotation(1, y), &math::axis_rotation(2, z)),
-            )
+            math::axis_rotation(0, x) * (math::axis_rotation(1, y) * math::axis_rotation(2, z))
         };
         TurnChain {
-            top: [0.1, 1.0, -0.2],
+            top: Vec3([0.1, 1.0, -0.2]),
             above: turn(0.1, 0.3, -0.05),
             locals: vec![
                 turn(0.4, 0.05, 0.1),
@@ -174,8 +163,12 @@ mod tests {
                 turn(0.7, -0.1, 0.0),
                 turn(-0.2, 0.0, 0.1),
             ],
-            offsets: vec![[0.0, -0.3, 0.05], [0.0, -0.3, -0.05], [0.0, -0.25, 0.02]],
-            tip: [0.03, -0.1, 0.08],
+            offsets: vec![
+                Vec3([0.0, -0.3, 0.05]),
+                Vec3([0.0, -0.3, -0.05]),
+                Vec3([0.0, -0.25, 0.02]),
+            ],
+            tip: Vec3([0.03, -0.1, 0.08]),
         }
     }
 
@@ -191,16 +184,16 @@ mod tests {
     }
 
     fn is_rotation(m: &Mat3) -> bool {
-        let mmt = math::mat_mul(m, &math::transpose(m));
+        let mmt = m * m.transpose();
         math::mat_max_abs_diff(&mmt, &math::IDENTITY) < 1e-12
-            && (math::dot(m[0], math::cross(m[1], m[2])) - 1.0).abs() < 1e-12
+            && (m.determinant() - 1.0).abs() < 1e-12
     }
 
     #[test]
     fn least_turn_brings_a_four_bone_leg_to_its_target_keeping_lengths() {
         let leg = hind_leg();
         let (_, _, tip) = leg.forward(&leg.locals);
-        let target = math::add(tip, [0.08, 0.05, -0.06]);
+        let target = tip + Vec3([0.08, 0.05, -0.06]);
         let reach = leg.reach();
         let locals = least_turn(&leg, target, 80, 1e-9, 0.05 * reach);
         let (positions, _, reached) = leg.forward(&locals);
@@ -208,9 +201,9 @@ mod tests {
         assert!(locals.iter().all(is_rotation));
         // Only rotations changed: every bone and the tip's lever keep their lengths.
         for (w, offset) in positions.windows(2).zip(&leg.offsets) {
-            assert!((distance(w[0], w[1]) - math::norm(*offset)).abs() < 1e-12);
+            assert!((distance(w[0], w[1]) - offset.norm()).abs() < 1e-12);
         }
-        assert!((distance(reached, positions[3]) - math::norm(leg.tip)).abs() < 1e-12);
+        assert!((distance(reached, positions[3]) - leg.tip.norm()).abs() < 1e-12);
         assert_eq!(positions[0], leg.top);
     }
 
@@ -227,7 +220,7 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         };
         for offset in [[0.05, 0.0, 0.0], [0.0, 0.04, -0.03], [-0.03, -0.02, 0.06]] {
-            let target = math::add(tip, offset);
+            let target = tip + Vec3(offset);
             let least = least_turn(&leg, target, 200, 1e-12, 1e-3 * reach);
             let cost = six_d_change(&leg.locals, &least);
             // Other exact answers near it: start from the least turn's, turned a little at
@@ -237,9 +230,9 @@ mod tests {
                 let start: Vec<Mat3> = least
                     .iter()
                     .map(|l| {
-                        let axis =
-                            math::normalize_or([uniform(), uniform(), uniform()], [1.0, 0.0, 0.0]);
-                        math::mat_mul(l, &rotation_about(axis, 0.05 * uniform()))
+                        let axis = Vec3::new(uniform(), uniform(), uniform())
+                            .normalize_or(Vec3::new(1.0, 0.0, 0.0));
+                        l * rotation_about(axis, 0.05 * uniform())
                     })
                     .collect();
                 let nearby = TurnChain {
@@ -262,18 +255,18 @@ mod tests {
     fn least_turn_stretches_towards_a_target_out_of_reach_without_nan() {
         let leg = hind_leg();
         let reach = leg.reach();
-        let far = math::add(leg.top, [0.3, -2.0 * reach, 0.1]);
+        let far = leg.top + Vec3([0.3, -2.0 * reach, 0.1]);
         let locals = least_turn(&leg, far, 80, 1e-9, 0.05 * reach);
-        assert!(locals.iter().flatten().flatten().all(|v| v.is_finite()));
+        assert!(locals.iter().all(Mat3::is_finite));
         assert!(locals.iter().all(is_rotation));
         let (_, _, tip) = leg.forward(&locals);
         // Nearly straight towards it: within a few per cent of the closest reach.
         let closest = distance(far, leg.top) - reach;
         assert!(distance(tip, far) < closest + 0.03 * reach, "{tip:?}");
         // A target on the top itself, or NaN, changes nothing into NaN.
-        for target in [leg.top, [f64::NAN, 0.0, 0.0]] {
+        for target in [leg.top, Vec3([f64::NAN, 0.0, 0.0])] {
             let locals = least_turn(&leg, target, 80, 1e-9, 0.05 * reach);
-            assert!(locals.iter().flatten().flatten().all(|v| v.is_finite()));
+            assert!(locals.iter().all(Mat3::is_finite));
         }
     }
 }

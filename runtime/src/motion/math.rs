@@ -4,93 +4,290 @@
 //! `R * p` in its parent's frame; matrices are row-major (`m[row][col]`); quaternions are
 //! `[x, y, z, w]` (scalar last), the order of the engine's `Quaternion` and of glTF.
 
-/// A 3-vector.
-pub type Vec3 = [f64; 3];
-/// A row-major 3x3 matrix (`m[row][col]`).
-pub type Mat3 = [[f64; 3]; 3];
+use std::ops::{Add, AddAssign, Index, IndexMut, Mul, Neg, Sub, SubAssign};
+
+use serde::{Deserialize, Serialize};
+
+/// A 3-vector, with the arithmetic of one: `a + b`, `a - b`, `-a`, `a * s`, [`Vec3::dot`],
+/// [`Vec3::cross`], [`Vec3::norm`]. `v[i]` is component `i`; it is stored (and serialized) as
+/// `[x, y, z]`.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(transparent)]
+#[repr(transparent)]
+pub struct Vec3(pub [f64; 3]);
+
+impl Vec3 {
+    /// The zero vector.
+    pub const ZERO: Vec3 = Vec3([0.0; 3]);
+
+    /// The vector `(x, y, z)`.
+    pub const fn new(x: f64, y: f64, z: f64) -> Vec3 {
+        Vec3([x, y, z])
+    }
+
+    /// The vector whose component `i` is `f(i)`.
+    pub fn from_fn(f: impl FnMut(usize) -> f64) -> Vec3 {
+        Vec3(std::array::from_fn(f))
+    }
+
+    /// The unit vector along coordinate axis `axis` (0 = X, 1 = Y, 2 = Z), times `length`.
+    pub fn along(axis: usize, length: f64) -> Vec3 {
+        Vec3::from_fn(|i| if i == axis { length } else { 0.0 })
+    }
+
+    /// The components as an array.
+    pub const fn to_array(self) -> [f64; 3] {
+        self.0
+    }
+
+    /// Dot product.
+    pub fn dot(self, other: Vec3) -> f64 {
+        self.0[0] * other.0[0] + self.0[1] * other.0[1] + self.0[2] * other.0[2]
+    }
+
+    /// Cross product `self x other`.
+    pub fn cross(self, other: Vec3) -> Vec3 {
+        let (a, b) = (self.0, other.0);
+        Vec3([
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ])
+    }
+
+    /// Euclidean length.
+    pub fn norm(self) -> f64 {
+        self.dot(self).sqrt()
+    }
+
+    /// `self / |self|`, or `fallback` when `self` is (nearly) zero.
+    pub fn normalize_or(self, fallback: Vec3) -> Vec3 {
+        let n = self.norm();
+        if n > 1e-12 {
+            self * (1.0 / n)
+        } else {
+            fallback
+        }
+    }
+
+    /// Whether every component is finite.
+    pub fn is_finite(self) -> bool {
+        self.0.iter().all(|v| v.is_finite())
+    }
+
+    /// Each component through `f`, as an array (such as `v.map(|c| c as f32)`).
+    pub fn map<T>(self, f: impl FnMut(f64) -> T) -> [T; 3] {
+        self.0.map(f)
+    }
+
+    /// The components, x first.
+    pub fn iter(&self) -> std::slice::Iter<'_, f64> {
+        self.0.iter()
+    }
+}
+
+impl IntoIterator for Vec3 {
+    type Item = f64;
+    type IntoIter = std::array::IntoIter<f64, 3>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.into_iter()
+    }
+}
+
+impl<'a> IntoIterator for &'a Vec3 {
+    type Item = &'a f64;
+    type IntoIter = std::slice::Iter<'a, f64>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.iter()
+    }
+}
+
+impl From<[f64; 3]> for Vec3 {
+    fn from(v: [f64; 3]) -> Vec3 {
+        Vec3(v)
+    }
+}
+
+impl From<Vec3> for [f64; 3] {
+    fn from(v: Vec3) -> [f64; 3] {
+        v.0
+    }
+}
+
+impl Index<usize> for Vec3 {
+    type Output = f64;
+    fn index(&self, i: usize) -> &f64 {
+        &self.0[i]
+    }
+}
+
+impl IndexMut<usize> for Vec3 {
+    fn index_mut(&mut self, i: usize) -> &mut f64 {
+        &mut self.0[i]
+    }
+}
+
+impl Add for Vec3 {
+    type Output = Vec3;
+    fn add(self, b: Vec3) -> Vec3 {
+        Vec3([self.0[0] + b.0[0], self.0[1] + b.0[1], self.0[2] + b.0[2]])
+    }
+}
+
+impl Sub for Vec3 {
+    type Output = Vec3;
+    fn sub(self, b: Vec3) -> Vec3 {
+        Vec3([self.0[0] - b.0[0], self.0[1] - b.0[1], self.0[2] - b.0[2]])
+    }
+}
+
+impl Neg for Vec3 {
+    type Output = Vec3;
+    fn neg(self) -> Vec3 {
+        Vec3([-self.0[0], -self.0[1], -self.0[2]])
+    }
+}
+
+impl Mul<f64> for Vec3 {
+    type Output = Vec3;
+    fn mul(self, s: f64) -> Vec3 {
+        Vec3([self.0[0] * s, self.0[1] * s, self.0[2] * s])
+    }
+}
+
+impl AddAssign for Vec3 {
+    fn add_assign(&mut self, b: Vec3) {
+        *self = *self + b;
+    }
+}
+
+impl SubAssign for Vec3 {
+    fn sub_assign(&mut self, b: Vec3) {
+        *self = *self - b;
+    }
+}
+
+/// A row-major 3x3 matrix: `m[row][col]`, `m * v` for a column vector, `a * b` for a product.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+#[repr(transparent)]
+pub struct Mat3(pub [[f64; 3]; 3]);
+
 /// A unit quaternion `[x, y, z, w]` (scalar last): one order from the sampler to the engine's
 /// [`super::pose::Quaternion`] and glTF files.
 pub type Quat = [f64; 4];
 
 /// The identity matrix.
-pub const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+pub const IDENTITY: Mat3 = Mat3([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
 
-/// `a + b`.
-pub fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
+impl Mat3 {
+    /// The matrix whose entry `(row, col)` is `f(row, col)`.
+    pub fn from_fn(mut f: impl FnMut(usize, usize) -> f64) -> Mat3 {
+        Mat3(std::array::from_fn(|r| std::array::from_fn(|c| f(r, c))))
+    }
 
-/// `a - b`.
-pub fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
+    /// The matrix with these columns.
+    pub fn from_columns(x: Vec3, y: Vec3, z: Vec3) -> Mat3 {
+        Mat3([[x[0], y[0], z[0]], [x[1], y[1], z[1]], [x[2], y[2], z[2]]])
+    }
 
-/// `s * a`.
-pub fn scale(a: Vec3, s: f64) -> Vec3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
+    /// Row `r` as a vector.
+    pub fn row(&self, r: usize) -> Vec3 {
+        Vec3(self.0[r])
+    }
 
-/// Dot product.
-pub fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
+    /// Column `c` as a vector.
+    pub fn column(&self, c: usize) -> Vec3 {
+        Vec3([self.0[0][c], self.0[1][c], self.0[2][c]])
+    }
 
-/// Cross product `a x b`.
-pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
+    /// The determinant, `row 0 . (row 1 x row 2)` (1 for a rotation).
+    pub fn determinant(&self) -> f64 {
+        self.row(0).dot(self.row(1).cross(self.row(2)))
+    }
 
-/// Euclidean length.
-pub fn norm(a: Vec3) -> f64 {
-    dot(a, a).sqrt()
-}
+    /// Transpose (the inverse of a rotation).
+    pub fn transpose(&self) -> Mat3 {
+        Mat3::from_fn(|r, c| self.0[c][r])
+    }
 
-/// `a / |a|`, or `fallback` when `a` is (nearly) zero.
-pub fn normalize_or(a: Vec3, fallback: Vec3) -> Vec3 {
-    let n = norm(a);
-    if n > 1e-12 {
-        scale(a, 1.0 / n)
-    } else {
-        fallback
+    /// Whether every entry is finite.
+    pub fn is_finite(&self) -> bool {
+        self.0.iter().flatten().all(|v| v.is_finite())
     }
 }
 
-/// Matrix product `a * b`.
-pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    let mut out = [[0.0; 3]; 3];
-    for (r, row) in out.iter_mut().enumerate() {
-        for (c, value) in row.iter_mut().enumerate() {
-            *value = a[r][0] * b[0][c] + a[r][1] * b[1][c] + a[r][2] * b[2][c];
-        }
+impl<'a> IntoIterator for &'a Mat3 {
+    type Item = &'a [f64; 3];
+    type IntoIter = std::slice::Iter<'a, [f64; 3]>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.iter()
     }
-    out
 }
 
-/// Matrix-vector product `m * v`.
-pub fn mat_vec(m: &Mat3, v: Vec3) -> Vec3 {
-    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
+impl Index<usize> for Mat3 {
+    type Output = [f64; 3];
+    fn index(&self, r: usize) -> &[f64; 3] {
+        &self.0[r]
+    }
 }
 
-/// Transpose (the inverse of a rotation).
-pub fn transpose(m: &Mat3) -> Mat3 {
-    [
-        [m[0][0], m[1][0], m[2][0]],
-        [m[0][1], m[1][1], m[2][1]],
-        [m[0][2], m[1][2], m[2][2]],
-    ]
+impl IndexMut<usize> for Mat3 {
+    fn index_mut(&mut self, r: usize) -> &mut [f64; 3] {
+        &mut self.0[r]
+    }
+}
+
+impl Mul for Mat3 {
+    type Output = Mat3;
+    fn mul(self, b: Mat3) -> Mat3 {
+        let a = &self.0;
+        Mat3::from_fn(|r, c| a[r][0] * b.0[0][c] + a[r][1] * b.0[1][c] + a[r][2] * b.0[2][c])
+    }
+}
+
+impl Mul<Vec3> for Mat3 {
+    type Output = Vec3;
+    fn mul(self, v: Vec3) -> Vec3 {
+        Vec3([self.row(0).dot(v), self.row(1).dot(v), self.row(2).dot(v)])
+    }
+}
+
+impl Mul<&Mat3> for Mat3 {
+    type Output = Mat3;
+    fn mul(self, b: &Mat3) -> Mat3 {
+        self * *b
+    }
+}
+
+impl Mul<Mat3> for &Mat3 {
+    type Output = Mat3;
+    fn mul(self, b: Mat3) -> Mat3 {
+        *self * b
+    }
+}
+
+impl Mul<&Mat3> for &Mat3 {
+    type Output = Mat3;
+    fn mul(self, b: &Mat3) -> Mat3 {
+        *self * *b
+    }
+}
+
+impl Mul<Vec3> for &Mat3 {
+    type Output = Vec3;
+    fn mul(self, v: Vec3) -> Vec3 {
+        *self * v
+    }
 }
 
 /// Rotation by `radians` about coordinate axis `axis` (0 = X, 1 = Y, 2 = Z), right-handed.
 pub fn axis_rotation(axis: usize, radians: f64) -> Mat3 {
     let (s, c) = radians.sin_cos();
     match axis {
-        0 => [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]],
-        1 => [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]],
-        _ => [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]],
+        0 => Mat3([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]),
+        1 => Mat3([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]),
+        _ => Mat3([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]),
     }
 }
 
@@ -143,7 +340,7 @@ pub fn quat_from_mat(m: &Mat3) -> Quat {
 /// The rotation matrix of a (not necessarily unit) quaternion.
 pub fn mat_from_quat(q: Quat) -> Mat3 {
     let [x, y, z, w] = quat_normalize(q);
-    [
+    Mat3([
         [
             1.0 - 2.0 * (y * y + z * z),
             2.0 * (x * y - w * z),
@@ -159,7 +356,7 @@ pub fn mat_from_quat(q: Quat) -> Mat3 {
             2.0 * (y * z + w * x),
             1.0 - 2.0 * (x * x + y * y),
         ],
-    ]
+    ])
 }
 
 /// `q / |q|` (identity for a zero quaternion).
@@ -216,18 +413,18 @@ mod tests {
     #[test]
     fn axis_rotations_turn_basis_vectors_right_handed() {
         // +90 degrees about X takes +Y to +Z; about Y takes +Z to +X; about Z takes +X to +Y.
-        let close = |a: Vec3, b: Vec3| norm(sub(a, b)) < 1e-12;
+        let close = |a: Vec3, b: Vec3| (a - b).norm() < 1e-12;
         assert!(close(
-            mat_vec(&axis_rotation(0, FRAC_PI_2), [0.0, 1.0, 0.0]),
-            [0.0, 0.0, 1.0]
+            axis_rotation(0, FRAC_PI_2) * Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.0, 0.0, 1.0)
         ));
         assert!(close(
-            mat_vec(&axis_rotation(1, FRAC_PI_2), [0.0, 0.0, 1.0]),
-            [1.0, 0.0, 0.0]
+            axis_rotation(1, FRAC_PI_2) * Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 0.0)
         ));
         assert!(close(
-            mat_vec(&axis_rotation(2, FRAC_PI_2), [1.0, 0.0, 0.0]),
-            [0.0, 1.0, 0.0]
+            axis_rotation(2, FRAC_PI_2) * Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0)
         ));
     }
 
@@ -247,10 +444,7 @@ mod tests {
         // Rotations by ~180 degrees exercise each of Shepperd's diagonal branches.
         for axis in 0..3 {
             for angle in [0.3, 3.1, -3.1, std::f64::consts::PI - 1e-6] {
-                let m = mat_mul(
-                    &axis_rotation(axis, angle),
-                    &axis_rotation((axis + 1) % 3, 0.2),
-                );
+                let m = axis_rotation(axis, angle) * axis_rotation((axis + 1) % 3, 0.2);
                 let back = mat_from_quat(quat_from_mat(&m));
                 assert!(mat_max_abs_diff(&m, &back) < 1e-12);
             }

@@ -3,7 +3,7 @@
 
 use super::clip::LocalMotion;
 use super::features::{FeatureLayout, FeatureMatrix, MotionError, encode_motion};
-use super::math::{mat_from_quat, quat_from_mat};
+use super::math::{Vec3, mat_from_quat, quat_from_mat};
 use super::skeleton::Skeleton;
 
 /// A unit quaternion with named components (`w` the scalar part), laid out `x, y, z, w` in
@@ -43,7 +43,7 @@ impl Pose {
 /// One [`Pose`] per frame.
 pub fn poses(motion: &LocalMotion) -> Vec<Pose> {
     let joints = motion.skeleton.len();
-    let narrow = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
+    let narrow = |v: Vec3| v.0.map(|c| c as f32);
     (0..motion.frame_count())
         .map(|f| {
             let range = f * joints..(f + 1) * joints;
@@ -88,7 +88,7 @@ pub fn motion_from_poses(
     let joints = skeleton.len();
     let mut rotations = Vec::with_capacity(poses.len() * joints);
     let mut translations = Vec::with_capacity(poses.len() * joints);
-    let wide = |v: [f32; 3]| [f64::from(v[0]), f64::from(v[1]), f64::from(v[2])];
+    let wide = |v: [f32; 3]| Vec3(v.map(f64::from));
     for (frame, pose) in poses.iter().enumerate() {
         let bad = |problem: String| MotionError::BadPose { frame, problem };
         if pose.rotations.len() != joints || pose.translations.len() != joints {

@@ -34,7 +34,7 @@ pub fn resample(motion: &LocalMotion, to_fps: f64) -> LocalMotion {
             let (a, b) = (lo * joints + j, hi * joints + j);
             let ta = motion.translations[a];
             let tb = motion.translations[b];
-            translations.push(math::add(math::scale(ta, 1.0 - w), math::scale(tb, w)));
+            translations.push((ta * (1.0 - w)) + (tb * w));
             rotations.push(if w == 0.0 {
                 motion.rotations[a]
             } else {
@@ -55,15 +55,15 @@ pub fn resample(motion: &LocalMotion, to_fps: f64) -> LocalMotion {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::motion::math::{IDENTITY, axis_rotation, mat_max_abs_diff};
+    use crate::motion::math::{IDENTITY, Vec3, axis_rotation, mat_max_abs_diff};
     use crate::motion::skeleton::{Axis, Channel, Joint, Skeleton};
 
-    fn single_joint(frames: usize, fps: f64, velocity: [f64; 3], spin: f64) -> LocalMotion {
+    fn single_joint(frames: usize, fps: f64, velocity: Vec3, spin: f64) -> LocalMotion {
         let skeleton = Skeleton {
             joints: vec![Joint {
                 name: "root".into(),
                 parent: None,
-                offset: [0.0; 3],
+                offset: Vec3::ZERO,
                 channels: vec![
                     Channel::Position(Axis::X),
                     Channel::Position(Axis::Y),
@@ -73,9 +73,7 @@ mod tests {
                 end_site: None,
             }],
         };
-        let translations = (0..frames)
-            .map(|f| math::scale(velocity, f as f64 / fps))
-            .collect();
+        let translations = (0..frames).map(|f| velocity * (f as f64 / fps)).collect();
         let rotations = (0..frames)
             .map(|f| axis_rotation(1, spin * f as f64 / fps))
             .collect();
@@ -90,14 +88,14 @@ mod tests {
     #[test]
     fn constant_velocity_root_stays_on_its_line_at_the_new_rate() {
         // 120 fps for 2 s (241 frames) moving at (3, 0, -1.5) units/s and turning 0.5 rad/s.
-        let source = single_joint(241, 120.0, [3.0, 0.0, -1.5], 0.5);
+        let source = single_joint(241, 120.0, Vec3::new(3.0, 0.0, -1.5), 0.5);
         let out = resample(&source, 30.0);
         assert_eq!(out.frame_count(), 61);
         assert_eq!(out.fps, 30.0);
         for m in 0..61 {
             let t = m as f64 / 30.0;
             let want = [3.0 * t, 0.0, -1.5 * t];
-            assert!(math::norm(math::sub(out.translations[m], want)) < 1e-12);
+            assert!((out.translations[m] - Vec3(want)).norm() < 1e-12);
             assert!(mat_max_abs_diff(&out.rotations[m], &axis_rotation(1, 0.5 * t)) < 1e-12);
         }
     }
@@ -105,7 +103,7 @@ mod tests {
     #[test]
     fn upsampling_interpolates_between_frames() {
         // 24 -> 30 fps: frame 1 at t = 1/30 lies 0.8 of the way from source frame 0 to 1.
-        let source = single_joint(25, 24.0, [2.4, 0.0, 0.0], 2.4);
+        let source = single_joint(25, 24.0, Vec3::new(2.4, 0.0, 0.0), 2.4);
         let out = resample(&source, 30.0);
         assert_eq!(out.frame_count(), 31);
         assert!((out.translations[1][0] - 2.4 / 30.0).abs() < 1e-12);
@@ -114,7 +112,7 @@ mod tests {
 
     #[test]
     fn same_rate_is_a_copy() {
-        let source = single_joint(10, 30.0, [1.0, 0.0, 0.0], 0.0);
+        let source = single_joint(10, 30.0, Vec3::new(1.0, 0.0, 0.0), 0.0);
         assert_eq!(resample(&source, 30.0), source);
         assert_eq!(source.rotations[3], IDENTITY);
     }

@@ -13,7 +13,7 @@ pub fn euler_to_mat(order: &[Axis], radians: &[f64]) -> Mat3 {
         .iter()
         .zip(radians)
         .fold(math::IDENTITY, |acc, (axis, &angle)| {
-            math::mat_mul(&acc, &math::axis_rotation(axis.index(), angle))
+            acc * math::axis_rotation(axis.index(), angle)
         })
 }
 
@@ -60,18 +60,20 @@ pub fn mat_to_6d(m: &Mat3) -> [f64; 6] {
 /// The rotation nearest to a (possibly perturbed) 6D value, by Gram-Schmidt:
 /// `a = normalize(r0)`, `c = normalize(a x r1)`, `b = c x a`, rows `a, b, c`.
 pub fn mat_from_6d(v: &[f64]) -> Mat3 {
-    let r0: Vec3 = [v[0], v[1], v[2]];
-    let r1: Vec3 = [v[3], v[4], v[5]];
-    let a = math::normalize_or(r0, [1.0, 0.0, 0.0]);
+    let r0 = Vec3::new(v[0], v[1], v[2]);
+    let r1 = Vec3::new(v[3], v[4], v[5]);
+    let a = r0.normalize_or(Vec3::new(1.0, 0.0, 0.0));
     // A degenerate second row (parallel to the first, or zero) falls back to any perpendicular.
     let fallback = if a[0].abs() < 0.9 {
-        math::normalize_or(math::cross(a, [1.0, 0.0, 0.0]), [0.0, 0.0, 1.0])
+        a.cross(Vec3::new(1.0, 0.0, 0.0))
+            .normalize_or(Vec3::new(0.0, 0.0, 1.0))
     } else {
-        math::normalize_or(math::cross(a, [0.0, 1.0, 0.0]), [0.0, 0.0, 1.0])
+        a.cross(Vec3::new(0.0, 1.0, 0.0))
+            .normalize_or(Vec3::new(0.0, 0.0, 1.0))
     };
-    let c = math::normalize_or(math::cross(a, r1), fallback);
-    let b = math::cross(c, a);
-    [a, b, c]
+    let c = a.cross(r1).normalize_or(fallback);
+    let b = c.cross(a);
+    Mat3([a.0, b.0, c.0])
 }
 
 /// Shifts each angle (degrees) by a multiple of 360 so it lies nearest to `previous`, keeping
@@ -85,7 +87,7 @@ pub fn unwrap_degrees(angles: &mut [f64], previous: &[f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::motion::math::{axis_rotation, mat_max_abs_diff, mat_mul};
+    use crate::motion::math::{Vec3, axis_rotation, mat_max_abs_diff};
     use std::f64::consts::FRAC_PI_2;
 
     const ORDERS: [[Axis; 3]; 6] = [
@@ -98,7 +100,7 @@ mod tests {
     ];
 
     fn close(a: Vec3, b: Vec3) -> bool {
-        math::norm(math::sub(a, b)) < 1e-12
+        (a - b).norm() < 1e-12
     }
 
     #[test]
@@ -116,7 +118,7 @@ mod tests {
                 angles[slot] = FRAC_PI_2;
                 let m = euler_to_mat(&order, &angles);
                 let (from, to) = expected[order[slot].index()];
-                assert!(close(math::mat_vec(&m, from), to), "{order:?} slot {slot}");
+                assert!(close(m * Vec3(from), Vec3(to)), "{order:?} slot {slot}");
             }
         }
     }
@@ -126,9 +128,9 @@ mod tests {
         // For order Z X (R = Rz(90) Rx(90)): a point on +Y goes first to +Z (by Rx), then Rz keeps
         // it at +Z. For X Z (R = Rx(90) Rz(90)): +Y goes to -X (by Rz), then Rx keeps it at -X.
         let zx = euler_to_mat(&[Axis::Z, Axis::X], &[FRAC_PI_2, FRAC_PI_2]);
-        assert!(close(math::mat_vec(&zx, [0.0, 1.0, 0.0]), [0.0, 0.0, 1.0]));
+        assert!(close(zx * Vec3::new(0.0, 1.0, 0.0), Vec3([0.0, 0.0, 1.0])));
         let xz = euler_to_mat(&[Axis::X, Axis::Z], &[FRAC_PI_2, FRAC_PI_2]);
-        assert!(close(math::mat_vec(&xz, [0.0, 1.0, 0.0]), [-1.0, 0.0, 0.0]));
+        assert!(close(xz * Vec3::new(0.0, 1.0, 0.0), Vec3([-1.0, 0.0, 0.0])));
     }
 
     #[test]
@@ -141,13 +143,9 @@ mod tests {
                 assert!((a - b).abs() < 1e-12, "{order:?}: {angles:?} vs {back:?}");
             }
             // The decomposition agrees with an independent product of axis rotations.
-            let naive = mat_mul(
-                &mat_mul(
-                    &axis_rotation(order[0].index(), angles[0]),
-                    &axis_rotation(order[1].index(), angles[1]),
-                ),
-                &axis_rotation(order[2].index(), angles[2]),
-            );
+            let naive = (axis_rotation(order[0].index(), angles[0])
+                * axis_rotation(order[1].index(), angles[1]))
+                * axis_rotation(order[2].index(), angles[2]);
             assert!(mat_max_abs_diff(&m, &naive) < 1e-15);
         }
     }
@@ -194,21 +192,21 @@ mod tests {
             *x += n;
         }
         let m = mat_from_6d(&v);
-        let mtm = mat_mul(&math::transpose(&m), &m);
+        let mtm = m.transpose() * m;
         assert!(mat_max_abs_diff(&mtm, &math::IDENTITY) < 1e-12);
-        let det = math::dot(m[0], math::cross(m[1], m[2]));
+        let det = m.determinant();
         assert!((det - 1.0).abs() < 1e-12);
         assert!(mat_max_abs_diff(&m, &r) < 0.05);
         // The first row keeps the direction of the perturbed r0.
-        let r0 = math::normalize_or([v[0], v[1], v[2]], [1.0, 0.0, 0.0]);
-        assert!(close(m[0], r0));
+        let r0 = Vec3::new(v[0], v[1], v[2]).normalize_or(Vec3::new(1.0, 0.0, 0.0));
+        assert!(close(Vec3(m[0]), r0));
     }
 
     #[test]
     fn degenerate_6d_still_gives_a_rotation() {
         for v in [[0.0; 6], [1.0, 0.0, 0.0, 2.0, 0.0, 0.0]] {
             let m = mat_from_6d(&v);
-            let mtm = mat_mul(&math::transpose(&m), &m);
+            let mtm = m.transpose() * m;
             assert!(mat_max_abs_diff(&mtm, &math::IDENTITY) < 1e-12);
         }
     }

@@ -78,10 +78,8 @@ impl UpAxis {
 
     /// The unit vector of the axis, in file coordinates.
     pub fn direction(self) -> Vec3 {
-        let mut v = [0.0; 3];
         let (index, sign) = self.index_and_sign();
-        v[index] = sign;
-        v
+        Vec3::along(index, sign)
     }
 
     pub(crate) fn index_and_sign(self) -> (usize, f64) {
@@ -102,25 +100,23 @@ impl UpAxis {
     pub fn file_from_canonical(self) -> Mat3 {
         match self {
             UpAxis::PosY => math::IDENTITY,
-            UpAxis::NegY => [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]],
-            UpAxis::PosZ => [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]],
-            UpAxis::NegZ => [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]],
-            UpAxis::PosX => [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
-            UpAxis::NegX => [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+            UpAxis::NegY => Mat3([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]),
+            UpAxis::PosZ => Mat3([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]),
+            UpAxis::NegZ => Mat3([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]),
+            UpAxis::PosX => Mat3([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]),
+            UpAxis::NegX => Mat3([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]),
         }
     }
 
     /// The rotation that takes the file's coordinates to canonical ones.
     pub fn canonical_from_file(self) -> Mat3 {
-        math::transpose(&self.file_from_canonical())
+        self.file_from_canonical().transpose()
     }
 }
 
 /// The file's name of canonical axis `index` (0, 1 or 2) under up axis `up`, such as `-Y`.
 pub fn file_axis_name(up: UpAxis, index: usize) -> String {
-    let mut v = [0.0; 3];
-    v[index] = 1.0;
-    let f = math::mat_vec(&up.file_from_canonical(), v);
+    let f = up.file_from_canonical() * Vec3::along(index, 1.0);
     let i = (0..3).find(|&i| f[i] != 0.0).unwrap_or(index);
     let sign = if f[i] < 0.0 { "-" } else { "" };
     format!("{sign}{}", ["X", "Y", "Z"][i])
@@ -185,8 +181,8 @@ pub fn rotate_motion(motion: &LocalMotion, rotation: &Mat3) -> LocalMotion {
         }
         for f in 0..motion.frame_count() {
             let k = f * joints + j;
-            out.rotations[k] = math::mat_mul(rotation, &motion.rotations[k]);
-            out.translations[k] = math::mat_vec(rotation, motion.translations[k]);
+            out.rotations[k] = rotation * motion.rotations[k];
+            out.translations[k] = rotation * motion.translations[k];
         }
     }
     out
@@ -215,7 +211,7 @@ pub fn reorient(motion: &LocalMotion, rotation: &Mat3) -> LocalMotion {
     let mut out = rotate_motion(motion, rotation);
     for joint in &mut out.skeleton.joints {
         if joint.parent.is_none() {
-            joint.offset = math::mat_vec(rotation, joint.offset);
+            joint.offset = rotation * joint.offset;
         }
     }
     out
@@ -247,24 +243,15 @@ mod tests {
     fn each_axis_maps_canonical_up_to_itself_and_is_a_rotation() {
         for axis in UpAxis::ALL {
             let a = axis.file_from_canonical();
-            assert_eq!(
-                math::mat_vec(&a, [0.0, 1.0, 0.0]),
-                axis.direction(),
-                "{axis}"
-            );
-            let det = math::dot(a[0], math::cross(a[1], a[2]));
+            assert_eq!((a * Vec3::new(0.0, 1.0, 0.0)), axis.direction(), "{axis}");
+            let det = a.determinant();
             assert_eq!(det, 1.0, "{axis}");
-            assert_eq!(
-                math::mat_mul(&a, &axis.canonical_from_file()),
-                math::IDENTITY
-            );
+            assert_eq!((a * axis.canonical_from_file()), math::IDENTITY);
             // The file's up direction becomes canonical +Y.
             let (index, sign) = axis.index_and_sign();
-            let mut file_up = [0.0; 3];
-            file_up[index] = sign;
             assert_eq!(
-                math::mat_vec(&axis.canonical_from_file(), file_up),
-                [0.0, 1.0, 0.0]
+                axis.canonical_from_file() * Vec3::along(index, sign),
+                Vec3::new(0.0, 1.0, 0.0)
             );
         }
     }

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::motion::clip::LocalMotion;
 use crate::motion::contacts::travelling_root;
 use crate::motion::fk::global_poses;
-use crate::motion::math::{self, Vec3};
+use crate::motion::math::Vec3;
 use crate::motion::skeleton::Skeleton;
 use crate::motion::up::UpAxis;
 
@@ -94,13 +94,13 @@ fn limb_weights(skeleton: &Skeleton, top: usize) -> Vec<(usize, f64)> {
         .into_iter()
         .map(|leaf| {
             let joint = &skeleton.joints[leaf];
-            let mut length = joint.end_site.map_or(0.0, math::norm);
+            let mut length = joint.end_site.map_or(0.0, Vec3::norm);
             let mut j = leaf;
             while let Some(p) = skeleton.joints[j].parent {
                 if j == top {
                     break;
                 }
-                length += math::norm(skeleton.joints[j].offset);
+                length += skeleton.joints[j].offset.norm();
                 if children[p] > 1 || p == top {
                     break;
                 }
@@ -138,35 +138,35 @@ pub fn detect_up(motion: &LocalMotion) -> UpDetection {
         .map(|j| is_below(skeleton, j, top))
         .collect();
     let total_weight: f64 = weights.iter().map(|(_, w)| w).sum();
-    let mut hang = [0.0; 3];
+    let mut hang = Vec3::ZERO;
     let mut size = 0.0;
     for pose in &poses {
         // The body's centre: bone midpoints weighted by bone length.
-        let mut centre = [0.0; 3];
+        let mut centre = Vec3::ZERO;
         let mut mass = 0.0;
         for (j, joint) in skeleton.joints.iter().enumerate() {
             if let Some(p) = joint
                 .parent
                 .filter(|_| j != top && is_below(skeleton, j, top))
             {
-                let length = math::norm(math::sub(pose.joints[j], pose.joints[p]));
-                let mid = math::scale(math::add(pose.joints[j], pose.joints[p]), 0.5);
-                centre = math::add(centre, math::scale(mid, length));
+                let length = (pose.joints[j] - pose.joints[p]).norm();
+                let mid = (pose.joints[j] + pose.joints[p]) * 0.5;
+                centre += mid * length;
                 mass += length;
             }
         }
         let centre = if mass > 0.0 {
-            math::scale(centre, 1.0 / mass)
+            centre * (1.0 / mass)
         } else {
-            pose.joints.first().copied().unwrap_or([0.0; 3])
+            pose.joints.first().copied().unwrap_or(Vec3::ZERO)
         };
         if total_weight > 0.0 {
             for &(leaf, weight) in &weights {
-                let d = math::sub(pose.contact_point(leaf), centre);
-                hang = math::add(hang, math::scale(d, weight / total_weight));
+                let d = pose.contact_point(leaf) - centre;
+                hang += d * (weight / total_weight);
             }
         }
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        let (mut lo, mut hi) = (Vec3([f64::INFINITY; 3]), Vec3([f64::NEG_INFINITY; 3]));
         let body = pose
             .joints
             .iter()
@@ -185,24 +185,24 @@ pub fn detect_up(motion: &LocalMotion) -> UpDetection {
                 hi[i] = hi[i].max(p[i]);
             }
         }
-        size += math::norm(math::sub(hi, lo));
+        size += (hi - lo).norm();
     }
     let frames = poses.len();
     let (hang, size) = if frames > 0 {
-        (math::scale(hang, 1.0 / frames as f64), size / frames as f64)
+        ((hang * (1.0 / frames as f64)), size / frames as f64)
     } else {
-        ([0.0; 3], 0.0)
+        (Vec3::ZERO, 0.0)
     };
     let hang = if size > 0.0 && size.is_finite() {
-        math::scale(hang, 1.0 / size)
+        hang * (1.0 / size)
     } else {
-        [0.0; 3]
+        Vec3::ZERO
     };
-    let length = math::norm(hang);
+    let length = hang.norm();
     // Up is the signed axis most opposed to the hanging direction; ties and a zero vector give +Y.
     let axis = UpAxis::ALL
         .into_iter()
-        .map(|a| (a, -math::dot(a.direction(), hang)))
+        .map(|a| (a, -a.direction().dot(hang)))
         .fold((UpAxis::PosY, f64::NEG_INFINITY), |best, (a, s)| {
             if s > best.1 + 1e-12 || (a == UpAxis::PosY && s >= best.1 - 1e-12) {
                 (a, s)
@@ -212,7 +212,7 @@ pub fn detect_up(motion: &LocalMotion) -> UpDetection {
         })
         .0;
     let alignment = if length > 0.0 && length.is_finite() {
-        -math::dot(axis.direction(), hang) / length
+        -axis.direction().dot(hang) / length
     } else {
         0.0
     };

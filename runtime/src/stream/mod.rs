@@ -25,7 +25,7 @@ use crate::diffusion::{Method, Schedule};
 use crate::limits::MAX_SAMPLE_FRAMES;
 use crate::model_file::ModelMetadata;
 use crate::motion::feet::{Anchor, Feet, Kept, PlantOptions, plant_feet};
-use crate::motion::math::{self, Mat3, Vec3};
+use crate::motion::math::{Mat3, Vec3};
 use crate::motion::{FeatureMatrix, LocalMotion, MotionError, Pose, decode, poses};
 use crate::tasks::mask::soft_mask;
 use crate::tasks::{INBETWEEN_RAMP, TaskError};
@@ -352,10 +352,10 @@ impl Stream {
         if let Some(root) = &layout.root {
             let r = root.joint;
             if let (Some(last), true) = (self.last_root, done.start > 0) {
-                let offset = math::sub(last, motion.translations[(done.start - 1) * joints + r]);
+                let offset = last - motion.translations[(done.start - 1) * joints + r];
                 for frame in 0..done.end {
                     let t = &mut motion.translations[frame * joints + r];
-                    *t = math::add(*t, offset);
+                    *t += offset;
                 }
             }
             self.last_root = Some(motion.translations[(done.end - 1) * joints + r]);

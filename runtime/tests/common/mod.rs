@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use sinmdm::motion::{GlobalPose, math};
+use sinmdm::motion::GlobalPose;
 
 /// The workspace root.
 pub fn workspace() -> PathBuf {
@@ -70,6 +70,6 @@ pub fn max_position_error(a: &[GlobalPose], b: &[GlobalPose]) -> f64 {
             assert_eq!(p.joints.len(), q.joints.len());
             p.points().zip(q.points())
         })
-        .map(|(p, q)| math::norm(math::sub(p, q)))
+        .map(|(p, q)| (p - q).norm())
         .fold(0.0, f64::max)
 }

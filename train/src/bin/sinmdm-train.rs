@@ -1,4 +1,4 @@
-//! `sinmdm-train`: fit the denoiser on one BVH clip.
+//! `sinmdm-train`: fit the denoiser on one clip (BVH, glTF or FBX).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;

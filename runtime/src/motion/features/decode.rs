@@ -5,7 +5,7 @@ use ndarray::ArrayView2;
 use super::error::MotionError;
 use super::layout::FeatureLayout;
 use crate::motion::clip::LocalMotion;
-use crate::motion::math::{self, IDENTITY, Mat3, Vec3};
+use crate::motion::math::{IDENTITY, Mat3, Vec3};
 use crate::motion::rotation::mat_from_6d;
 use crate::motion::up::{UP, to_file};
 
@@ -42,7 +42,7 @@ pub fn decode(
     if let Some(root) = layout.root.as_ref().filter(|r| r.turned()) {
         for f in 0..frames {
             let t = &mut translations[f * joints + root.joint];
-            *t = math::mat_vec(&root.frame, *t);
+            *t = root.frame * *t;
         }
     }
     let mut row = 0;
@@ -79,11 +79,11 @@ pub fn decode(
         row += 1;
     }
     if let Some(root) = layout.root.as_ref().filter(|r| r.turned()) {
-        let back = math::transpose(&root.frame);
+        let back = root.frame.transpose();
         for f in 0..frames {
             let k = f * joints + root.joint;
-            translations[k] = math::mat_vec(&back, translations[k]);
-            rotations[k] = math::mat_mul(&back, &rotations[k]);
+            translations[k] = back * translations[k];
+            rotations[k] = back * rotations[k];
         }
     }
     let canonical = LocalMotion {

@@ -10,7 +10,7 @@ use crate::motion::clip::{ChannelClip, LocalMotion};
 use crate::motion::contacts::{ContactConfig, choose_contact_joints, label_contacts};
 use crate::motion::fk::{global_pose, global_poses, skeleton_height};
 use crate::motion::ground::ground_level;
-use crate::motion::math::{self, IDENTITY, Vec3};
+use crate::motion::math::{IDENTITY, Mat3, Vec3};
 use crate::motion::resample::resample;
 use crate::motion::rotation::mat_to_6d;
 use crate::motion::skeleton::{Axis, Channel, Skeleton};
@@ -158,7 +158,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
                 }
             }
             if joint.parent.is_none() {
-                translation = math::mat_vec(&canonical_from_file, translation);
+                translation = canonical_from_file * translation;
             }
             translation
         })
@@ -168,15 +168,17 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
     // Entries within 1e-9 of 0 or +-1 are snapped, so a container turned by a quarter turn
     // written as text (cos 90 = 6e-17) gives an exact axis permutation.
     let frame = match skeleton.joints[root_joint].parent {
-        Some(parent) => global_pose(&local, 0).rotations[parent].map(|row| {
-            row.map(|v| {
+        Some(parent) => {
+            let frame = global_pose(&local, 0).rotations[parent];
+            Mat3::from_fn(|r, c| {
+                let v = frame[r][c];
                 if (v - v.round()).abs() < 1e-9 {
                     v.round() + 0.0
                 } else {
                     v
                 }
             })
-        }),
+        }
         None => IDENTITY,
     };
     let to_canonical_axes = if root_joint == 0 {
@@ -199,7 +201,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
     let root = (!root_axes.is_empty()).then(|| RootFeatures {
         joint: root_joint,
         axes: root_axes.into_iter().map(Axis::from_index).collect(),
-        start_position: math::mat_vec(&frame, local.translations[root_joint]),
+        start_position: (frame * local.translations[root_joint]),
         frame,
     });
     let rotation_joints: Vec<usize> = (0..joints)
@@ -291,7 +293,7 @@ fn fill_features(
             let at = |f: usize| {
                 let t = local.translations[f * joints + root.joint];
                 if root.turned() {
-                    math::mat_vec(&root.frame, t)[a]
+                    (root.frame * t)[a]
                 } else {
                     t[a]
                 }
@@ -318,7 +320,7 @@ fn fill_features(
         for f in 0..frames {
             let rotation = &local.rotations[f * joints + joint];
             let six = match root_turn {
-                Some((j, frame)) if j == joint => mat_to_6d(&math::mat_mul(&frame, rotation)),
+                Some((j, frame)) if j == joint => mat_to_6d(&(frame * rotation)),
                 _ => mat_to_6d(rotation),
             };
             for (c, value) in six.iter().enumerate() {

@@ -6,7 +6,6 @@ use super::encode::encode_for;
 use super::error::MotionError;
 use super::layout::FeatureLayout;
 use crate::motion::clip::ChannelClip;
-use crate::motion::math;
 use crate::motion::up::{UpAxis, reorient, reorient_problem};
 use crate::motion::up_detect::{Confidence, detect_up};
 
@@ -52,10 +51,7 @@ pub fn encode_for_model(
             problem,
         });
     }
-    let turn = math::mat_mul(
-        &model_up.file_from_canonical(),
-        &clip_up.canonical_from_file(),
-    );
+    let turn = model_up.file_from_canonical() * clip_up.canonical_from_file();
     let turned = reorient(&clip.to_local(), &turn).to_channels();
     Ok(ClipForModel {
         features: encode_for(&turned, layout)?,

@@ -1,7 +1,7 @@
 //! The chain of joints above a contact joint that foot planting may turn: the limb from just
 //! below the joint where it branches off the body (the hip, the shoulder) down to the foot.
 
-use crate::motion::math::{self, Vec3};
+use crate::motion::math::Vec3;
 use crate::motion::skeleton::Skeleton;
 
 /// The most bones a chain has: a quadruped's leg (hip, knee, hock, paw) is three or four.
@@ -53,7 +53,7 @@ pub fn leg_chain(skeleton: &Skeleton, rest: &[Vec3], contact: usize) -> Option<L
         j = parent;
     }
     limb.reverse();
-    let length = |j: usize| rest.get(j).map_or(0.0, |&o| math::norm(o));
+    let length = |j: usize| rest.get(j).map_or(0.0, |&o| o.norm());
     let total: f64 = limb.iter().skip(1).map(|&j| length(j)).sum();
     // A top whose own offset is nothing sits on its parent; its child's offset is a pelvis bone.
     while limb.len() > 2 && length(limb[0]) <= 1e-6 * total.max(f64::MIN_POSITIVE) {
@@ -98,13 +98,13 @@ mod tests {
     fn a_human_leg_ends_at_the_ankle_below_a_zero_offset_hip_joint() {
         // Hips -> LHipJoint (on the hips) -> Hip -> Knee -> Ankle -> Toe; Hips -> Spine.
         let (s, rest) = skeleton(&[
-            ("Hips", None, [0.0; 3]),
-            ("LHipJoint", Some(0), [0.0; 3]),
-            ("Hip", Some(1), [1.2, -1.6, 0.7]),
-            ("Knee", Some(2), [2.5, -6.9, 0.0]),
-            ("Ankle", Some(3), [2.4, -6.5, 0.0]),
-            ("Toe", Some(4), [0.1, -0.4, 2.2]),
-            ("Spine", Some(0), [0.0, 2.0, 0.0]),
+            ("Hips", None, Vec3([0.0; 3])),
+            ("LHipJoint", Some(0), Vec3([0.0; 3])),
+            ("Hip", Some(1), Vec3([1.2, -1.6, 0.7])),
+            ("Knee", Some(2), Vec3([2.5, -6.9, 0.0])),
+            ("Ankle", Some(3), Vec3([2.4, -6.5, 0.0])),
+            ("Toe", Some(4), Vec3([0.1, -0.4, 2.2])),
+            ("Spine", Some(0), Vec3([0.0, 2.0, 0.0])),
         ]);
         let chain = leg_chain(&s, &rest, 5).unwrap();
         assert_eq!(chain.joints, vec![2, 3, 4]);
@@ -115,12 +115,12 @@ mod tests {
     fn a_quadruped_leg_keeps_its_three_bones() {
         // Hip -> Leg01 -> Leg02 -> Foot01 -> Foot02 (paw); Hip -> Tail.
         let (s, rest) = skeleton(&[
-            ("Hip", None, [0.0; 3]),
-            ("Leg01", Some(0), [4.8, 5.2, -7.0]),
-            ("Leg02", Some(1), [18.9, 0.0, 0.0]),
-            ("Foot01", Some(2), [17.9, 0.0, 0.0]),
-            ("Foot02", Some(3), [15.8, 0.0, 0.0]),
-            ("Tail", Some(0), [4.0, 16.0, 0.0]),
+            ("Hip", None, Vec3([0.0; 3])),
+            ("Leg01", Some(0), Vec3([4.8, 5.2, -7.0])),
+            ("Leg02", Some(1), Vec3([18.9, 0.0, 0.0])),
+            ("Foot01", Some(2), Vec3([17.9, 0.0, 0.0])),
+            ("Foot02", Some(3), Vec3([15.8, 0.0, 0.0])),
+            ("Tail", Some(0), Vec3([4.0, 16.0, 0.0])),
         ]);
         let chain = leg_chain(&s, &rest, 4).unwrap();
         assert_eq!(chain.joints, vec![1, 2, 3, 4]);

@@ -14,7 +14,7 @@ use crate::motion::clip::LocalMotion;
 use crate::motion::features::{FeatureLayout, MotionError};
 use crate::motion::fk::{GlobalPose, global_pose, global_poses};
 use crate::motion::ground::ground_level;
-use crate::motion::math::{self, Vec3};
+use crate::motion::math::Vec3;
 use crate::motion::up::{UP, height_of, horizontal, to_canonical, to_file};
 
 /// Coordinates below this size can be subtracted, squared and summed without overflow.
@@ -185,7 +185,7 @@ impl<'a> Planting<'a> {
                     } else {
                         f.saturating_sub(1)
                     };
-                    math::norm(horizontal(math::sub(points[next], points[f]))) * fps / height
+                    horizontal(points[next] - points[f]).norm() * fps / height
                 };
                 let low = |f: usize| {
                     height_of(points[f]) - self.stats.ground < options.grow_within * height
@@ -221,9 +221,8 @@ impl<'a> Planting<'a> {
         let joints = self.motion.skeleton.len();
         for (f, t) in travel.iter().enumerate() {
             let root = &mut self.motion.translations[f * joints + self.top];
-            *root = math::add(*root, *t);
-            self.stats.max_root_travel =
-                self.stats.max_root_travel.max(math::norm(*t) / self.height);
+            *root += *t;
+            self.stats.max_root_travel = self.stats.max_root_travel.max(t.norm() / self.height);
         }
         self.poses = global_poses(&self.motion);
     }
@@ -322,8 +321,7 @@ impl<'a> Planting<'a> {
                 self.stats.max_lift = self.stats.max_lift.max(total_lift / self.height);
             }
             for w in &wanted {
-                let miss = math::norm(math::sub(solved.contact_point(w.chain.contact), w.target))
-                    / self.height;
+                let miss = (solved.contact_point(w.chain.contact) - w.target).norm() / self.height;
                 if miss > 1e-3 {
                     self.stats.unreached += 1;
                 }

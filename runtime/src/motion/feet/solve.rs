@@ -83,10 +83,8 @@ fn turn_least(
             .iter()
             .map(|&j| out.translations[f * joints + j])
             .collect(),
-        tip: math::mat_vec(
-            &math::transpose(&pose.rotations[effector]),
-            math::sub(pose.contact_point(chain.contact), pose.joints[effector]),
-        ),
+        tip: (pose.rotations[effector].transpose()
+            * (pose.contact_point(chain.contact) - pose.joints[effector])),
     };
     let reach = turn.reach();
     let now = pose.contact_point(chain.contact);
@@ -118,14 +116,14 @@ fn soften(top: Vec3, current: Vec3, goal: Vec3, reach: f64, share: f64) -> Vec3 
             start + soft * (1.0 - (-(d - start) / soft).exp())
         }
     };
-    let offset = math::sub(goal, top);
-    let d = math::norm(offset);
-    let d0 = math::norm(math::sub(current, top));
+    let offset = goal - top;
+    let d = offset.norm();
+    let d0 = (current - top).norm();
     if d <= 0.0 {
         return goal;
     }
     let wanted = (d0 + eased(d) - eased(d0)).min(d.max(d0));
-    math::add(top, math::scale(offset, wanted / d))
+    top + (offset * (wanted / d))
 }
 
 /// The lowest height of a pose's joints and End Sites.
@@ -173,12 +171,12 @@ mod tests {
         let top = [0.0, 1.0, 0.0];
         // Well inside the reach: the goal itself.
         let goal = [0.1, 0.5, 0.0];
-        let kept = soften(top, [0.0, 0.4, 0.0], goal, 1.0, 0.2);
-        assert!(math::norm(math::sub(kept, goal)) < 1e-12, "{kept:?}");
+        let kept = soften(Vec3(top), Vec3([0.0, 0.4, 0.0]), Vec3(goal), 1.0, 0.2);
+        assert!((kept - Vec3(goal)).norm() < 1e-12, "{kept:?}");
         // Past the reach: pulled back towards the top, along its line, never past the reach.
         let far = [0.0, -0.5, 0.0];
-        let eased = soften(top, [0.0, 0.4, 0.0], far, 1.0, 0.2);
-        let d = math::norm(math::sub(eased, top));
+        let eased = soften(Vec3(top), Vec3([0.0, 0.4, 0.0]), Vec3(far), 1.0, 0.2);
+        let d = (eased - Vec3(top)).norm();
         assert!(d < 1.0 && d > 0.8, "{d}");
         assert!(eased[0].abs() < 1e-12 && eased[2].abs() < 1e-12);
     }

@@ -2,7 +2,7 @@
 //! with it instead, so the legs need turning only for what the feet do differently from each
 //! other. A root move changes no joint rotation and no bone length.
 
-use crate::motion::math::{self, Vec3};
+use crate::motion::math::Vec3;
 use crate::motion::up::horizontal;
 
 /// Per frame, the horizontal offset to add to the root so that the contact points in stance
@@ -28,42 +28,39 @@ pub(super) fn stance_travel(
     radius: usize,
 ) -> Vec<Vec3> {
     let frames = kept.len();
-    let mut step = vec![[0.0; 3]; frames];
+    let mut step = vec![Vec3::ZERO; frames];
     for f in 1..frames {
         if kept[f] {
             continue;
         }
-        let (mut sum, mut total) = ([0.0; 3], 0.0);
+        let (mut sum, mut total) = (Vec3::ZERO, 0.0);
         for (p, w) in points.iter().zip(weights) {
             let weight = w[f].min(w[f - 1]);
             if weight > 0.0 {
-                sum = math::add(
-                    sum,
-                    math::scale(horizontal(math::sub(p[f], p[f - 1])), weight),
-                );
+                sum += horizontal(p[f] - p[f - 1]) * weight;
                 total += weight;
             }
         }
         if total > 0.0 {
-            step[f] = math::scale(sum, -total.min(1.0) / total);
+            step[f] = sum * (-total.min(1.0) / total);
         }
     }
     let smoothed: Vec<Vec3> = (0..frames)
         .map(|f| {
             if kept[f] {
-                return [0.0; 3];
+                return Vec3::ZERO;
             }
             let window = f.saturating_sub(radius)..(f + radius + 1).min(frames);
-            let (mut sum, mut total) = ([0.0; 3], 0.0);
+            let (mut sum, mut total) = (Vec3::ZERO, 0.0);
             for g in window {
                 let w = (radius + 1 - g.abs_diff(f)) as f64;
-                sum = math::add(sum, math::scale(step[g], w));
+                sum += step[g] * w;
                 total += w;
             }
-            math::scale(sum, 1.0 / total)
+            sum * (1.0 / total)
         })
         .collect();
-    let mut offset = vec![[0.0; 3]; frames];
+    let mut offset = vec![Vec3::ZERO; frames];
     let mut start = 0;
     while start < frames {
         if kept[start] {
@@ -71,16 +68,16 @@ pub(super) fn stance_travel(
             continue;
         }
         let end = (start..frames).find(|&f| kept[f]).unwrap_or(frames);
-        let mut running = [0.0; 3];
+        let mut running = Vec3::ZERO;
         for f in start..end {
-            running = math::add(running, smoothed[f]);
+            running += smoothed[f];
             offset[f] = running;
         }
         if end < frames {
             // Hand the offset back so that the kept frame at `end` is met exactly.
             let span = (end - start + 1) as f64;
             for (i, f) in (start..end).enumerate() {
-                offset[f] = math::sub(offset[f], math::scale(running, (i + 1) as f64 / span));
+                offset[f] -= running * ((i + 1) as f64 / span);
             }
         }
         start = end;
@@ -97,7 +94,7 @@ mod tests {
         let mut v = [0.0; 3];
         v[(UP + 1) % 3] = x;
         v[(UP + 2) % 3] = z;
-        v
+        Vec3(v)
     }
 
     #[test]
@@ -121,14 +118,14 @@ mod tests {
             0,
         );
         for f in 3..12 {
-            let held = math::add(points[f], offset[f]);
-            let first = math::add(points[3], offset[3]);
-            let d = horizontal(math::sub(held, first));
-            assert!(math::norm(d) < 1e-12, "frame {f}: {d:?}");
+            let held = points[f] + offset[f];
+            let first = points[3] + offset[3];
+            let d = horizontal(held - first);
+            assert!(d.norm() < 1e-12, "frame {f}: {d:?}");
             assert_eq!(offset[f][UP], 0.0);
         }
         // Outside the span the root keeps the offset it had (no pull from a swinging foot).
-        assert_eq!(offset[0], [0.0; 3]);
+        assert_eq!(offset[0], Vec3([0.0; 3]));
         assert_eq!(offset[15], offset[11]);
     }
 
@@ -161,8 +158,8 @@ mod tests {
             &kept,
             2,
         );
-        assert_eq!(offset[0], [0.0; 3]);
-        assert_eq!(offset[19], [0.0; 3]);
+        assert_eq!(offset[0], Vec3([0.0; 3]));
+        assert_eq!(offset[19], Vec3([0.0; 3]));
         // The hand-back leaves the run's middle moving less than the foot, but still against it.
         assert!(offset[10][(UP + 1) % 3] < 0.0);
         // With nothing kept and a constant slide, smoothing changes nothing inside the clip.

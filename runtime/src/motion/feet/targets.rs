@@ -7,7 +7,7 @@ use std::ops::Range;
 use super::chain::LegChain;
 use super::options::{Anchor, Kept, PlantOptions};
 use super::spans::span_weights;
-use crate::motion::math::{self, Vec3};
+use crate::motion::math::Vec3;
 use crate::motion::up::UP;
 
 /// Spans grown on both sides over the frames where `low` holds, merged where they meet.
@@ -38,8 +38,8 @@ fn anchor(points: &[Vec3], span: Range<usize>, kind: Anchor, ground: f64) -> Vec
         Anchor::Landing => points[span.start],
         Anchor::Mean => {
             let n = span.len() as f64;
-            let sum = points[span].iter().fold([0.0; 3], |a, &p| math::add(a, p));
-            math::scale(sum, 1.0 / n)
+            let sum = points[span].iter().fold(Vec3::ZERO, |a, &p| a + p);
+            sum * (1.0 / n)
         }
     };
     at[UP] = at[UP].max(ground);
@@ -89,18 +89,15 @@ pub(super) fn chain_targets(
             if let Some((span, w)) = weights[f] {
                 let s = &spans[span];
                 let edge = if f < s.start { s.start } else { s.end - 1 };
-                let offset = math::sub(anchors[span], points[edge]);
+                let offset = anchors[span] - points[edge];
                 let pull = if s.contains(&f) {
-                    math::sub(anchors[span], points[f])
+                    anchors[span] - points[f]
                 } else {
-                    math::scale(offset, w)
+                    offset * w
                 };
-                let length = math::norm(pull);
+                let length = pull.norm();
                 let most = options.max_hold * height;
-                target = math::add(
-                    points[f],
-                    math::scale(pull, if length > most { most / length } else { 1.0 }),
-                );
+                target = points[f] + (pull * (if length > most { most / length } else { 1.0 }));
                 if w >= 1.0 {
                     planted += 1;
                 }
@@ -127,8 +124,14 @@ mod tests {
 
     #[test]
     fn an_anchor_never_goes_below_the_ground() {
-        let points = [[0.0, -1.0, 0.0], [2.0, 1.0, 0.0], [4.0, -3.0, 0.0]];
-        assert_eq!(anchor(&points, 0..3, Anchor::Mean, 0.0), [2.0, 0.0, 0.0]);
-        assert_eq!(anchor(&points, 1..3, Anchor::Landing, 0.0), [2.0, 1.0, 0.0]);
+        let points = [[0.0, -1.0, 0.0], [2.0, 1.0, 0.0], [4.0, -3.0, 0.0]].map(Vec3);
+        assert_eq!(
+            anchor(&points, 0..3, Anchor::Mean, 0.0),
+            Vec3([2.0, 0.0, 0.0])
+        );
+        assert_eq!(
+            anchor(&points, 1..3, Anchor::Landing, 0.0),
+            Vec3([2.0, 1.0, 0.0])
+        );
     }
 }
