@@ -248,6 +248,11 @@ pub fn parse_position(text: &str, fps: f64) -> Result<usize> {
     }
 }
 
+/// Every span of a repeated `START:END` flag, in order.
+pub fn parse_spans(texts: &[String], fps: f64, frames: usize) -> Result<Vec<Span>> {
+    texts.iter().map(|s| parse_span(s, fps, frames)).collect()
+}
+
 /// A span `START:END` (END exclusive, empty = `frames`), each part frames or seconds.
 pub fn parse_span(text: &str, fps: f64, frames: usize) -> Result<Span> {
     let (a, b) = text

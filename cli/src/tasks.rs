@@ -6,7 +6,7 @@ use anyhow::{Result, bail};
 use clap::Args;
 
 use crate::clip_files::ClipUpArg;
-use crate::sampling::{SamplingArgs, parse_position, parse_span, reference_features, run_task};
+use crate::sampling::{SamplingArgs, parse_position, parse_spans, reference_features, run_task};
 use sinmdm::tasks::{
     EXPAND_RAMP, HARMONIZE_FACTOR, HARMONIZE_FREE_SHARE, INBETWEEN_RAMP, Task, joints_by_name,
     subtree,
@@ -154,11 +154,7 @@ pub(crate) fn inbetween(args: &InbetweenArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
     let reference = reference_features(&model, &args.reference, &args.up)?;
     let fps = model.metadata().layout.fps;
-    let keep = args
-        .keep
-        .iter()
-        .map(|s| parse_span(s, fps, reference.ncols()))
-        .collect::<Result<Vec<_>>>()?;
+    let keep = parse_spans(&args.keep, fps, reference.ncols())?;
     let task = Task::Inbetween {
         reference,
         keep,
@@ -191,11 +187,7 @@ pub(crate) fn compose(args: &ComposeArgs) -> Result<()> {
     for top in joints_by_name(layout, &args.part)? {
         joints.extend(subtree(layout, top));
     }
-    let spans = args
-        .frames
-        .iter()
-        .map(|s| parse_span(s, fps, reference.ncols()))
-        .collect::<Result<Vec<_>>>()?;
+    let spans = parse_spans(&args.frames, fps, reference.ncols())?;
     let task = Task::Compose {
         reference,
         joints,
