@@ -1,6 +1,9 @@
 //! The generating subcommands: `generate`, `inbetween`, `expand`, `compose`, `harmonize`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use ndarray::Array2;
+use sinmdm::FeatureLayout;
 
 use anyhow::{Result, bail};
 use clap::Args;
@@ -150,63 +153,79 @@ pub(crate) fn generate(args: &GenerateArgs) -> Result<()> {
     Ok(())
 }
 
-pub(crate) fn inbetween(args: &InbetweenArgs) -> Result<()> {
-    let mut model = args.sampling.open_model()?;
-    let reference = reference_features(&model, &args.reference, &args.up)?;
-    let fps = model.metadata().layout.fps;
-    let keep = parse_spans(&args.keep, fps, reference.ncols())?;
-    let task = Task::Inbetween {
-        reference,
-        keep,
-        ramp: args.ramp,
-    };
-    run_task(&args.sampling, &mut model, task)?;
+/// The tasks that start from a clip: opens the model, reads `clip` in its layout, builds the
+/// task from the layout and the clip's features, and runs it.
+fn run_from_clip(
+    sampling: &SamplingArgs,
+    clip: &Path,
+    read: &ClipUpArg,
+    task: impl FnOnce(&FeatureLayout, Array2<f32>) -> Result<Task>,
+) -> Result<()> {
+    let mut model = sampling.open_model()?;
+    let features = reference_features(&model, clip, read)?;
+    let task = task(&model.metadata().layout, features)?;
+    run_task(sampling, &mut model, task)?;
     Ok(())
+}
+
+pub(crate) fn inbetween(args: &InbetweenArgs) -> Result<()> {
+    run_from_clip(
+        &args.sampling,
+        &args.reference,
+        &args.up,
+        |layout, reference| {
+            Ok(Task::Inbetween {
+                keep: parse_spans(&args.keep, layout.fps, reference.ncols())?,
+                reference,
+                ramp: args.ramp,
+            })
+        },
+    )
 }
 
 pub(crate) fn expand(args: &ExpandArgs) -> Result<()> {
-    let mut model = args.sampling.open_model()?;
-    let reference = reference_features(&model, &args.reference, &args.up)?;
-    let fps = model.metadata().layout.fps;
-    let task = Task::Expand {
-        reference,
-        prefix: parse_position(&args.prefix, fps)?,
-        suffix: parse_position(&args.suffix, fps)?,
-        ramp: args.ramp,
-    };
-    run_task(&args.sampling, &mut model, task)?;
-    Ok(())
+    run_from_clip(
+        &args.sampling,
+        &args.reference,
+        &args.up,
+        |layout, reference| {
+            Ok(Task::Expand {
+                reference,
+                prefix: parse_position(&args.prefix, layout.fps)?,
+                suffix: parse_position(&args.suffix, layout.fps)?,
+                ramp: args.ramp,
+            })
+        },
+    )
 }
 
 pub(crate) fn compose(args: &ComposeArgs) -> Result<()> {
-    let mut model = args.sampling.open_model()?;
-    let reference = reference_features(&model, &args.reference, &args.up)?;
-    let layout = &model.metadata().layout;
-    let fps = layout.fps;
-    let mut joints = joints_by_name(layout, &args.joints)?;
-    for top in joints_by_name(layout, &args.part)? {
-        joints.extend(subtree(layout, top));
-    }
-    let spans = parse_spans(&args.frames, fps, reference.ncols())?;
-    let task = Task::Compose {
-        reference,
-        joints,
-        root: args.root,
-        spans,
-        ramp: args.ramp,
-    };
-    run_task(&args.sampling, &mut model, task)?;
-    Ok(())
+    run_from_clip(
+        &args.sampling,
+        &args.reference,
+        &args.up,
+        |layout, reference| {
+            let mut joints = joints_by_name(layout, &args.joints)?;
+            for top in joints_by_name(layout, &args.part)? {
+                joints.extend(subtree(layout, top));
+            }
+            Ok(Task::Compose {
+                spans: parse_spans(&args.frames, layout.fps, reference.ncols())?,
+                reference,
+                joints,
+                root: args.root,
+                ramp: args.ramp,
+            })
+        },
+    )
 }
 
 pub(crate) fn harmonize(args: &HarmonizeArgs) -> Result<()> {
-    let mut model = args.sampling.open_model()?;
-    let content = reference_features(&model, &args.content, &args.up)?;
-    let task = Task::Harmonize {
-        content,
-        factor: args.factor,
-        free_share: args.free_share,
-    };
-    run_task(&args.sampling, &mut model, task)?;
-    Ok(())
+    run_from_clip(&args.sampling, &args.content, &args.up, |_, content| {
+        Ok(Task::Harmonize {
+            content,
+            factor: args.factor,
+            free_share: args.free_share,
+        })
+    })
 }
