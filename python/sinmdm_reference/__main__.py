@@ -38,7 +38,6 @@ def main(argv=None):
         p.add_argument("--count", type=int, default=1)
         p.add_argument("--seed", type=int, default=0)
         p.add_argument("--steps", default="50", help="respaced steps S, or 'all'")
-        p.add_argument("--threads", type=int, default=None)
         p.add_argument("--sampler", choices=["ancestral", "ddim", "dpm2m"], default="ancestral")
         p.add_argument("--eta", type=float, default=0.0)
         return p
@@ -73,7 +72,7 @@ def main(argv=None):
 
     method = (args.sampler, args.eta) if args.sampler == "ddim" else (args.sampler,)
     try:
-        model = Model(args.model, args.threads)
+        model = Model(args.model)
         fps = model.layout["fps"]
         inpainting = harmonization = None
 

@@ -16,13 +16,17 @@ class ModelError(Exception):
 
 
 class Model:
-    """The denoiser session and the metadata dictionary."""
+    """The denoiser session and the metadata dictionary.
 
-    def __init__(self, path, threads=None):
+    As the runtime (SPEC section 6, the same bits on every machine): onnxruntime runs on one
+    intra-op thread and each sample of a batch is its own call, so a sample's values depend
+    neither on the machine's cores nor on its place in the batch."""
+
+    def __init__(self, path):
         if not os.path.exists(path):
             raise ModelError(f"model file '{path}' does not exist")
         options = ort.SessionOptions()
-        options.intra_op_num_threads = threads or os.cpu_count() or 1
+        options.intra_op_num_threads = 1
         options.inter_op_num_threads = 1
         options.add_session_config_entry("session.intra_op.allow_spinning", "0")
         options.add_session_config_entry("session.inter_op.allow_spinning", "0")
@@ -46,11 +50,14 @@ class Model:
         return self.metadata["layout"]
 
     def denoise(self, x_t, t):
-        """x_t float32 [B, F, N], t int64 [B] -> predicted x0 float32 [B, F, N]."""
-        (x0,) = self.session.run(
-            ["x0"], {"x_t": np.ascontiguousarray(x_t, dtype=np.float32), "t": np.asarray(t, dtype=np.int64)}
-        )
-        return x0
+        """x_t float32 [B, F, N], t int64 [B] -> predicted x0 float32 [B, F, N], one call per
+        sample."""
+        x_t = np.ascontiguousarray(x_t, dtype=np.float32)
+        t = np.asarray(t, dtype=np.int64)
+        out = np.empty_like(x_t)
+        for b in range(x_t.shape[0]):
+            (out[b : b + 1],) = self.session.run(["x0"], {"x_t": x_t[b : b + 1], "t": t[b : b + 1]})
+        return out
 
     def normalize(self, raw):
         """(x - mean) / std per feature row of raw [F, N], in float32."""

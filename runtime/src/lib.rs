@@ -75,4 +75,4 @@ pub use onnxruntime::{
     load_onnxruntime,
 };
 pub use stream::{Stream, StreamChunk, StreamCompose, StreamOptions};
-pub use tasks::{Generated, Plan, Request, Span, Task, TaskError, plan, run};
+pub use tasks::{Generated, Plan, Progress, Request, Run, Span, Task, TaskError, plan, run};

@@ -33,3 +33,8 @@ pub const MAX_WINDOW: usize = 255;
 pub const MAX_DIFFUSION_STEPS: usize = 100_000;
 /// Highest frame rate a model may have.
 pub const MAX_FPS: f64 = 10_000.0;
+
+/// Most threads a model runs samples on at once (each has its own onnxruntime session, a few
+/// megabytes): far beyond any machine's cores, and it stops a typo such as `u32::MAX` from
+/// asking for that many sessions.
+pub const MAX_THREADS: usize = 1024;

@@ -3,12 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use ndarray::{Array3, ArrayView3};
+use ndarray::{Array3, ArrayView3, Axis};
 use ort::session::Session;
 use ort::session::builder::GraphOptimizationLevel;
 use ort::value::Tensor;
 use thiserror::Error;
 
+use crate::limits::MAX_THREADS;
 use crate::model_file::{MetadataError, ModelMetadata, parse_metadata};
 use crate::network::{INPUT_FEATURES, INPUT_STEP, OUTPUT_FEATURES};
 use crate::onnxruntime::{self, RuntimeLibraryError};
@@ -65,6 +66,9 @@ pub enum ModelError {
         /// Timesteps given.
         steps: usize,
     },
+    /// More threads than [`crate::limits::MAX_THREADS`].
+    #[error("a model runs on 1 to {MAX_THREADS} threads (0 or none: every core), got {0}")]
+    Threads(usize),
     /// onnxruntime failed while running the graph.
     #[error("onnxruntime failed running '{path}': {message}")]
     Run {
@@ -75,16 +79,25 @@ pub enum ModelError {
     },
 }
 
-/// How a model's onnxruntime session is set up.
+/// How a model's onnxruntime sessions are set up.
+///
+/// The same bits on every machine: each sample of a batch is its own onnxruntime call on one
+/// intra-op thread, so a sample's values depend neither on the thread count nor on its place
+/// in the batch. `threads` is how many samples run at once (one session and one thread each).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct ModelOptions {
-    /// Threads for one denoiser call; `None` uses every core.
+    /// Samples of a batch denoised at once, each on its own thread and session; `None` uses
+    /// every core. At most [`crate::limits::MAX_THREADS`].
     pub threads: Option<usize>,
 }
 
 /// A trained denoiser, ready to run.
 pub struct Model {
-    session: Session,
+    /// One session per thread that has run a sample so far (made when a batch first needs it).
+    sessions: Vec<Session>,
+    /// The file's bytes, for the sessions not made yet.
+    bytes: Vec<u8>,
+    threads: usize,
     metadata: ModelMetadata,
     path: PathBuf,
 }
@@ -149,15 +162,13 @@ fn check_interface(session: &Session, features: usize) -> Result<(), String> {
     expect(OUTPUT_FEATURES, &x0, Float32, 3, Some(f))
 }
 
-/// A session over `bytes` with `threads` intra-op threads and no spinning when idle.
-fn open_session(
-    environment: &ort::environment::Environment,
-    bytes: &[u8],
-    threads: usize,
-) -> ort::Result<Session> {
+/// A session over `bytes` that runs each call on the calling thread alone (one intra-op
+/// thread: onnxruntime starts no thread pool, and a reduction's order never depends on how
+/// work was split), with no spinning when idle.
+fn open_session(environment: &ort::environment::Environment, bytes: &[u8]) -> ort::Result<Session> {
     Session::builder(environment)?
-        .with_optimization_level(GraphOptimizationLevel::Level3)?
-        .with_intra_threads(threads)?
+        .with_optimization_level(GraphOptimizationLevel::All)?
+        .with_intra_threads(1)?
         .with_inter_threads(1)?
         .with_intra_op_spinning(false)?
         .with_inter_op_spinning(false)?
@@ -194,11 +205,15 @@ impl Model {
             path: path.clone(),
             message,
         };
-        let threads = options.threads.unwrap_or_else(|| {
-            std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-        });
-        let session = open_session(&runtime.environment, bytes, threads.max(1))
-            .map_err(|e| not_onnx(e.to_string()))?;
+        let threads = match options.threads {
+            Some(n) if n > MAX_THREADS => return Err(ModelError::Threads(n)),
+            Some(n) => n.max(1),
+            None => std::thread::available_parallelism()
+                .map_or(1, std::num::NonZeroUsize::get)
+                .min(MAX_THREADS),
+        };
+        let session =
+            open_session(&runtime.environment, bytes).map_err(|e| not_onnx(e.to_string()))?;
         let metadata = {
             let meta = session.metadata().map_err(|e| not_onnx(e.to_string()))?;
             parse_metadata(&path, |key| meta.custom(key))?
@@ -210,7 +225,9 @@ impl Model {
             }
         })?;
         Ok(Model {
-            session,
+            sessions: vec![session],
+            bytes: bytes.to_vec(),
+            threads,
             metadata,
             path,
         })
@@ -246,6 +263,25 @@ impl Model {
         self.metadata.network.features
     }
 
+    /// Samples of a batch this model denoises at once (threads), as opened.
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+
+    /// Makes sure `count` sessions exist (one per thread a batch will use).
+    fn sessions_for(&mut self, count: usize) -> Result<(), ModelError> {
+        while self.sessions.len() < count {
+            let runtime = onnxruntime::init()?;
+            let session =
+                open_session(&runtime.environment, &self.bytes).map_err(|e| ModelError::Run {
+                    path: self.path.clone(),
+                    message: format!("could not open another session: {e}"),
+                })?;
+            self.sessions.push(session);
+        }
+        Ok(())
+    }
+
     /// One denoiser call: noisy normalised features `x_t` `[B, F, N]` at diffusion steps `t`
     /// (one per batch row) to the predicted clean features `[B, F, N]`.
     pub fn denoise(
@@ -266,35 +302,115 @@ impl Model {
                 steps: t.len(),
             });
         }
-        let path = self.path.clone();
-        let run_failed = |e: ort::Error| ModelError::Run {
-            path: path.clone(),
-            message: e.to_string(),
-        };
-        let data: Vec<f32> = match x_t.as_slice() {
-            Some(s) => s.to_vec(),
-            None => x_t.iter().copied().collect(),
-        };
-        let xs = Tensor::from_array(([b, f, n], data.into_boxed_slice())).map_err(run_failed)?;
-        let ts = Tensor::from_array(([b], t.to_vec().into_boxed_slice())).map_err(run_failed)?;
-        let outputs = self
-            .session
-            .run(ort::inputs![INPUT_FEATURES => xs, INPUT_STEP => ts])
-            .map_err(run_failed)?;
-        let (shape, values) = outputs[OUTPUT_FEATURES]
-            .try_extract_tensor::<f32>()
-            .map_err(run_failed)?;
-        if shape.to_vec() != [b as i64, f as i64, n as i64] {
-            return Err(ModelError::Run {
-                path,
-                message: format!("output shape {shape:?}, expected [{b}, {f}, {n}]"),
-            });
+        let workers = self.threads.min(b).max(1);
+        self.sessions_for(workers)?;
+        let mut out = Array3::<f32>::zeros((b, f, n));
+        let path = self.path.as_path();
+        if workers == 1 {
+            let session = &mut self.sessions[0];
+            for (sample, target) in out.outer_iter_mut().enumerate() {
+                denoise_one(
+                    session,
+                    path,
+                    x_t.index_axis(Axis(0), sample),
+                    t[sample],
+                    target,
+                )?;
+            }
+            return Ok(out);
         }
-        Array3::from_shape_vec((b, f, n), values.to_vec()).map_err(|e| ModelError::Run {
-            path: self.path.clone(),
-            message: format!("output of {} values: {e}", values.len()),
-        })
+        // Sample i goes to thread i mod W; each thread has its own session, and the first one
+        // is the calling thread.
+        let mut shares: Vec<Vec<(usize, ndarray::ArrayViewMut2<'_, f32>)>> =
+            (0..workers).map(|_| Vec::new()).collect();
+        for (sample, target) in out.outer_iter_mut().enumerate() {
+            shares[sample % workers].push((sample, target));
+        }
+        let sessions = &mut self.sessions[..workers];
+        let results: Vec<Result<(), ModelError>> = std::thread::scope(|scope| {
+            let mut shares = shares.into_iter();
+            let mut sessions = sessions.iter_mut();
+            let own = (sessions.next(), shares.next());
+            let handles: Vec<_> = sessions
+                .zip(shares)
+                .map(|(session, share)| {
+                    scope.spawn(move || {
+                        for (sample, target) in share {
+                            denoise_one(
+                                session,
+                                path,
+                                x_t.index_axis(Axis(0), sample),
+                                t[sample],
+                                target,
+                            )?;
+                        }
+                        Ok(())
+                    })
+                })
+                .collect();
+            let mut results = Vec::with_capacity(workers);
+            if let (Some(session), Some(share)) = own {
+                results.push(share.into_iter().try_for_each(|(sample, target)| {
+                    denoise_one(
+                        session,
+                        path,
+                        x_t.index_axis(Axis(0), sample),
+                        t[sample],
+                        target,
+                    )
+                }));
+            }
+            for handle in handles {
+                results.push(handle.join().unwrap_or_else(|_| {
+                    Err(ModelError::Run {
+                        path: path.to_path_buf(),
+                        message: "a denoising thread panicked".into(),
+                    })
+                }));
+            }
+            results
+        });
+        results.into_iter().collect::<Result<Vec<()>, _>>()?;
+        Ok(out)
     }
+}
+
+/// One sample `[F, N]` at diffusion step `t` through `session`, written into `target`.
+fn denoise_one(
+    session: &mut Session,
+    path: &Path,
+    x_t: ndarray::ArrayView2<'_, f32>,
+    t: i64,
+    mut target: ndarray::ArrayViewMut2<'_, f32>,
+) -> Result<(), ModelError> {
+    let (f, n) = x_t.dim();
+    let run_failed = |e: ort::Error| ModelError::Run {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let data: Vec<f32> = match x_t.as_slice() {
+        Some(s) => s.to_vec(),
+        None => x_t.iter().copied().collect(),
+    };
+    let xs = Tensor::from_array(([1, f, n], data.into_boxed_slice())).map_err(run_failed)?;
+    let ts = Tensor::from_array(([1], vec![t].into_boxed_slice())).map_err(run_failed)?;
+    let outputs = session
+        .run(ort::inputs![INPUT_FEATURES => xs, INPUT_STEP => ts])
+        .map_err(run_failed)?;
+    let (shape, values) = outputs[OUTPUT_FEATURES]
+        .try_extract_tensor::<f32>()
+        .map_err(run_failed)?;
+    if shape.to_vec() != [1, f as i64, n as i64] || values.len() != f * n {
+        return Err(ModelError::Run {
+            path: path.to_path_buf(),
+            message: format!("output shape {shape:?}, expected [1, {f}, {n}]"),
+        });
+    }
+    match target.as_slice_mut() {
+        Some(slice) => slice.copy_from_slice(values),
+        None => target.iter_mut().zip(values).for_each(|(o, v)| *o = *v),
+    }
+    Ok(())
 }
 
 impl crate::diffusion::Denoiser for Model {

@@ -1,30 +1,48 @@
 //! Finding and loading the onnxruntime shared library (`ort` with `load-dynamic`).
 //!
-//! A host that ships the library names it with [`load_onnxruntime`]. Otherwise the first model
-//! opened looks for it: the `ORT_DYLIB_PATH` environment variable (the `ort` crate's own), then
-//! the project's Python virtual environment made by `scripts/setup.sh`
-//! (`.venv/.../onnxruntime/capi/`), looked for above the current directory and above the running
-//! executable. Nothing of the machine the crate was built on is searched. A failed attempt is not
-//! remembered: the next one searches (or loads) again.
+//! The search, in order; the first library that loads and is recent enough wins:
+//! 1. the file a host names with [`load_onnxruntime`] (then nothing else is tried);
+//! 2. the file named by the `ORT_DYLIB_PATH` environment variable (`ort`'s own; then nothing
+//!    else is tried);
+//! 3. next to the running executable (where a game ships it);
+//! 4. next to the library that holds this code, when that is not the executable (the C ABI's
+//!    `sinmdm_c` inside an engine's plugin folder);
+//! 5. by bare name through the system loader's own search (`LD_LIBRARY_PATH`, the `ldconfig`
+//!    cache, `DYLD_LIBRARY_PATH`, or on Windows its DLL search order, which reaches System32:
+//!    Windows 10 and 11 keep an older onnxruntime.dll there that is refused as too old);
+//! 6. a developer checkout's `.venv` (made by the project's set-up script), above the working
+//!    directory or the executable.
+//!
+//! A library older than [`ONNXRUNTIME_OLDEST`] is refused and the search goes on. Nothing of the
+//! machine the crate was built on is searched. A failed attempt is not remembered: the next one
+//! searches (or loads) again.
 
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
 
 use thiserror::Error;
 
-/// The onnxruntime version the project pins (the PyPI wheel `onnxruntime==1.31.1`).
+/// The onnxruntime version the project pins and tests with (the PyPI wheel
+/// `onnxruntime==1.31.1`).
 pub const ONNXRUNTIME_VERSION: &str = "1.31.1";
+
+/// The oldest onnxruntime release the runtime works with (the C API level it asks for).
+pub const ONNXRUNTIME_OLDEST: &str = "1.17";
 
 /// The onnxruntime library could not be found or loaded.
 #[derive(Debug, Error, Clone)]
 pub enum RuntimeLibraryError {
-    /// No library in any searched place.
+    /// No library that loads in any searched place.
     #[error(
-        "the onnxruntime {ONNXRUNTIME_VERSION} shared library was not found (looked in: {searched}); \
-         run `scripts/setup.sh` in the sinmdm-rs checkout, or set ORT_DYLIB_PATH to the library file"
+        "onnxruntime (release {ONNXRUNTIME_OLDEST} or later, tested with {ONNXRUNTIME_VERSION}) was not found; \
+         ship {file} next to the program's executable, or set ORT_DYLIB_PATH to the library file. \
+         Tried: {searched}"
     )]
     NotFound {
-        /// The places looked at.
+        /// The usual file name on this platform.
+        file: &'static str,
+        /// The places tried, each with what went wrong there.
         searched: String,
     },
     /// `ORT_DYLIB_PATH` names a file that does not exist.
@@ -38,7 +56,7 @@ pub enum RuntimeLibraryError {
         /// The library asked for.
         asked: PathBuf,
     },
-    /// The file exists but onnxruntime would not load from it.
+    /// The file exists but onnxruntime would not load from it (or it is too old).
     #[error("could not load onnxruntime from '{path}': {message}")]
     LoadFailed {
         /// The library file.
@@ -48,19 +66,43 @@ pub enum RuntimeLibraryError {
     },
 }
 
-/// File names the library has in the PyPI wheel on each platform.
-fn library_names() -> &'static [&'static str] {
+/// The usual file name of the library on this platform.
+fn usual_name() -> &'static str {
     if cfg!(target_os = "windows") {
-        &["onnxruntime.dll"]
+        "onnxruntime.dll"
     } else if cfg!(target_os = "macos") {
-        &["libonnxruntime.1.31.1.dylib", "libonnxruntime.dylib"]
+        "libonnxruntime.dylib"
     } else {
-        &[
-            "libonnxruntime.so.1.31.1",
-            "libonnxruntime.so.1",
-            "libonnxruntime.so",
-        ]
+        "libonnxruntime.so"
     }
+}
+
+/// Whether a file name is the onnxruntime library's on this platform (versioned names too:
+/// `libonnxruntime.so.1.31.1`, `libonnxruntime.1.31.1.dylib`).
+fn is_library_name(name: &str) -> bool {
+    if cfg!(target_os = "windows") {
+        name.eq_ignore_ascii_case("onnxruntime.dll")
+    } else if cfg!(target_os = "macos") {
+        name.starts_with("libonnxruntime") && name.ends_with(".dylib")
+    } else {
+        name == "libonnxruntime.so" || name.starts_with("libonnxruntime.so.")
+    }
+}
+
+/// The library files in a folder, shortest name first (the plain name before versioned ones).
+fn in_folder(folder: &Path) -> Vec<PathBuf> {
+    let mut found: Vec<PathBuf> = std::fs::read_dir(folder)
+        .into_iter()
+        .flatten()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.is_file()
+                && p.file_name()
+                    .is_some_and(|n| is_library_name(&n.to_string_lossy()))
+        })
+        .collect();
+    found.sort_by_key(|p| (p.as_os_str().len(), p.clone()));
+    found
 }
 
 /// The onnxruntime library inside a virtual environment, if present.
@@ -78,16 +120,14 @@ fn in_venv(venv: &Path) -> Option<PathBuf> {
         site_packages.extend(pythons.into_iter().map(|p| p.join("site-packages")));
     }
     site_packages.into_iter().find_map(|sp| {
-        let capi = sp.join("onnxruntime").join("capi");
-        library_names()
-            .iter()
-            .map(|name| capi.join(name))
-            .find(|p| p.is_file())
+        in_folder(&sp.join("onnxruntime").join("capi"))
+            .into_iter()
+            .next()
     })
 }
 
 /// Directories whose `.venv` may hold the library, nearest first.
-fn candidate_roots() -> Vec<PathBuf> {
+fn checkout_roots() -> Vec<PathBuf> {
     let mut roots = Vec::new();
     if let Ok(dir) = std::env::current_dir() {
         roots.extend(dir.ancestors().map(Path::to_path_buf));
@@ -100,33 +140,168 @@ fn candidate_roots() -> Vec<PathBuf> {
     roots
 }
 
-/// Where the onnxruntime shared library is, following the search order above.
-pub fn locate_library() -> Result<PathBuf, RuntimeLibraryError> {
-    locate_in(std::env::var_os("ORT_DYLIB_PATH"), &candidate_roots())
+/// One place the search tries.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub(crate) enum Candidate {
+    /// A file found in a folder (or named), loaded by its full path.
+    File(PathBuf),
+    /// A bare name handed to the system loader, which searches its own path.
+    System(&'static str),
 }
 
-/// The search itself: `env_path` first, then `.venv` under each root in turn.
-fn locate_in(
-    env_path: Option<std::ffi::OsString>,
+impl std::fmt::Display for Candidate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Candidate::File(p) => write!(f, "{}", p.display()),
+            Candidate::System(name) => write!(f, "{name} on the system's library path"),
+        }
+    }
+}
+
+/// The folders a program's own files sit in, searched before the system: the executable's
+/// and the one of the library holding this code.
+struct Folders {
+    executable: Option<PathBuf>,
+    library: Option<PathBuf>,
+}
+
+impl Folders {
+    fn of_this_process() -> Folders {
+        Folders {
+            executable: std::env::current_exe()
+                .ok()
+                .and_then(|p| p.parent().map(Path::to_path_buf)),
+            library: own_library::path().and_then(|p| p.parent().map(Path::to_path_buf)),
+        }
+    }
+}
+
+/// Bare names the system loader is asked for.
+fn system_names() -> &'static [&'static str] {
+    if cfg!(target_os = "windows") {
+        &["onnxruntime.dll"]
+    } else if cfg!(target_os = "macos") {
+        &["libonnxruntime.dylib"]
+    } else {
+        &["libonnxruntime.so.1", "libonnxruntime.so"]
+    }
+}
+
+/// The search order of the module documentation, steps 2 to 6: the candidates to try in turn,
+/// or the error when `ORT_DYLIB_PATH` names a missing file.
+fn candidates(
+    env_path: Option<OsString>,
+    folders: &Folders,
     roots: &[PathBuf],
-) -> Result<PathBuf, RuntimeLibraryError> {
+) -> Result<Vec<Candidate>, RuntimeLibraryError> {
     if let Some(path) = env_path.filter(|p| !p.is_empty()) {
         let path = PathBuf::from(path);
         return if path.is_file() {
-            Ok(path)
+            Ok(vec![Candidate::File(path)])
         } else {
             Err(RuntimeLibraryError::EnvPathMissing(path))
         };
     }
-    if let Some(found) = roots.iter().find_map(|r| in_venv(&r.join(".venv"))) {
-        return Ok(found);
+    let mut list = Vec::new();
+    let mut folders_seen = Vec::new();
+    for folder in [&folders.executable, &folders.library]
+        .into_iter()
+        .flatten()
+    {
+        if !folders_seen.contains(folder) {
+            folders_seen.push(folder.clone());
+            list.extend(in_folder(folder).into_iter().map(Candidate::File));
+        }
     }
-    Err(RuntimeLibraryError::NotFound {
-        searched: std::iter::once("ORT_DYLIB_PATH (unset)".to_string())
-            .chain(roots.iter().map(|r| r.join(".venv").display().to_string()))
-            .collect::<Vec<_>>()
-            .join(", "),
-    })
+    list.extend(system_names().iter().map(|n| Candidate::System(n)));
+    list.extend(
+        roots
+            .iter()
+            .filter_map(|r| in_venv(&r.join(".venv")))
+            .map(Candidate::File),
+    );
+    let mut seen = std::collections::HashSet::new();
+    list.retain(|c| seen.insert(c.clone()));
+    Ok(list)
+}
+
+/// The path of the shared library (or executable) that holds this code.
+#[cfg(unix)]
+mod own_library {
+    use std::ffi::{CStr, c_char, c_int, c_void};
+    use std::path::PathBuf;
+
+    #[repr(C)]
+    struct DlInfo {
+        dli_fname: *const c_char,
+        dli_fbase: *mut c_void,
+        dli_sname: *const c_char,
+        dli_saddr: *mut c_void,
+    }
+
+    unsafe extern "C" {
+        fn dladdr(address: *const c_void, info: *mut DlInfo) -> c_int;
+    }
+
+    pub(super) fn path() -> Option<PathBuf> {
+        let mut info = DlInfo {
+            dli_fname: std::ptr::null(),
+            dli_fbase: std::ptr::null_mut(),
+            dli_sname: std::ptr::null(),
+            dli_saddr: std::ptr::null_mut(),
+        };
+        let address = path as fn() -> Option<PathBuf> as *const c_void;
+        // SAFETY: dladdr only reads the address and fills `info`; the name it points to
+        // belongs to the loader and is copied at once.
+        let found = unsafe { dladdr(address, &mut info) };
+        if found == 0 || info.dli_fname.is_null() {
+            return None;
+        }
+        let name = unsafe { CStr::from_ptr(info.dli_fname) };
+        let path = PathBuf::from(name.to_string_lossy().into_owned());
+        path.is_absolute().then_some(path)
+    }
+}
+
+/// The path of the DLL (or executable) that holds this code.
+#[cfg(windows)]
+mod own_library {
+    use std::ffi::c_void;
+    use std::os::windows::ffi::OsStringExt;
+    use std::path::PathBuf;
+
+    const FROM_ADDRESS: u32 = 0x4;
+    const UNCHANGED_REFCOUNT: u32 = 0x2;
+
+    #[link(name = "kernel32")]
+    unsafe extern "system" {
+        fn GetModuleHandleExW(flags: u32, address: *const u16, module: *mut *mut c_void) -> i32;
+        fn GetModuleFileNameW(module: *mut c_void, name: *mut u16, size: u32) -> u32;
+    }
+
+    pub(super) fn path() -> Option<PathBuf> {
+        let mut module = std::ptr::null_mut();
+        let address = path as fn() -> Option<PathBuf> as *const u16;
+        // SAFETY: the flags ask for the module holding `address` without touching its count.
+        let ok =
+            unsafe { GetModuleHandleExW(FROM_ADDRESS | UNCHANGED_REFCOUNT, address, &mut module) };
+        if ok == 0 {
+            return None;
+        }
+        let mut buffer = vec![0u16; 32_768];
+        let length =
+            unsafe { GetModuleFileNameW(module, buffer.as_mut_ptr(), buffer.len() as u32) };
+        (length > 0 && (length as usize) < buffer.len())
+            .then(|| PathBuf::from(std::ffi::OsString::from_wide(&buffer[..length as usize])))
+    }
+}
+
+/// Elsewhere the folder of the library holding this code is not looked up.
+#[cfg(not(any(unix, windows)))]
+mod own_library {
+    pub(super) fn path() -> Option<std::path::PathBuf> {
+        None
+    }
 }
 
 /// The loaded onnxruntime: the library's path and the process-wide environment every session
@@ -192,27 +367,61 @@ fn load(asked: Option<&Path>) -> Result<&'static OnnxRuntime, RuntimeLibraryErro
     if let Some(runtime) = LOADED.get() {
         return check(runtime);
     }
-    let path = match asked {
-        Some(p) if p.is_file() => p.to_path_buf(),
+    let list = match asked {
+        Some(p) if p.is_file() => vec![Candidate::File(p.to_path_buf())],
         Some(p) => {
             return Err(RuntimeLibraryError::LoadFailed {
                 path: p.to_path_buf(),
                 message: "no such file".into(),
             });
         }
-        None => locate_library()?,
+        None => candidates(
+            std::env::var_os("ORT_DYLIB_PATH"),
+            &Folders::of_this_process(),
+            &checkout_roots(),
+        )?,
     };
-    let failed = |message: String| RuntimeLibraryError::LoadFailed {
-        path: path.clone(),
-        message,
-    };
-    let environment = ort::init_from(&path)
-        .map_err(|e| failed(e.to_string()))?
+    let mut tried = Vec::new();
+    for candidate in &list {
+        let path = match candidate {
+            Candidate::File(p) => p.clone(),
+            Candidate::System(name) => PathBuf::from(name),
+        };
+        match start_environment(&path) {
+            Ok(environment) => {
+                return Ok(LOADED.get_or_init(|| OnnxRuntime { path, environment }));
+            }
+            Err(message) => tried.push(format!("{candidate} ({message})")),
+        }
+    }
+    match (asked, list.as_slice()) {
+        (Some(p), _) => Err(RuntimeLibraryError::LoadFailed {
+            path: p.to_path_buf(),
+            message: tried.join("; "),
+        }),
+        (None, [Candidate::File(p)]) if std::env::var_os("ORT_DYLIB_PATH").is_some() => {
+            Err(RuntimeLibraryError::LoadFailed {
+                path: p.clone(),
+                message: tried.join("; "),
+            })
+        }
+        _ => Err(RuntimeLibraryError::NotFound {
+            file: usual_name(),
+            searched: tried.join("; "),
+        }),
+    }
+}
+
+/// Loads the library at `path` (a bare name goes to the system loader) and makes the process's
+/// environment; the loader's or onnxruntime's words on failure (a release older than
+/// [`ONNXRUNTIME_OLDEST`] is refused here).
+fn start_environment(path: &Path) -> Result<ort::environment::Environment, String> {
+    ort::init_from(path)
+        .map_err(|e| e.to_string())?
         .with_name("sinmdm")
         .with_telemetry(false)
         .build()
-        .map_err(|e| failed(e.to_string()))?;
-    Ok(LOADED.get_or_init(|| OnnxRuntime { path, environment }))
+        .map_err(|e| e.to_string())
 }
 
 fn same_file(a: &Path, b: &Path) -> bool {
@@ -233,36 +442,86 @@ mod tests {
         dir
     }
 
+    fn no_folders() -> Folders {
+        Folders {
+            executable: None,
+            library: None,
+        }
+    }
+
+    fn files(list: &[Candidate]) -> Vec<PathBuf> {
+        list.iter()
+            .filter_map(|c| match c {
+                Candidate::File(p) => Some(p.clone()),
+                Candidate::System(_) => None,
+            })
+            .collect()
+    }
+
     #[test]
-    fn finds_the_library_in_a_project_venv() {
-        let root = temp_root("venv");
-        let capi = root.join(".venv/lib/python3.12/site-packages/onnxruntime/capi");
-        std::fs::create_dir_all(&capi).unwrap();
-        let lib = capi.join(library_names()[0]);
-        std::fs::write(&lib, b"").unwrap();
-        let elsewhere = temp_root("empty");
-        assert_eq!(
-            locate_in(None, &[elsewhere.clone(), root.clone()]).unwrap(),
-            lib
+    fn the_search_order_is_executable_library_system_then_checkouts() {
+        let root = temp_root("order");
+        let (exe, lib, venv) = (
+            root.join("game"),
+            root.join("plugins"),
+            root.join("checkout"),
         );
+        let capi = venv.join(".venv/lib/python3.12/site-packages/onnxruntime/capi");
+        for dir in [&exe, &lib, &capi] {
+            std::fs::create_dir_all(dir).unwrap();
+        }
+        let name = usual_name();
+        for dir in [&exe, &lib, &capi] {
+            std::fs::write(dir.join(name), b"").unwrap();
+        }
+        std::fs::write(exe.join("unrelated.txt"), b"").unwrap();
+        let folders = Folders {
+            executable: Some(exe.clone()),
+            library: Some(lib.clone()),
+        };
+        let list = candidates(None, &folders, std::slice::from_ref(&venv)).unwrap();
+        assert_eq!(
+            files(&list),
+            vec![exe.join(name), lib.join(name), capi.join(name)]
+        );
+        let system = list
+            .iter()
+            .position(|c| matches!(c, Candidate::System(_)))
+            .unwrap();
+        assert_eq!(
+            system, 2,
+            "the system loader comes after both folders: {list:?}"
+        );
+        assert!(matches!(list.last(), Some(Candidate::File(p)) if p == &capi.join(name)));
         std::fs::remove_dir_all(root).unwrap();
-        std::fs::remove_dir_all(elsewhere).unwrap();
     }
 
     #[test]
     fn the_environment_variable_wins_and_must_exist() {
         let missing = PathBuf::from("/nonexistent/libonnxruntime.so");
-        let e = locate_in(Some(missing.clone().into()), &[]).unwrap_err();
+        let e = candidates(Some(missing.clone().into()), &no_folders(), &[]).unwrap_err();
         assert!(matches!(e, RuntimeLibraryError::EnvPathMissing(p) if p == missing));
     }
 
     #[test]
-    fn not_found_says_what_to_run() {
-        let root = temp_root("none");
-        let e = locate_in(None, std::slice::from_ref(&root)).unwrap_err();
+    fn the_library_holding_this_code_is_found() {
+        let own = own_library::path().expect("dladdr names this test binary");
+        assert!(own.is_file(), "{}", own.display());
+    }
+
+    #[test]
+    fn not_found_speaks_to_whoever_ships_the_program() {
+        let e = RuntimeLibraryError::NotFound {
+            file: usual_name(),
+            searched: "x".into(),
+        };
         let message = e.to_string();
-        assert!(message.contains("scripts/setup.sh"), "{message}");
+        assert!(
+            message.contains("next to the program's executable"),
+            "{message}"
+        );
         assert!(message.contains("ORT_DYLIB_PATH"), "{message}");
-        std::fs::remove_dir_all(root).unwrap();
+        assert!(message.contains(ONNXRUNTIME_OLDEST), "{message}");
+        assert!(!message.contains("setup"), "{message}");
     }
 }

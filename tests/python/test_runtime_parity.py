@@ -89,7 +89,7 @@ def test_rust_and_python_agree(case, references):
     args, refs = CASES[case]
     work = references["work"]
     rust_json, py_json = work / f"{case}-rust.json", work / f"{case}-python.json"
-    common = ["-m", MODEL, "--seed", 11, "--threads", 1]
+    common = ["-m", MODEL, "--seed", 11]
     rust_refs, py_refs = [], []
     for flag, name in refs.items():
         clip = WALK if name == "walk" else HOP

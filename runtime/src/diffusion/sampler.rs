@@ -42,21 +42,23 @@ pub trait Denoiser {
 /// A sampling run in progress: noise drawn, steps taken one at a time by [`Sampler::step`].
 ///
 /// Stepping to the end gives exactly what `Plan::run` gives (it is the same code), so a caller
-/// can spread a run over frames of a game, report progress or stop early.
-pub struct Sampler<'a> {
-    schedule: &'a Schedule,
-    guidance: &'a Guidance,
+/// can spread a run over frames of a game, report progress or stop early. It owns its schedule
+/// and guidance (`Send + 'static`), so it can be kept across frames or moved to a worker.
+pub struct Sampler {
+    schedule: Schedule,
+    guidance: Guidance,
     shape: (usize, usize, usize),
     x: Array3<f32>,
     done: usize,
     free: usize,
     noise: NoiseWorker,
     method: Method,
-    /// The previous step's guided clean prediction (kept for multistep methods only).
+    /// The last step's guided clean prediction (read by multistep methods, and the partial
+    /// result of a run finished early).
     x0_prev: Option<Array3<f32>>,
 }
 
-impl std::fmt::Debug for Sampler<'_> {
+impl std::fmt::Debug for Sampler {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Sampler")
             .field("shape", &self.shape)
@@ -66,16 +68,17 @@ impl std::fmt::Debug for Sampler<'_> {
     }
 }
 
-impl<'a> Sampler<'a> {
-    /// Draws the initial noise of `batch` samples of `features` rows and `frames` frames.
+impl Sampler {
+    /// Draws the initial noise of `batch` samples of `features` rows and `frames` frames (the
+    /// schedule and guidance are copied into the sampler).
     pub fn new(
-        schedule: &'a Schedule,
-        guidance: &'a Guidance,
+        schedule: &Schedule,
+        guidance: &Guidance,
         batch: usize,
         features: usize,
         frames: usize,
         seed: u64,
-    ) -> Result<Sampler<'a>, SamplerError> {
+    ) -> Result<Sampler, SamplerError> {
         if batch == 0 || frames == 0 {
             return Err(SamplerError::Empty { batch, frames });
         }
@@ -88,8 +91,8 @@ impl<'a> Sampler<'a> {
             .as_ref()
             .map_or(0, |h| h.free_steps(schedule.len()));
         Ok(Sampler {
-            schedule,
-            guidance,
+            schedule: schedule.clone(),
+            guidance: guidance.clone(),
             shape,
             x,
             done: 0,
@@ -104,7 +107,7 @@ impl<'a> Sampler<'a> {
 
     /// The same run with another update rule (ancestral until changed); only before the first
     /// step.
-    pub fn with_method(mut self, method: Method) -> Result<Sampler<'a>, SamplerError> {
+    pub fn with_method(mut self, method: Method) -> Result<Sampler, SamplerError> {
         if let Some(problem) = method.problem() {
             return Err(SamplerError::Method(problem));
         }
@@ -137,6 +140,13 @@ impl<'a> Sampler<'a> {
         self.x
     }
 
+    /// The last step's guided clean prediction `[B, F, N]` (what the network expects the
+    /// sample to become; masks applied); `None` before the first step. Once the run is
+    /// finished, [`Sampler::into_sample`] is the result.
+    pub fn latest_prediction(&self) -> Option<ArrayView3<'_, f32>> {
+        self.x0_prev.as_ref().map(|x0| x0.view())
+    }
+
     /// Takes one denoising step; does nothing once finished. On a denoiser error the sample is
     /// left as it was before the step.
     pub fn step<D: Denoiser>(&mut self, denoiser: &mut D) -> Result<(), StepError<D::Error>> {
@@ -155,7 +165,7 @@ impl<'a> Sampler<'a> {
         let k = steps - 1 - step;
         let t = vec![self.schedule.timesteps[k] as i64; batch];
         let harmonizing = self.guidance.harmonization.is_some() && step < steps - self.free;
-        let c = self.method.coefficients(self.schedule, k);
+        let c = self.method.coefficients(&self.schedule, k);
         let noisy_step = k > 0 && c.sigma > 0.0;
         if noisy_step {
             self.noise.request(step as u64 + 1);
@@ -212,9 +222,7 @@ impl<'a> Sampler<'a> {
                 .and(&x0)
                 .for_each(|x, &p| *x = c0 * p + ct * *x),
         }
-        if self.method == Method::DpmSolver2M {
-            self.x0_prev = Some(x0);
-        }
+        self.x0_prev = Some(x0);
         if let Some(h) = &self.guidance.harmonization
             && harmonizing
         {

@@ -28,7 +28,7 @@ use crate::motion::feet::{Anchor, Feet, Kept, PlantOptions, plant_feet};
 use crate::motion::math::{Mat3, Vec3};
 use crate::motion::{FeatureMatrix, LocalMotion, MotionError, Pose, decode, poses};
 use crate::tasks::mask::soft_mask;
-use crate::tasks::{INBETWEEN_RAMP, TaskError};
+use crate::tasks::{INBETWEEN_RAMP, Progress, TaskError};
 use blocks::{BlockSizes, block_seed};
 use guide::Guide;
 
@@ -110,8 +110,15 @@ struct Frame {
     translations: Vec<Vec3>,
 }
 
+/// A block whose sampling run is under way (see [`Stream::prepare`]).
+#[derive(Debug)]
+struct PendingBlock {
+    window: blocks::Window,
+    sampler: Sampler,
+}
+
 /// Endless motion from one model; see the [module documentation](self).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Stream {
     metadata: ModelMetadata,
     feet: Feet,
@@ -132,6 +139,8 @@ pub struct Stream {
     last_root: Option<Vec3>,
     /// Final frames not yet handed out.
     ready: VecDeque<Frame>,
+    /// The next block, when its run has been started ahead of need.
+    pending: Option<PendingBlock>,
     guide: Guide,
 }
 
@@ -213,6 +222,7 @@ impl Stream {
             tail: None,
             last_root: None,
             ready: VecDeque::new(),
+            pending: None,
             guide: Guide::default(),
         })
     }
@@ -261,7 +271,7 @@ impl Stream {
             });
         }
         while self.ready.len() < frames {
-            self.make_block(denoiser)?;
+            self.advance(denoiser, usize::MAX)?;
         }
         let layout = &self.metadata.layout;
         let joints = layout.skeleton.len();
@@ -289,11 +299,77 @@ impl Stream {
         })
     }
 
-    /// Makes the next block and queues its final frames.
-    fn make_block<D: Denoiser>(&mut self, denoiser: &mut D) -> Result<(), TaskError>
+    /// Final frames made and not yet handed out: [`Stream::next`] for at most this many frames
+    /// runs no network.
+    pub fn ready_frames(&self) -> usize {
+        self.ready.len()
+    }
+
+    /// Prepares frames ahead of need, spending at most `max_steps` denoising steps: while
+    /// fewer than `ahead` frames are ready, it steps the next block's run (starting it if
+    /// needed) and queues its frames once it finishes. A game calls it every frame with a
+    /// small `max_steps` and reads with [`Stream::next`], which then never waits when enough
+    /// frames are ready. The motion is the same bits as a stream read without preparing.
+    /// Returns the progress of the block in the making (`0 of 0` when none is).
+    pub fn prepare<D: Denoiser>(
+        &mut self,
+        denoiser: &mut D,
+        max_steps: usize,
+        ahead: usize,
+    ) -> Result<Progress, TaskError>
     where
         TaskError: From<D::Error>,
     {
+        let mut budget = max_steps;
+        while self.ready.len() < ahead && budget > 0 {
+            budget -= self.advance(denoiser, budget)?;
+        }
+        Ok(self.block_progress())
+    }
+
+    /// Steps taken and steps in all of the block in the making (`0 of 0` when none is).
+    pub fn block_progress(&self) -> Progress {
+        self.pending
+            .as_ref()
+            .map_or(Progress { done: 0, total: 0 }, |p| Progress {
+                done: p.sampler.done(),
+                total: p.sampler.steps(),
+            })
+    }
+
+    /// Takes up to `max_steps` steps of the next block (starting it if none is under way) and
+    /// queues its frames when it finishes; returns the steps taken (at least one, so a caller
+    /// looping on it always gets on).
+    fn advance<D: Denoiser>(
+        &mut self,
+        denoiser: &mut D,
+        max_steps: usize,
+    ) -> Result<usize, TaskError>
+    where
+        TaskError: From<D::Error>,
+    {
+        let mut pending = match self.pending.take() {
+            Some(p) => p,
+            None => self.start_block()?,
+        };
+        let mut taken = 0;
+        while taken < max_steps.max(1) && !pending.sampler.is_finished() {
+            if let Err(e) = pending.sampler.step(denoiser) {
+                self.pending = Some(pending);
+                return Err(e.into());
+            }
+            taken += 1;
+        }
+        if pending.sampler.is_finished() {
+            self.complete_block(pending)?;
+        } else {
+            self.pending = Some(pending);
+        }
+        Ok(taken.max(1))
+    }
+
+    /// Starts the next block's sampling run: its window, guidance and noise.
+    fn start_block(&mut self) -> Result<PendingBlock, TaskError> {
         let sizes = self.sizes;
         let window = sizes.window(self.blocks);
         let f = self.metadata.network.features;
@@ -334,11 +410,16 @@ impl Stream {
             Guidance::default()
         };
         let seed = block_seed(self.seed, self.blocks as u64);
-        let mut sampler =
+        let sampler =
             Sampler::new(&self.schedule, &guidance, 1, f, n, seed)?.with_method(self.method)?;
-        while !sampler.is_finished() {
-            sampler.step(denoiser)?;
-        }
+        Ok(PendingBlock { window, sampler })
+    }
+
+    /// Decodes a finished block and queues its final frames.
+    fn complete_block(&mut self, pending: PendingBlock) -> Result<(), TaskError> {
+        let PendingBlock { window, sampler } = pending;
+        let sizes = self.sizes;
+        let n = window.frames;
         let normalized = sampler.into_sample().index_axis_move(Axis(0), 0);
         let keep = sizes.context + sizes.ramp;
         self.carried = Some(normalized.slice(s![.., n - keep..]).to_owned());

@@ -10,6 +10,7 @@ mod generated;
 mod joints;
 pub mod mask;
 mod plan;
+mod run;
 
 use std::convert::Infallible;
 
@@ -24,6 +25,7 @@ pub use generated::Generated;
 pub use joints::{joints_by_name, subtree};
 pub use mask::Span;
 pub use plan::{Plan, plan, run};
+pub use run::{Progress, Run};
 
 pub use crate::limits::{MAX_RUN_VALUES, MAX_SAMPLE_FRAMES, MAX_SAMPLES};
 /// Default soft border of in-betweening and composition spans, in frames.
@@ -49,6 +51,12 @@ pub enum TaskError {
     Cancelled {
         /// Steps taken.
         done: usize,
+        /// Steps in the run.
+        steps: usize,
+    },
+    /// A run finished before its first step: there is no motion to show yet.
+    #[error("the run has taken none of its {steps} steps, so there is no motion yet")]
+    NotStarted {
         /// Steps in the run.
         steps: usize,
     },

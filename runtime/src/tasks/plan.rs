@@ -7,6 +7,7 @@ use ndarray::Array2;
 
 use super::Generated;
 use super::mask::{Span, covered, soft_mask};
+use super::run::Run;
 use super::{Request, Task, TaskError};
 use crate::diffusion::sampler::{Denoiser, Guidance, Harmonization, Inpainting, Sampler};
 use crate::diffusion::{Method, SamplerError, Schedule};
@@ -109,7 +110,7 @@ impl Plan {
     }
 
     /// A sampler for this plan, to step by hand.
-    pub fn sampler(&self) -> Result<Sampler<'_>, TaskError> {
+    pub fn sampler(&self) -> Result<Sampler, TaskError> {
         Ok(Sampler::new(
             &self.schedule,
             &self.guidance,
@@ -121,14 +122,23 @@ impl Plan {
         .with_method(self.method)?)
     }
 
-    /// The batch of a sampler made by [`Plan::sampler`] (finished, or stopped early).
-    pub fn finish(&self, sampler: Sampler<'_>) -> Generated {
+    /// The batch of a sampler made by [`Plan::sampler`] once finished.
+    pub fn finish(&self, sampler: Sampler) -> Generated {
+        self.batch(sampler.into_sample())
+    }
+
+    /// The batch of normalised features `[B, F, N]` made by this plan's sampler.
+    pub(crate) fn batch(&self, normalized: ndarray::Array3<f32>) -> Generated {
         let kept = Kept {
             joints: self.kept_joints().unwrap_or_default(),
             root: self.kept_root().unwrap_or_default(),
         };
-        Generated::from_normalized(self.metadata.clone(), sampler.into_sample())
-            .with_feet(self.feet, kept)
+        Generated::from_normalized(self.metadata.clone(), normalized).with_feet(self.feet, kept)
+    }
+
+    /// Starts an owned, stepped run of this plan (see [`Run`]).
+    pub fn start(&self) -> Result<Run, TaskError> {
+        Run::new(self.clone())
     }
 
     /// Runs the plan on a denoiser. `progress` is called after each step with (steps done,
@@ -142,17 +152,9 @@ impl Plan {
     where
         TaskError: From<D::Error>,
     {
-        let mut sampler = self.sampler()?;
-        while !sampler.is_finished() {
-            sampler.step(denoiser)?;
-            if progress(sampler.done(), sampler.steps()).is_break() && !sampler.is_finished() {
-                return Err(TaskError::Cancelled {
-                    done: sampler.done(),
-                    steps: sampler.steps(),
-                });
-            }
-        }
-        Ok(self.finish(sampler))
+        let mut run = self.start()?;
+        run.complete(denoiser, progress)?;
+        run.finish()
     }
 }
 
