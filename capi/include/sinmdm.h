@@ -1,4 +1,68 @@
-/* sinmdm: single-motion diffusion runtime, C ABI. See README.md, section Embedding. */
+/*
+ * # sinmdm-c
+ *
+ * The C ABI of the sinmdm runtime, for engines in C, C++, C# and anything else that calls C.
+ * This text is the introduction of the header include/sinmdm.h, which cbindgen generates from
+ * the crate (a test keeps it current). Built as a shared library (libsinmdm_c.so,
+ * sinmdm_c.dll, libsinmdm_c.dylib) and a static one.
+ *
+ * Conventions, the same at every entry point:
+ * - Status: every function returns a SinmdmStatus (the _free functions return nothing).
+ *   On failure sinmdm_last_error() (per thread, valid until the next call on that thread)
+ *   says why, naming the argument, field or file. One kind of mistake gets one status
+ *   everywhere: a NULL pointer SINMDM_NULL_ARGUMENT; a value past its bound, an unknown
+ *   constant or index, malformed poses, a handle of another model SINMDM_INVALID_ARGUMENT;
+ *   a short buffer SINMDM_BUFFER_TOO_SMALL. A panic inside the library is caught and
+ *   returned as SINMDM_INTERNAL: nothing unwinds into the caller.
+ * - Bounds: every count and size is checked against the SINMDM_MAX_* constants below before
+ *   anything is read or allocated, and every size is computed in checked arithmetic.
+ * - Handles are opaque and freed with their _free function (NULL is accepted there). A
+ *   function that gives a handle through out sets *out to NULL first, so on failure it
+ *   holds NULL, never a stale pointer.
+ * - Buffers belong to the caller, with their capacity in elements. Strings are UTF-8 and
+ *   NUL-terminated. Where a function takes a needed pointer (joint names, parents, rest
+ *   offsets, contact joints), a NULL buffer asks for the size only and needed gets it; a
+ *   buffer too small writes nothing and gives SINMDM_BUFFER_TOO_SMALL (with needed set).
+ *   Pose buffers are sized from sinmdm_result_frames and SinmdmModelInfo::joints.
+ * - Memory handed in is read during the call only: sinmdm_model_open_bytes copies the
+ *   bytes, reference poses are copied, nothing is kept.
+ * - Runs in a game's frame: sinmdm_TASK_begin checks a request and gives an owned run;
+ *   sinmdm_run_step(run, model, k, ...) takes at most k denoising steps (a step costs about
+ *   1/50 of a default run); sinmdm_run_finish gives the batch (before the last step: a
+ *   preview, the network's latest clean prediction); sinmdm_run_free cancels. A stream is
+ *   prepared ahead with sinmdm_stream_step so sinmdm_stream_next never waits. Stepping a
+ *   run any number of steps at a time gives the bits of the one-call task.
+ * - Progress and cancel on a worker thread: sinmdm_model_set_progress sets a callback
+ *   (userdata first) called after each step of a blocking task; returning
+ *   SINMDM_PROGRESS_CANCEL stops it with SINMDM_CANCELLED and the model stays usable.
+ * - Threads: a handle may move between threads but must be used by one thread at a time; a
+ *   model and the runs and streams that run on it count as one. Different models may run at
+ *   once on different threads. sinmdm_load_onnxruntime and sinmdm_last_error may be
+ *   called from any thread. The library starts these threads: for each run or stream block
+ *   in progress, one that draws the next step's noise (it ends with the run); for a batch of
+ *   several samples on a model opened with threads > 1, up to threads - 1 that each run
+ *   samples during a denoising call and are joined before it returns. onnxruntime itself runs
+ *   on the calling thread (one intra-op thread, no pool).
+ * - The same bits on every machine: the same model file, seed and arguments give the same
+ *   poses whatever threads is and wherever a sample sits in its batch (each sample is its
+ *   own onnxruntime call on one intra-op thread), through this ABI, the Rust API and the
+ *   Python reference alike; threads changes speed only. What the bits still depend on is
+ *   onnxruntime's choice of CPU kernels by instruction set (AVX2, AVX-512, NEON): machines
+ *   with the same set agree (onnxruntime 1.17.0, 1.19.2, 1.20.1 and 1.31.1 gave the same bits
+ *   on AVX2).
+ * - onnxruntime is loaded at run time, release 1.17 or later (tested with 1.17.0, 1.19.2,
+ *   1.20.1 and 1.31.1). sinmdm_load_onnxruntime(path) names it;
+ *   otherwise the first model opened looks, in order: ORT_DYLIB_PATH, next to the
+ *   executable, next to this library, the system loader's search path, a developer
+ *   checkout's .venv. On Windows the loader's path reaches System32, where Windows may keep
+ *   an onnxruntime.dll of its own and of another release: ship yours next to the executable
+ *   (or the plugin) so it is found first. A release older than 1.17 is refused.
+ * - Poses are in the model file's frame: right-handed, its up axis (sinmdm_model_info) and
+ *   its units; quaternions are x, y, z, w. See the README's Embedding section for Unity and
+ *   Unreal.
+ * - Compatibility: the layout of the structs here does not change; new abilities come as new
+ *   functions.
+ */
 
 #ifndef SINMDM_H
 #define SINMDM_H
@@ -10,6 +74,50 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
+
+/*
+ The longest sample a task makes, and the longest stream chunk or block, in frames
+ (`SinmdmPoses.frames`, `frames` of `sinmdm_generate` and `sinmdm_stream_next`, a task's
+ length after expansion).
+ */
+#define SINMDM_MAX_SAMPLE_FRAMES 100000
+
+/*
+ The widest soft border (`ramp`) of a task's kept spans, in frames.
+ */
+#define SINMDM_MAX_RAMP_FRAMES 100000
+
+/*
+ The largest crowd one run makes (`SinmdmSampling.count`).
+ */
+#define SINMDM_MAX_SAMPLES 1024
+
+/*
+ The largest working set one run may need, in f32 values (1 GiB): `count x frames x` the
+ larger of `F + 8 C` and `12 x joints`; a bigger request is refused before anything runs.
+ */
+#define SINMDM_MAX_RUN_VALUES (1 << 28)
+
+/*
+ The most threads a model runs samples on (`threads` of `sinmdm_model_open*`; 0 = every core).
+ */
+#define SINMDM_MAX_THREADS 1024
+
+/*
+ The largest model `sinmdm_model_open_bytes` takes, in bytes (protobuf's 2 GiB limit on an
+ ONNX file).
+ */
+#define SINMDM_MAX_MODEL_BYTES ((1 << 31) - 1)
+
+/*
+ A progress callback's answer: go on.
+ */
+#define SINMDM_PROGRESS_CONTINUE 0
+
+/*
+ A progress callback's answer: stop the run (any value but 0 does the same).
+ */
+#define SINMDM_PROGRESS_CANCEL 1
 
 /*
  Respaced sampling steps of the command line (the library's `DEFAULT_STEPS`); what a `steps`
@@ -49,7 +157,8 @@
 
 /*
  What a call did. Every function returns one; on anything but `SINMDM_OK`,
- `sinmdm_last_error` says why, in words that name the argument, field or file.
+ `sinmdm_last_error` says why, in words that name the argument, field or file. One kind of
+ mistake always gets the same status, whichever function it is made at.
  */
 typedef enum SinmdmStatus {
   /*
@@ -61,12 +170,15 @@ typedef enum SinmdmStatus {
    */
   SINMDM_NULL_ARGUMENT = 1,
   /*
-   An argument out of range or malformed (a count, an index, a string that is not UTF-8,
-   poses that do not fit the skeleton).
+   An argument outside its documented range, or malformed: a count, length, step count,
+   ramp, span, joint index, factor, share or thread count past its bound (`SINMDM_MAX_*`),
+   an unknown constant, a string that is not UTF-8, poses that do not fit the skeleton, a
+   handle used with another model, or a call its handle's state does not allow.
    */
   SINMDM_INVALID_ARGUMENT = 2,
   /*
-   An output buffer too small; the message gives the size needed.
+   An output buffer too small; nothing was written and the message gives the size needed
+   (pass a NULL buffer to ask for it).
    */
   SINMDM_BUFFER_TOO_SMALL = 3,
   /*
@@ -74,7 +186,7 @@ typedef enum SinmdmStatus {
    */
   SINMDM_UNKNOWN_JOINT = 4,
   /*
-   onnxruntime could not be loaded.
+   onnxruntime could not be found or loaded (the message lists where it was looked for).
    */
   SINMDM_RUNTIME_LIBRARY = 5,
   /*
@@ -82,7 +194,7 @@ typedef enum SinmdmStatus {
    */
   SINMDM_BAD_MODEL = 6,
   /*
-   A request the model refused (spans, lengths, counts), or a run that failed.
+   A valid request whose run failed inside onnxruntime (out of memory, say).
    */
   SINMDM_TASK_FAILED = 7,
   /*
@@ -93,6 +205,10 @@ typedef enum SinmdmStatus {
    A bug in the library (a caught panic); the handle involved should be freed.
    */
   SINMDM_INTERNAL = 9,
+  /*
+   The progress callback asked to stop; the model (and a stepped run) can be used on.
+   */
+  SINMDM_CANCELLED = 10,
 } SinmdmStatus;
 
 /*
@@ -106,9 +222,24 @@ typedef struct SinmdmModel SinmdmModel;
 typedef struct SinmdmResult SinmdmResult;
 
 /*
+ A task being run (opaque): it owns its plan, schedule, guidance, noise and sample, not the
+ model; each step is given the model it was begun on.
+ */
+typedef struct SinmdmRun SinmdmRun;
+
+/*
  A stream (opaque): motion handed out a chunk at a time, forever, in flat memory.
  */
 typedef struct SinmdmStream SinmdmStream;
+
+/*
+ A progress callback: called after each denoising step of a blocking task on the model it was
+ set on, with the host's `userdata` first, then the steps done and the steps in all. Return
+ `SINMDM_PROGRESS_CONTINUE` to go on, or `SINMDM_PROGRESS_CANCEL` (any value but 0) to stop:
+ the call then returns `SINMDM_CANCELLED` and gives no result. It runs on the thread that
+ made the call and must not call back into the library with the same model.
+ */
+typedef int32_t (*SinmdmProgressFn)(void *userdata, size_t done, size_t total);
 
 /*
  The facts of a model an engine needs to hold its poses.
@@ -175,52 +306,6 @@ typedef struct SinmdmPoses {
    */
   const float *translations;
 } SinmdmPoses;
-
-/*
- Sampling settings shared by every task. The same model, settings and arguments give the same
- poses, here, in Rust and in the Python reference.
- */
-typedef struct SinmdmSampling {
-  /*
-   Seed of the portable noise.
-   */
-  uint64_t seed;
-  /*
-   Samples in the batch (a crowd when more than 1).
-   */
-  uint32_t count;
-  /*
-   Respaced denoising steps; 0 for `SINMDM_DEFAULT_STEPS`, `SINMDM_ALL_STEPS` for all of
-   the model's T.
-   */
-  uint32_t steps;
-  /*
-   `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
-   */
-  uint32_t feet;
-  /*
-   `SINMDM_METHOD_ANCESTRAL` (0, the default), `SINMDM_METHOD_DDIM` or `SINMDM_METHOD_DPM2M`.
-   */
-  uint32_t method;
-  /*
-   DDIM's share of the ancestral noise, 0 to 1 (ignored by the other methods).
-   */
-  double eta;
-} SinmdmSampling;
-
-/*
- A span of frames `start..end` (end excluded).
- */
-typedef struct SinmdmSpan {
-  /*
-   First frame.
-   */
-  size_t start;
-  /*
-   One past the last frame.
-   */
-  size_t end;
-} SinmdmSpan;
 
 /*
  Caller-owned arrays the library fills with poses; capacities are in floats. Needed: root
@@ -297,6 +382,52 @@ typedef struct SinmdmStreamOptions {
   double eta;
 } SinmdmStreamOptions;
 
+/*
+ Sampling settings shared by every task. The same model, settings and arguments give the same
+ poses, here, in Rust and in the Python reference.
+ */
+typedef struct SinmdmSampling {
+  /*
+   Seed of the portable noise.
+   */
+  uint64_t seed;
+  /*
+   Samples in the batch (a crowd when more than 1).
+   */
+  uint32_t count;
+  /*
+   Respaced denoising steps; 0 for `SINMDM_DEFAULT_STEPS`, `SINMDM_ALL_STEPS` for all of
+   the model's T.
+   */
+  uint32_t steps;
+  /*
+   `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
+   */
+  uint32_t feet;
+  /*
+   `SINMDM_METHOD_ANCESTRAL` (0, the default), `SINMDM_METHOD_DDIM` or `SINMDM_METHOD_DPM2M`.
+   */
+  uint32_t method;
+  /*
+   DDIM's share of the ancestral noise, 0 to 1 (ignored by the other methods).
+   */
+  double eta;
+} SinmdmSampling;
+
+/*
+ A span of frames `start..end` (end excluded).
+ */
+typedef struct SinmdmSpan {
+  /*
+   First frame.
+   */
+  size_t start;
+  /*
+   One past the last frame.
+   */
+  size_t end;
+} SinmdmSpan;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -308,9 +439,11 @@ const char *sinmdm_version(void);
 
 /*
  Loads onnxruntime from the shared library at `path` (an engine that ships its own copy), or
- finds it when `path` is NULL (`ORT_DYLIB_PATH`, then the project's `.venv`). Opening a model
- does this on its own with NULL; call it first to choose the library. Asking for a second,
- different library once one is loaded fails.
+ finds it when `path` is NULL, in this order: `ORT_DYLIB_PATH`, next to the executable, next
+ to this library, the system loader's search path, a developer checkout's `.venv`. A release
+ older than 1.17 is refused and the search goes on. Opening a model does this on its own with
+ NULL; call it first to choose the library. Asking for a second, different library once one
+ is loaded fails.
 
  # Safety
  `path` is NULL or a NUL-terminated string.
@@ -318,9 +451,10 @@ const char *sinmdm_version(void);
 enum SinmdmStatus sinmdm_load_onnxruntime(const char *path);
 
 /*
- Opens the model file at `path`, running it on `threads` threads (0: every core), and writes
- its handle to `out`. The file is checked before anything runs: a file that is not a model
- gives `SINMDM_BAD_MODEL` and names the field or problem.
+ Opens the model file at `path` and writes its handle to `out`. `threads` is how many samples
+ of a batch run at once, each on its own thread (0: every core; at most
+ `SINMDM_MAX_THREADS`); it changes speed, never values. The file is checked before anything
+ runs: a file that is not a model gives `SINMDM_BAD_MODEL` and names the field or problem.
 
  # Safety
  `path` is a NUL-terminated string; `out` is writable.
@@ -329,6 +463,7 @@ enum SinmdmStatus sinmdm_model_open(const char *path, uint32_t threads, struct S
 
 /*
  Opens a model from the `length` bytes at `bytes` (a file the engine read or packed itself).
+ The bytes are copied: they may be freed as soon as the call returns.
 
  # Safety
  `bytes` is readable for `length` bytes; `out` is writable.
@@ -337,6 +472,20 @@ enum SinmdmStatus sinmdm_model_open_bytes(const uint8_t *bytes,
                                           size_t length,
                                           uint32_t threads,
                                           struct SinmdmModel **out);
+
+/*
+ Sets the progress callback of the blocking tasks run on `model` (`sinmdm_generate` and the
+ other tasks), with the host's `userdata` handed back to it; a NULL `callback` removes it.
+ Meant for a host that runs tasks on a worker thread and wants to show progress or cancel;
+ a game that spreads a run over frames uses `sinmdm_*_begin` and `sinmdm_run_step` instead.
+
+ # Safety
+ `model` is a live handle; `callback` NULL or a function as `SinmdmProgressFn` says, which
+ with `userdata` stays valid while it is set.
+ */
+enum SinmdmStatus sinmdm_model_set_progress(struct SinmdmModel *model,
+                                            SinmdmProgressFn callback,
+                                            void *userdata);
 
 /*
  Frees a model (NULL is fine). Streams made on it must not be advanced afterwards.
@@ -355,8 +504,8 @@ void sinmdm_model_free(struct SinmdmModel *model);
 enum SinmdmStatus sinmdm_model_info(const struct SinmdmModel *model, struct SinmdmModelInfo *info);
 
 /*
- Copies the name of joint `joint` into `buffer` (see the size convention in the header's
- introduction); `needed` gets its size with the NUL.
+ Copies the name of joint `joint` into `buffer` of `capacity` bytes; `needed` (if not NULL)
+ gets its size with the NUL, also when the buffer is NULL (a size query) or too small.
 
  # Safety
  `model` is a live handle; `buffer` NULL or writable for `capacity` bytes; `needed` NULL or
@@ -381,36 +530,44 @@ enum SinmdmStatus sinmdm_model_find_joint(const struct SinmdmModel *model,
 
 /*
  Writes every joint's parent index (-1 for the root) to `parents`, which holds `capacity`
- values (at least the joint count).
+ values; `needed` (if not NULL) gets the joint count, also for a NULL `parents` (a size query).
 
  # Safety
- `model` is a live handle; `parents` writable for `capacity` values.
+ `model` is a live handle; `parents` NULL or writable for `capacity` values; `needed` NULL
+ or writable.
  */
 enum SinmdmStatus sinmdm_model_parents(const struct SinmdmModel *model,
                                        int32_t *parents,
-                                       size_t capacity);
+                                       size_t capacity,
+                                       size_t *needed);
 
 /*
  Writes every joint's rest offset from its parent (x, y, z; file units) to `offsets`, which
- holds `capacity` floats (at least 3 x the joint count).
+ holds `capacity` floats; `needed` (if not NULL) gets 3 x the joint count, also for a NULL
+ `offsets` (a size query).
 
  # Safety
- `model` is a live handle; `offsets` writable for `capacity` floats.
+ `model` is a live handle; `offsets` NULL or writable for `capacity` floats; `needed` NULL or
+ writable.
  */
 enum SinmdmStatus sinmdm_model_rest_offsets(const struct SinmdmModel *model,
                                             float *offsets,
-                                            size_t capacity);
+                                            size_t capacity,
+                                            size_t *needed);
 
 /*
  Writes the contact joints' indices (feet, paws: where planting holds the motion on the
- ground) to `joints`, which holds `capacity` values (`SinmdmModelInfo::contact_joints`).
+ ground) to `joints`, which holds `capacity` values; `needed` (if not NULL) gets their count
+ (`SinmdmModelInfo::contact_joints`), also for a NULL `joints` (a size query).
 
  # Safety
- `model` is a live handle; `joints` writable for `capacity` values.
+ `model` is a live handle; `joints` NULL or writable for `capacity` values; `needed` NULL or
+ writable.
  */
 enum SinmdmStatus sinmdm_model_contact_joints(const struct SinmdmModel *model,
                                               size_t *joints,
-                                              size_t capacity);
+                                              size_t capacity,
+                                              size_t *needed);
 
 /*
  Writes `poses` of the model's skeleton to the BVH file `path` (at the model's frame rate,
@@ -423,81 +580,6 @@ enum SinmdmStatus sinmdm_model_contact_joints(const struct SinmdmModel *model,
 enum SinmdmStatus sinmdm_write_bvh(const struct SinmdmModel *model,
                                    const struct SinmdmPoses *poses,
                                    const char *path);
-
-/*
- New motion of `frames` frames.
-
- # Safety
- `model` is a live handle, `sampling` readable, `out` writable.
- */
-enum SinmdmStatus sinmdm_generate(struct SinmdmModel *model,
-                                  const struct SinmdmSampling *sampling,
-                                  size_t frames,
-                                  struct SinmdmResult **out);
-
-/*
- In-betweening: keeps the `span_count` spans `keep` of the `reference` poses (soft borders
- of `ramp` frames) and generates the gaps.
-
- # Safety
- Pointers as their types' documentation says; `keep` readable for `span_count` spans.
- */
-enum SinmdmStatus sinmdm_inbetween(struct SinmdmModel *model,
-                                   const struct SinmdmSampling *sampling,
-                                   const struct SinmdmPoses *reference,
-                                   const struct SinmdmSpan *keep,
-                                   size_t span_count,
-                                   size_t ramp,
-                                   struct SinmdmResult **out);
-
-/*
- Expansion: the `reference` poses in the middle, `prefix` new frames before and `suffix`
- after.
-
- # Safety
- Pointers as their types' documentation says.
- */
-enum SinmdmStatus sinmdm_expand(struct SinmdmModel *model,
-                                const struct SinmdmSampling *sampling,
-                                const struct SinmdmPoses *reference,
-                                size_t prefix,
-                                size_t suffix,
-                                size_t ramp,
-                                struct SinmdmResult **out);
-
-/*
- Composition: the `joint_count` `joints` (and the root's travel when `root` is not 0) taken
- from the `reference` poses on the `span_count` `spans` (every frame when 0), the rest of
- the body generated.
-
- # Safety
- Pointers as their types' documentation says; `joints` readable for `joint_count` values,
- `spans` for `span_count` spans.
- */
-enum SinmdmStatus sinmdm_compose(struct SinmdmModel *model,
-                                 const struct SinmdmSampling *sampling,
-                                 const struct SinmdmPoses *reference,
-                                 const size_t *joints,
-                                 size_t joint_count,
-                                 int32_t root,
-                                 const struct SinmdmSpan *spans_in,
-                                 size_t span_count,
-                                 size_t ramp,
-                                 struct SinmdmResult **out);
-
-/*
- Harmonization (style transfer): the `content` poses' low frequencies (down-sampled by
- `factor`) in the model's style, the last `free_share` of steps left free.
-
- # Safety
- Pointers as their types' documentation says.
- */
-enum SinmdmStatus sinmdm_harmonize(struct SinmdmModel *model,
-                                   const struct SinmdmSampling *sampling,
-                                   const struct SinmdmPoses *content,
-                                   size_t factor,
-                                   double free_share,
-                                   struct SinmdmResult **out);
 
 /*
  Writes the number of samples in the batch to `count`.
@@ -534,6 +616,39 @@ enum SinmdmStatus sinmdm_result_poses(const struct SinmdmResult *result,
 void sinmdm_result_free(struct SinmdmResult *result);
 
 /*
+ Takes up to `max_steps` denoising steps of `run` on `model` (the model it was begun on),
+ and writes the steps taken so far and in all to `done` and `total` (each may be NULL). One
+ step costs about a 50th of the whole run at the default step count; 0 steps only reports.
+
+ # Safety
+ `run` and `model` are live handles; `done` and `total` NULL or writable.
+ */
+enum SinmdmStatus sinmdm_run_step(struct SinmdmRun *run,
+                                  struct SinmdmModel *model,
+                                  size_t max_steps,
+                                  size_t *done,
+                                  size_t *total);
+
+/*
+ Finishes `run` and writes its batch to `out`: the motion once every step is taken, or,
+ before that, the network's latest prediction of the clean motion (a preview; a run that has
+ taken no step has none and gives `SINMDM_INVALID_ARGUMENT`). The run is spent afterwards:
+ free it with `sinmdm_run_free`.
+
+ # Safety
+ `run` is a live handle; `out` writable.
+ */
+enum SinmdmStatus sinmdm_run_finish(struct SinmdmRun *run, struct SinmdmResult **out);
+
+/*
+ Frees a run (NULL is fine); freeing one before it is finished cancels it.
+
+ # Safety
+ `run` is NULL or a handle from this library, not used again.
+ */
+void sinmdm_run_free(struct SinmdmRun *run);
+
+/*
  The message of the last failed call on this thread ("" after a call that worked). The text
  belongs to the library and stays valid until the next call on the same thread; copy it to
  keep it. Never NULL.
@@ -552,9 +667,9 @@ enum SinmdmStatus sinmdm_stream_new(const struct SinmdmModel *model,
 
 /*
  Supplies poses for the frames after the last supplied ones (the first call supplies frame
- 0 on), for a stream with composed joints. Poses supplied at least
- `2 x block_frames + 10` frames ahead of what has been handed out make the stream's motion
- independent of chunk sizes.
+ 0 on), for a stream made with composed joints (`SINMDM_INVALID_ARGUMENT` for one without).
+ Poses supplied at least `2 x block_frames + 10` frames ahead of what has been handed out
+ make the stream's motion independent of chunk sizes.
 
  # Safety
  `stream` and `model` are live handles (the stream's model); `poses` as its documentation says.
@@ -564,8 +679,10 @@ enum SinmdmStatus sinmdm_stream_supply(struct SinmdmStream *stream,
                                        const struct SinmdmPoses *poses);
 
 /*
- Makes the next `frames` frames on `model` (the model the stream was made with) and writes
- their poses into `buffers`. The motion is the same whatever chunk sizes are asked for.
+ Makes the next `frames` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) on `model` (the model
+ the stream was made with) and writes their poses into `buffers`. The motion is the same
+ whatever chunk sizes are asked for. It runs the network only for frames not yet prepared
+ by `sinmdm_stream_step`.
 
  # Safety
  `stream` and `model` are live handles; `buffers` as its documentation says.
@@ -576,12 +693,177 @@ enum SinmdmStatus sinmdm_stream_next(struct SinmdmStream *stream,
                                      const struct SinmdmPoseBuffers *buffers);
 
 /*
+ Prepares frames ahead on `model` (the stream's), spending at most `max_steps` denoising
+ steps: while fewer than `ahead` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) are ready, the
+ next block is made a step at a time. A game calls it each frame with a small `max_steps`
+ and reads with `sinmdm_stream_next`, which then never waits when enough frames are ready;
+ the motion is the same bits as without preparing. `ready` (if not NULL) gets the frames
+ ready now; `done` and `total` (if not NULL) the steps of the block in the making (0 of 0
+ when none is).
+
+ # Safety
+ `stream` and `model` are live handles; `ready`, `done` and `total` NULL or writable.
+ */
+enum SinmdmStatus sinmdm_stream_step(struct SinmdmStream *stream,
+                                     struct SinmdmModel *model,
+                                     size_t max_steps,
+                                     size_t ahead,
+                                     size_t *ready,
+                                     size_t *done,
+                                     size_t *total);
+
+/*
  Frees a stream (NULL is fine).
 
  # Safety
  `stream` is NULL or a handle from this library, not used again.
  */
 void sinmdm_stream_free(struct SinmdmStream *stream);
+
+/*
+ Begins new motion of `frames` frames (see `sinmdm_run_step`).
+
+ # Safety
+ `model` is a live handle, `sampling` readable, `out` writable.
+ */
+enum SinmdmStatus sinmdm_generate_begin(struct SinmdmModel *model,
+                                        const struct SinmdmSampling *sampling,
+                                        size_t frames,
+                                        struct SinmdmRun **out);
+
+/*
+ New motion of `frames` frames.
+
+ # Safety
+ `model` is a live handle, `sampling` readable, `out` writable.
+ */
+enum SinmdmStatus sinmdm_generate(struct SinmdmModel *model,
+                                  const struct SinmdmSampling *sampling,
+                                  size_t frames,
+                                  struct SinmdmResult **out);
+
+/*
+ Begins an in-between (see `sinmdm_inbetween` and `sinmdm_run_step`).
+
+ # Safety
+ As `sinmdm_inbetween`.
+ */
+enum SinmdmStatus sinmdm_inbetween_begin(struct SinmdmModel *model,
+                                         const struct SinmdmSampling *sampling,
+                                         const struct SinmdmPoses *reference,
+                                         const struct SinmdmSpan *keep,
+                                         size_t span_count,
+                                         size_t ramp,
+                                         struct SinmdmRun **out);
+
+/*
+ In-betweening: keeps the `span_count` spans `keep` of the `reference` poses (soft borders
+ of `ramp` frames) and generates the gaps.
+
+ # Safety
+ Pointers as their types' documentation says; `keep` readable for `span_count` spans.
+ */
+enum SinmdmStatus sinmdm_inbetween(struct SinmdmModel *model,
+                                   const struct SinmdmSampling *sampling,
+                                   const struct SinmdmPoses *reference,
+                                   const struct SinmdmSpan *keep,
+                                   size_t span_count,
+                                   size_t ramp,
+                                   struct SinmdmResult **out);
+
+/*
+ Begins an expansion (see `sinmdm_expand` and `sinmdm_run_step`).
+
+ # Safety
+ As `sinmdm_expand`.
+ */
+enum SinmdmStatus sinmdm_expand_begin(struct SinmdmModel *model,
+                                      const struct SinmdmSampling *sampling,
+                                      const struct SinmdmPoses *reference,
+                                      size_t prefix,
+                                      size_t suffix,
+                                      size_t ramp,
+                                      struct SinmdmRun **out);
+
+/*
+ Expansion: the `reference` poses in the middle, `prefix` new frames before and `suffix`
+ after (all together at most `SINMDM_MAX_SAMPLE_FRAMES`).
+
+ # Safety
+ Pointers as their types' documentation says.
+ */
+enum SinmdmStatus sinmdm_expand(struct SinmdmModel *model,
+                                const struct SinmdmSampling *sampling,
+                                const struct SinmdmPoses *reference,
+                                size_t prefix,
+                                size_t suffix,
+                                size_t ramp,
+                                struct SinmdmResult **out);
+
+/*
+ Begins a composition (see `sinmdm_compose` and `sinmdm_run_step`).
+
+ # Safety
+ As `sinmdm_compose`.
+ */
+enum SinmdmStatus sinmdm_compose_begin(struct SinmdmModel *model,
+                                       const struct SinmdmSampling *sampling,
+                                       const struct SinmdmPoses *reference,
+                                       const size_t *joints,
+                                       size_t joint_count,
+                                       int32_t root,
+                                       const struct SinmdmSpan *spans_in,
+                                       size_t span_count,
+                                       size_t ramp,
+                                       struct SinmdmRun **out);
+
+/*
+ Composition: the `joint_count` `joints` (and the root's travel when `root` is not 0) taken
+ from the `reference` poses on the `span_count` `spans` (every frame when 0), the rest of
+ the body generated.
+
+ # Safety
+ Pointers as their types' documentation says; `joints` readable for `joint_count` values,
+ `spans` for `span_count` spans.
+ */
+enum SinmdmStatus sinmdm_compose(struct SinmdmModel *model,
+                                 const struct SinmdmSampling *sampling,
+                                 const struct SinmdmPoses *reference,
+                                 const size_t *joints,
+                                 size_t joint_count,
+                                 int32_t root,
+                                 const struct SinmdmSpan *spans_in,
+                                 size_t span_count,
+                                 size_t ramp,
+                                 struct SinmdmResult **out);
+
+/*
+ Begins a harmonization (see `sinmdm_harmonize` and `sinmdm_run_step`).
+
+ # Safety
+ As `sinmdm_harmonize`.
+ */
+enum SinmdmStatus sinmdm_harmonize_begin(struct SinmdmModel *model,
+                                         const struct SinmdmSampling *sampling,
+                                         const struct SinmdmPoses *content,
+                                         size_t factor,
+                                         double free_share,
+                                         struct SinmdmRun **out);
+
+/*
+ Harmonization (style transfer): the `content` poses' low frequencies (down-sampled by
+ `factor`, 1 to the content's frames) in the model's style, the last `free_share` (0 to 1)
+ of steps left free.
+
+ # Safety
+ Pointers as their types' documentation says.
+ */
+enum SinmdmStatus sinmdm_harmonize(struct SinmdmModel *model,
+                                   const struct SinmdmSampling *sampling,
+                                   const struct SinmdmPoses *content,
+                                   size_t factor,
+                                   double free_share,
+                                   struct SinmdmResult **out);
 
 #ifdef __cplusplus
 }  // extern "C"

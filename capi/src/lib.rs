@@ -1,49 +1,108 @@
 //! # sinmdm-c
 //!
-//! The C ABI of the sinmdm runtime, for engines in C, C++, C# and anything else that calls C:
-//! the header `include/sinmdm.h` is generated from this crate by cbindgen. Built as a shared
-//! library (`libsinmdm_c.so`, `sinmdm_c.dll`, `libsinmdm_c.dylib`) and a static one.
+//! The C ABI of the sinmdm runtime, for engines in C, C++, C# and anything else that calls C.
+//! This text is the introduction of the header `include/sinmdm.h`, which cbindgen generates from
+//! the crate (a test keeps it current). Built as a shared library (`libsinmdm_c.so`,
+//! `sinmdm_c.dll`, `libsinmdm_c.dylib`) and a static one.
 //!
 //! Conventions, the same at every entry point:
-//! - Every function returns a [`SinmdmStatus`]; on failure [`sinmdm_last_error`] (per thread)
-//!   says why. A panic inside the library is caught and returned as `SINMDM_INTERNAL`: nothing
-//!   unwinds into the caller.
-//! - Handles are opaque and freed with their `_free` function (NULL is accepted there).
-//! - Output buffers belong to the caller, with their capacity given in elements; a buffer too
-//!   small gives `SINMDM_BUFFER_TOO_SMALL` and writes nothing. Strings are UTF-8 and
-//!   NUL-terminated; passing a NULL buffer asks for the size only.
+//! - Status: every function returns a `SinmdmStatus` (the `_free` functions return nothing).
+//!   On failure `sinmdm_last_error()` (per thread, valid until the next call on that thread)
+//!   says why, naming the argument, field or file. One kind of mistake gets one status
+//!   everywhere: a NULL pointer `SINMDM_NULL_ARGUMENT`; a value past its bound, an unknown
+//!   constant or index, malformed poses, a handle of another model `SINMDM_INVALID_ARGUMENT`;
+//!   a short buffer `SINMDM_BUFFER_TOO_SMALL`. A panic inside the library is caught and
+//!   returned as `SINMDM_INTERNAL`: nothing unwinds into the caller.
+//! - Bounds: every count and size is checked against the `SINMDM_MAX_*` constants below before
+//!   anything is read or allocated, and every size is computed in checked arithmetic.
+//! - Handles are opaque and freed with their `_free` function (NULL is accepted there). A
+//!   function that gives a handle through `out` sets `*out` to NULL first, so on failure it
+//!   holds NULL, never a stale pointer.
+//! - Buffers belong to the caller, with their capacity in elements. Strings are UTF-8 and
+//!   NUL-terminated. Where a function takes a `needed` pointer (joint names, parents, rest
+//!   offsets, contact joints), a NULL buffer asks for the size only and `needed` gets it; a
+//!   buffer too small writes nothing and gives `SINMDM_BUFFER_TOO_SMALL` (with `needed` set).
+//!   Pose buffers are sized from `sinmdm_result_frames` and `SinmdmModelInfo::joints`.
+//! - Memory handed in is read during the call only: `sinmdm_model_open_bytes` copies the
+//!   bytes, reference poses are copied, nothing is kept.
+//! - Runs in a game's frame: `sinmdm_TASK_begin` checks a request and gives an owned run;
+//!   `sinmdm_run_step(run, model, k, ...)` takes at most k denoising steps (a step costs about
+//!   1/50 of a default run); `sinmdm_run_finish` gives the batch (before the last step: a
+//!   preview, the network's latest clean prediction); `sinmdm_run_free` cancels. A stream is
+//!   prepared ahead with `sinmdm_stream_step` so `sinmdm_stream_next` never waits. Stepping a
+//!   run any number of steps at a time gives the bits of the one-call task.
+//! - Progress and cancel on a worker thread: `sinmdm_model_set_progress` sets a callback
+//!   (`userdata` first) called after each step of a blocking task; returning
+//!   `SINMDM_PROGRESS_CANCEL` stops it with `SINMDM_CANCELLED` and the model stays usable.
+//! - Threads: a handle may move between threads but must be used by one thread at a time; a
+//!   model and the runs and streams that run on it count as one. Different models may run at
+//!   once on different threads. `sinmdm_load_onnxruntime` and `sinmdm_last_error` may be
+//!   called from any thread. The library starts these threads: for each run or stream block
+//!   in progress, one that draws the next step's noise (it ends with the run); for a batch of
+//!   several samples on a model opened with `threads` > 1, up to `threads - 1` that each run
+//!   samples during a denoising call and are joined before it returns. onnxruntime itself runs
+//!   on the calling thread (one intra-op thread, no pool).
+//! - The same bits on every machine: the same model file, seed and arguments give the same
+//!   poses whatever `threads` is and wherever a sample sits in its batch (each sample is its
+//!   own onnxruntime call on one intra-op thread), through this ABI, the Rust API and the
+//!   Python reference alike; `threads` changes speed only. What the bits still depend on is
+//!   onnxruntime's choice of CPU kernels by instruction set (AVX2, AVX-512, NEON): machines
+//!   with the same set agree (onnxruntime 1.17.0, 1.19.2, 1.20.1 and 1.31.1 gave the same bits
+//!   on AVX2).
+//! - onnxruntime is loaded at run time, release 1.17 or later (tested with 1.17.0, 1.19.2,
+//!   1.20.1 and 1.31.1). `sinmdm_load_onnxruntime(path)` names it;
+//!   otherwise the first model opened looks, in order: `ORT_DYLIB_PATH`, next to the
+//!   executable, next to this library, the system loader's search path, a developer
+//!   checkout's `.venv`. On Windows the loader's path reaches System32, where Windows may keep
+//!   an onnxruntime.dll of its own and of another release: ship yours next to the executable
+//!   (or the plugin) so it is found first. A release older than 1.17 is refused.
 //! - Poses are in the model file's frame: right-handed, its up axis (`sinmdm_model_info`) and
 //!   its units; quaternions are `x, y, z, w`. See the README's Embedding section for Unity and
 //!   Unreal.
-//! - Threads: a handle may move between threads but must be used by one thread at a time; a
-//!   model and the streams that run on it count as one. Different models may run at once on
-//!   different threads. `sinmdm_load_onnxruntime` and `sinmdm_last_error` may be called from
-//!   any thread.
+//! - Compatibility: the layout of the structs here does not change; new abilities come as new
+//!   functions.
 
 #![warn(missing_docs)]
 
+mod limits;
 mod model;
 mod poses;
+mod result;
 mod run;
+mod sampling;
 mod status;
 mod stream;
+mod tasks;
 mod text;
 
+pub use limits::{
+    SINMDM_MAX_MODEL_BYTES, SINMDM_MAX_RAMP_FRAMES, SINMDM_MAX_RUN_VALUES,
+    SINMDM_MAX_SAMPLE_FRAMES, SINMDM_MAX_SAMPLES, SINMDM_MAX_THREADS,
+};
 pub use model::{
-    SinmdmModel, SinmdmModelInfo, sinmdm_load_onnxruntime, sinmdm_model_contact_joints,
+    SINMDM_PROGRESS_CANCEL, SINMDM_PROGRESS_CONTINUE, SinmdmModel, SinmdmModelInfo,
+    SinmdmProgressFn, sinmdm_load_onnxruntime, sinmdm_model_contact_joints,
     sinmdm_model_find_joint, sinmdm_model_free, sinmdm_model_info, sinmdm_model_joint_name,
     sinmdm_model_open, sinmdm_model_open_bytes, sinmdm_model_parents, sinmdm_model_rest_offsets,
-    sinmdm_version,
+    sinmdm_model_set_progress, sinmdm_version,
 };
 pub use poses::{SinmdmPoseBuffers, SinmdmPoses, sinmdm_write_bvh};
-pub use run::{
+pub use result::{
+    SinmdmResult, sinmdm_result_count, sinmdm_result_frames, sinmdm_result_free,
+    sinmdm_result_poses,
+};
+pub use run::{SinmdmRun, sinmdm_run_finish, sinmdm_run_free, sinmdm_run_step};
+pub use sampling::{
     SINMDM_ALL_STEPS, SINMDM_DEFAULT_STEPS, SINMDM_FEET_PLANTED, SINMDM_FEET_RAW,
-    SINMDM_METHOD_ANCESTRAL, SINMDM_METHOD_DDIM, SINMDM_METHOD_DPM2M, SinmdmResult, SinmdmSampling,
-    SinmdmSpan, sinmdm_compose, sinmdm_expand, sinmdm_generate, sinmdm_harmonize, sinmdm_inbetween,
-    sinmdm_result_count, sinmdm_result_frames, sinmdm_result_free, sinmdm_result_poses,
+    SINMDM_METHOD_ANCESTRAL, SINMDM_METHOD_DDIM, SINMDM_METHOD_DPM2M, SinmdmSampling, SinmdmSpan,
 };
 pub use status::{SinmdmStatus, sinmdm_last_error};
 pub use stream::{
     SinmdmStream, SinmdmStreamOptions, sinmdm_stream_free, sinmdm_stream_new, sinmdm_stream_next,
-    sinmdm_stream_supply,
+    sinmdm_stream_step, sinmdm_stream_supply,
+};
+pub use tasks::{
+    sinmdm_compose, sinmdm_compose_begin, sinmdm_expand, sinmdm_expand_begin, sinmdm_generate,
+    sinmdm_generate_begin, sinmdm_harmonize, sinmdm_harmonize_begin, sinmdm_inbetween,
+    sinmdm_inbetween_begin,
 };

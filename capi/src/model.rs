@@ -1,15 +1,76 @@
 //! Loading onnxruntime, opening models, and what a model's skeleton is.
 
-use std::ffi::c_char;
+use std::ffi::{c_char, c_void};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use sinmdm::{Model, ModelOptions, UpAxis};
 
-use crate::status::{Failure, SinmdmStatus, guard};
-use crate::text::{copy_str, give, handle, out_slice, slice_arg, str_arg};
+use crate::limits::SINMDM_MAX_MODEL_BYTES;
+use crate::status::{Failure, SinmdmStatus, guard, guard_out};
+use crate::text::{copy_array, copy_str, give, handle, slice_arg, str_arg};
+
+/// A progress callback: called after each denoising step of a blocking task on the model it was
+/// set on, with the host's `userdata` first, then the steps done and the steps in all. Return
+/// `SINMDM_PROGRESS_CONTINUE` to go on, or `SINMDM_PROGRESS_CANCEL` (any value but 0) to stop:
+/// the call then returns `SINMDM_CANCELLED` and gives no result. It runs on the thread that
+/// made the call and must not call back into the library with the same model.
+pub type SinmdmProgressFn =
+    Option<unsafe extern "C" fn(userdata: *mut c_void, done: usize, total: usize) -> i32>;
+
+/// A progress callback's answer: go on.
+pub const SINMDM_PROGRESS_CONTINUE: i32 = 0;
+/// A progress callback's answer: stop the run (any value but 0 does the same).
+pub const SINMDM_PROGRESS_CANCEL: i32 = 1;
+
+/// The progress callback of a model and its host's pointer.
+#[derive(Clone, Copy)]
+pub(crate) struct Progress {
+    pub callback: SinmdmProgressFn,
+    pub userdata: *mut c_void,
+}
+
+impl Progress {
+    /// Calls the callback (if any): whether to go on.
+    pub(crate) fn go_on(&self, done: usize, total: usize) -> bool {
+        match self.callback {
+            // SAFETY: the host set this function and pointer with sinmdm_model_set_progress.
+            Some(callback) => (unsafe { callback(self.userdata, done, total) }) == 0,
+            None => true,
+        }
+    }
+}
 
 /// An open model (opaque): the network and its metadata.
 pub struct SinmdmModel {
     pub(crate) model: Model,
+    /// Unique in the process: runs and streams remember the model they were made on.
+    pub(crate) id: u64,
+    pub(crate) progress: Progress,
+}
+
+impl SinmdmModel {
+    fn new(model: Model) -> SinmdmModel {
+        static NEXT: AtomicU64 = AtomicU64::new(1);
+        SinmdmModel {
+            model,
+            id: NEXT.fetch_add(1, Ordering::Relaxed),
+            progress: Progress {
+                callback: None,
+                userdata: std::ptr::null_mut(),
+            },
+        }
+    }
+
+    /// Refuses a handle (a run, a stream) made on another model.
+    pub(crate) fn check_same(&self, made_on: u64, what: &str) -> Result<(), Failure> {
+        if made_on == self.id {
+            Ok(())
+        } else {
+            Err(Failure::invalid(format!(
+                "the {what} was made with another model; pass the model it was made with"
+            )))
+        }
+    }
 }
 
 /// The model behind a handle.
@@ -51,9 +112,11 @@ pub extern "C" fn sinmdm_version() -> *const c_char {
 }
 
 /// Loads onnxruntime from the shared library at `path` (an engine that ships its own copy), or
-/// finds it when `path` is NULL (`ORT_DYLIB_PATH`, then the project's `.venv`). Opening a model
-/// does this on its own with NULL; call it first to choose the library. Asking for a second,
-/// different library once one is loaded fails.
+/// finds it when `path` is NULL, in this order: `ORT_DYLIB_PATH`, next to the executable, next
+/// to this library, the system loader's search path, a developer checkout's `.venv`. A release
+/// older than 1.17 is refused and the search goes on. Opening a model does this on its own with
+/// NULL; call it first to choose the library. Asking for a second, different library once one
+/// is loaded fails.
 ///
 /// # Safety
 /// `path` is NULL or a NUL-terminated string.
@@ -77,9 +140,10 @@ fn options(threads: u32) -> ModelOptions {
     }
 }
 
-/// Opens the model file at `path`, running it on `threads` threads (0: every core), and writes
-/// its handle to `out`. The file is checked before anything runs: a file that is not a model
-/// gives `SINMDM_BAD_MODEL` and names the field or problem.
+/// Opens the model file at `path` and writes its handle to `out`. `threads` is how many samples
+/// of a batch run at once, each on its own thread (0: every core; at most
+/// `SINMDM_MAX_THREADS`); it changes speed, never values. The file is checked before anything
+/// runs: a file that is not a model gives `SINMDM_BAD_MODEL` and names the field or problem.
 ///
 /// # Safety
 /// `path` is a NUL-terminated string; `out` is writable.
@@ -89,18 +153,18 @@ pub unsafe extern "C" fn sinmdm_model_open(
     threads: u32,
     out: *mut *mut SinmdmModel,
 ) -> SinmdmStatus {
-    guard(|| {
-        let path = unsafe { str_arg(path, "path") }?;
-        if out.is_null() {
-            return Err(Failure::null("out"));
-        }
-        let model = Model::open(path, &options(threads))?;
-        unsafe { give(out, SinmdmModel { model }) };
-        Ok(())
-    })
+    unsafe {
+        guard_out(out, |out| {
+            let path = str_arg(path, "path")?;
+            let model = Model::open(path, &options(threads))?;
+            give(out, SinmdmModel::new(model));
+            Ok(())
+        })
+    }
 }
 
 /// Opens a model from the `length` bytes at `bytes` (a file the engine read or packed itself).
+/// The bytes are copied: they may be freed as soon as the call returns.
 ///
 /// # Safety
 /// `bytes` is readable for `length` bytes; `out` is writable.
@@ -111,13 +175,38 @@ pub unsafe extern "C" fn sinmdm_model_open_bytes(
     threads: u32,
     out: *mut *mut SinmdmModel,
 ) -> SinmdmStatus {
+    unsafe {
+        guard_out(out, |out| {
+            if length > SINMDM_MAX_MODEL_BYTES {
+                return Err(Failure::invalid(format!(
+                    "length is {length} bytes; an ONNX file holds at most {SINMDM_MAX_MODEL_BYTES}"
+                )));
+            }
+            let bytes = slice_arg(bytes, length, "bytes")?;
+            let model = Model::from_bytes(bytes, "model bytes", &options(threads))?;
+            give(out, SinmdmModel::new(model));
+            Ok(())
+        })
+    }
+}
+
+/// Sets the progress callback of the blocking tasks run on `model` (`sinmdm_generate` and the
+/// other tasks), with the host's `userdata` handed back to it; a NULL `callback` removes it.
+/// Meant for a host that runs tasks on a worker thread and wants to show progress or cancel;
+/// a game that spreads a run over frames uses `sinmdm_*_begin` and `sinmdm_run_step` instead.
+///
+/// # Safety
+/// `model` is a live handle; `callback` NULL or a function as `SinmdmProgressFn` says, which
+/// with `userdata` stays valid while it is set.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_model_set_progress(
+    model: *mut SinmdmModel,
+    callback: SinmdmProgressFn,
+    userdata: *mut c_void,
+) -> SinmdmStatus {
     guard(|| {
-        let bytes = unsafe { slice_arg(bytes, length, "bytes") }?;
-        if out.is_null() {
-            return Err(Failure::null("out"));
-        }
-        let model = Model::from_bytes(bytes, "model bytes", &options(threads))?;
-        unsafe { give(out, SinmdmModel { model }) };
+        let model = unsafe { handle(model, "model") }?;
+        model.progress = Progress { callback, userdata };
         Ok(())
     })
 }
@@ -162,8 +251,8 @@ pub unsafe extern "C" fn sinmdm_model_info(
     })
 }
 
-/// Copies the name of joint `joint` into `buffer` (see the size convention in the header's
-/// introduction); `needed` gets its size with the NUL.
+/// Copies the name of joint `joint` into `buffer` of `capacity` bytes; `needed` (if not NULL)
+/// gets its size with the NUL, also when the buffer is NULL (a size query) or too small.
 ///
 /// # Safety
 /// `model` is a live handle; `buffer` NULL or writable for `capacity` bytes; `needed` NULL or
@@ -224,68 +313,75 @@ pub unsafe extern "C" fn sinmdm_model_find_joint(
 }
 
 /// Writes every joint's parent index (-1 for the root) to `parents`, which holds `capacity`
-/// values (at least the joint count).
+/// values; `needed` (if not NULL) gets the joint count, also for a NULL `parents` (a size query).
 ///
 /// # Safety
-/// `model` is a live handle; `parents` writable for `capacity` values.
+/// `model` is a live handle; `parents` NULL or writable for `capacity` values; `needed` NULL
+/// or writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn sinmdm_model_parents(
     model: *const SinmdmModel,
     parents: *mut i32,
     capacity: usize,
+    needed: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
         let model = unsafe { model_arg(model) }?;
-        let joints = &model.skeleton().joints;
-        let out = unsafe { out_slice(parents, capacity, joints.len(), "parents") }?;
-        for (slot, joint) in out.iter_mut().zip(joints) {
-            *slot = joint.parent.map_or(-1, |p| p as i32);
-        }
-        Ok(())
+        let values: Vec<i32> = model
+            .skeleton()
+            .joints
+            .iter()
+            .map(|joint| joint.parent.map_or(-1, |p| p as i32))
+            .collect();
+        unsafe { copy_array(&values, parents, capacity, needed, "parents") }
     })
 }
 
 /// Writes every joint's rest offset from its parent (x, y, z; file units) to `offsets`, which
-/// holds `capacity` floats (at least 3 x the joint count).
+/// holds `capacity` floats; `needed` (if not NULL) gets 3 x the joint count, also for a NULL
+/// `offsets` (a size query).
 ///
 /// # Safety
-/// `model` is a live handle; `offsets` writable for `capacity` floats.
+/// `model` is a live handle; `offsets` NULL or writable for `capacity` floats; `needed` NULL or
+/// writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn sinmdm_model_rest_offsets(
     model: *const SinmdmModel,
     offsets: *mut f32,
     capacity: usize,
+    needed: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
         let model = unsafe { model_arg(model) }?;
-        let rest = &model.metadata().layout.rest_translations;
-        let out = unsafe { out_slice(offsets, capacity, rest.len() * 3, "offsets") }?;
-        for (slot, value) in out.iter_mut().zip(rest.iter().flatten()) {
-            *slot = *value as f32;
-        }
-        Ok(())
+        let values: Vec<f32> = model
+            .metadata()
+            .layout
+            .rest_translations
+            .iter()
+            .flatten()
+            .map(|&v| v as f32)
+            .collect();
+        unsafe { copy_array(&values, offsets, capacity, needed, "offsets") }
     })
 }
 
 /// Writes the contact joints' indices (feet, paws: where planting holds the motion on the
-/// ground) to `joints`, which holds `capacity` values (`SinmdmModelInfo::contact_joints`).
+/// ground) to `joints`, which holds `capacity` values; `needed` (if not NULL) gets their count
+/// (`SinmdmModelInfo::contact_joints`), also for a NULL `joints` (a size query).
 ///
 /// # Safety
-/// `model` is a live handle; `joints` writable for `capacity` values.
+/// `model` is a live handle; `joints` NULL or writable for `capacity` values; `needed` NULL or
+/// writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn sinmdm_model_contact_joints(
     model: *const SinmdmModel,
     joints: *mut usize,
     capacity: usize,
+    needed: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
         let model = unsafe { model_arg(model) }?;
         let contacts = &model.metadata().layout.contact_joints;
-        if contacts.is_empty() {
-            return Ok(());
-        }
-        let out = unsafe { out_slice(joints, capacity, contacts.len(), "joints") }?;
-        out.copy_from_slice(contacts);
-        Ok(())
+        unsafe { copy_array(contacts, joints, capacity, needed, "joints") }
     })
 }

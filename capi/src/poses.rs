@@ -117,11 +117,20 @@ pub(crate) unsafe fn pose_slices<'a>(
     joints: usize,
 ) -> Result<PoseSlices<'a>, Failure> {
     let b = unsafe { handle(buffers.cast_mut(), "buffers") }?;
+    let size = |per_frame: usize| {
+        per_frame.checked_mul(frames).ok_or_else(|| {
+            Failure::invalid(format!(
+                "{frames} frames of {joints} joints do not fit in memory"
+            ))
+        })
+    };
+    let (root_size, rotation_size, translation_size) =
+        (size(3)?, size(4 * joints)?, size(3 * joints)?);
     let roots = unsafe {
         out_slice(
             b.root_positions,
             b.root_positions_capacity,
-            3 * frames,
+            root_size,
             "root_positions",
         )
     }?;
@@ -129,7 +138,7 @@ pub(crate) unsafe fn pose_slices<'a>(
         out_slice(
             b.rotations,
             b.rotations_capacity,
-            4 * joints * frames,
+            rotation_size,
             "rotations",
         )
     }?;
@@ -140,7 +149,7 @@ pub(crate) unsafe fn pose_slices<'a>(
             out_slice(
                 b.translations,
                 b.translations_capacity,
-                3 * joints * frames,
+                translation_size,
                 "translations",
             )
         }?)

@@ -6,7 +6,8 @@ use std::ffi::{CString, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// What a call did. Every function returns one; on anything but `SINMDM_OK`,
-/// `sinmdm_last_error` says why, in words that name the argument, field or file.
+/// `sinmdm_last_error` says why, in words that name the argument, field or file. One kind of
+/// mistake always gets the same status, whichever function it is made at.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SinmdmStatus {
@@ -14,23 +15,28 @@ pub enum SinmdmStatus {
     SinmdmOk = 0,
     /// A pointer that must not be NULL was NULL.
     SinmdmNullArgument = 1,
-    /// An argument out of range or malformed (a count, an index, a string that is not UTF-8,
-    /// poses that do not fit the skeleton).
+    /// An argument outside its documented range, or malformed: a count, length, step count,
+    /// ramp, span, joint index, factor, share or thread count past its bound (`SINMDM_MAX_*`),
+    /// an unknown constant, a string that is not UTF-8, poses that do not fit the skeleton, a
+    /// handle used with another model, or a call its handle's state does not allow.
     SinmdmInvalidArgument = 2,
-    /// An output buffer too small; the message gives the size needed.
+    /// An output buffer too small; nothing was written and the message gives the size needed
+    /// (pass a NULL buffer to ask for it).
     SinmdmBufferTooSmall = 3,
     /// A joint name the skeleton does not have.
     SinmdmUnknownJoint = 4,
-    /// onnxruntime could not be loaded.
+    /// onnxruntime could not be found or loaded (the message lists where it was looked for).
     SinmdmRuntimeLibrary = 5,
     /// A model file that could not be opened or is not a valid model.
     SinmdmBadModel = 6,
-    /// A request the model refused (spans, lengths, counts), or a run that failed.
+    /// A valid request whose run failed inside onnxruntime (out of memory, say).
     SinmdmTaskFailed = 7,
     /// Reading or writing a file failed.
     SinmdmIo = 8,
     /// A bug in the library (a caught panic); the handle involved should be freed.
     SinmdmInternal = 9,
+    /// The progress callback asked to stop; the model (and a stepped run) can be used on.
+    SinmdmCancelled = 10,
 }
 
 /// A failed call: its status and message.
@@ -62,9 +68,13 @@ impl Failure {
 
 impl From<sinmdm::TaskError> for Failure {
     fn from(e: sinmdm::TaskError) -> Failure {
-        let status = match e {
-            sinmdm::TaskError::UnknownJoint { .. } => SinmdmStatus::SinmdmUnknownJoint,
-            _ => SinmdmStatus::SinmdmTaskFailed,
+        use sinmdm::TaskError;
+        let status = match &e {
+            TaskError::Model(model) => return Failure::from_model(model, e.to_string()),
+            TaskError::UnknownJoint { .. } => SinmdmStatus::SinmdmUnknownJoint,
+            TaskError::Cancelled { .. } => SinmdmStatus::SinmdmCancelled,
+            // Everything else is a request checked before it runs: an argument out of range.
+            _ => SinmdmStatus::SinmdmInvalidArgument,
         };
         Failure::new(status, e.to_string())
     }
@@ -76,13 +86,26 @@ impl From<sinmdm::motion::MotionError> for Failure {
     }
 }
 
-impl From<sinmdm::ModelError> for Failure {
-    fn from(e: sinmdm::ModelError) -> Failure {
+impl Failure {
+    /// The status of a model error: the library, a bad file, a bad argument, or a failed run.
+    fn from_model(e: &sinmdm::ModelError, message: String) -> Failure {
+        use sinmdm::ModelError;
         let status = match e {
-            sinmdm::ModelError::Runtime(_) => SinmdmStatus::SinmdmRuntimeLibrary,
+            ModelError::Runtime(_) => SinmdmStatus::SinmdmRuntimeLibrary,
+            ModelError::Threads(_)
+            | ModelError::FeatureRows { .. }
+            | ModelError::StepCount { .. } => SinmdmStatus::SinmdmInvalidArgument,
+            ModelError::Run { .. } => SinmdmStatus::SinmdmTaskFailed,
             _ => SinmdmStatus::SinmdmBadModel,
         };
-        Failure::new(status, e.to_string())
+        Failure::new(status, message)
+    }
+}
+
+impl From<sinmdm::ModelError> for Failure {
+    fn from(e: sinmdm::ModelError) -> Failure {
+        let message = e.to_string();
+        Failure::from_model(&e, message)
     }
 }
 
@@ -93,6 +116,24 @@ thread_local! {
 fn set_last_error(message: &str) {
     let text = CString::new(message.replace('\0', " ")).unwrap_or_default();
     LAST_ERROR.with(|slot| *slot.borrow_mut() = text);
+}
+
+/// Runs the body of an entry point that gives a handle through `out`: `*out` is set to NULL
+/// first (when `out` is not NULL), so a failed call never leaves a stale pointer there.
+///
+/// # Safety
+/// `out` is NULL or writable.
+pub(crate) unsafe fn guard_out<T>(
+    out: *mut *mut T,
+    body: impl FnOnce(*mut *mut T) -> Result<(), Failure>,
+) -> SinmdmStatus {
+    guard(|| {
+        if out.is_null() {
+            return Err(Failure::null("out"));
+        }
+        unsafe { *out = std::ptr::null_mut() };
+        body(out)
+    })
 }
 
 /// Runs an entry point's body: records its error, and turns a panic into a status.

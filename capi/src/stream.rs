@@ -2,15 +2,19 @@
 
 use sinmdm::{Stream, StreamCompose, StreamOptions};
 
-use crate::model::{SinmdmModel, model_arg};
+use crate::limits::SINMDM_MAX_SAMPLE_FRAMES;
+use crate::model::SinmdmModel;
 use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, pose_slices, poses_in, poses_out};
-use crate::run::{feet_arg, method_arg, steps_arg};
-use crate::status::{Failure, SinmdmStatus, guard};
+use crate::sampling::{feet_arg, method_arg, steps_arg};
+use crate::status::{Failure, SinmdmStatus, guard, guard_out};
+use crate::tasks::MAX_JOINT_INDICES;
 use crate::text::{give, handle, slice_arg};
 
 /// A stream (opaque): motion handed out a chunk at a time, forever, in flat memory.
 pub struct SinmdmStream {
     stream: Stream,
+    /// The model it was made on.
+    model: u64,
 }
 
 /// How a stream makes its motion; zeros give the defaults.
@@ -48,37 +52,47 @@ pub unsafe extern "C" fn sinmdm_stream_new(
     options: *const SinmdmStreamOptions,
     out: *mut *mut SinmdmStream,
 ) -> SinmdmStatus {
-    guard(|| {
-        let model = unsafe { model_arg(model) }?;
-        let o = *unsafe { handle(options.cast_mut(), "options") }?;
-        if out.is_null() {
-            return Err(Failure::null("out"));
-        }
-        let joints =
-            unsafe { slice_arg(o.compose_joints, o.compose_joint_count, "compose_joints") }?;
-        let compose = (!joints.is_empty() || o.compose_root != 0).then(|| StreamCompose {
-            joints: joints.to_vec(),
-            root: o.compose_root != 0,
-        });
-        let options = StreamOptions {
-            seed: o.seed,
-            steps: steps_arg(o.steps),
-            block_frames: (o.block_frames > 0).then_some(o.block_frames as usize),
-            feet: feet_arg(o.feet)?,
-            compose,
-            method: method_arg(o.method, o.eta)?,
-            ..StreamOptions::default()
-        };
-        let stream = Stream::new(model.metadata(), options)?;
-        unsafe { give(out, SinmdmStream { stream }) };
-        Ok(())
-    })
+    unsafe {
+        guard_out(out, |out| {
+            let model = handle(model.cast_mut(), "model")?;
+            let o = *handle(options.cast_mut(), "options")?;
+            if o.compose_joint_count > MAX_JOINT_INDICES {
+                return Err(Failure::invalid(format!(
+                    "compose_joint_count is {}; at most {MAX_JOINT_INDICES} joint indices are taken",
+                    o.compose_joint_count
+                )));
+            }
+            let joints = slice_arg(o.compose_joints, o.compose_joint_count, "compose_joints")?;
+            let compose = (!joints.is_empty() || o.compose_root != 0).then(|| StreamCompose {
+                joints: joints.to_vec(),
+                root: o.compose_root != 0,
+            });
+            let options = StreamOptions {
+                seed: o.seed,
+                steps: steps_arg(o.steps),
+                block_frames: (o.block_frames > 0).then_some(o.block_frames as usize),
+                feet: feet_arg(o.feet)?,
+                compose,
+                method: method_arg(o.method, o.eta)?,
+                ..StreamOptions::default()
+            };
+            let stream = Stream::new(model.model.metadata(), options)?;
+            give(
+                out,
+                SinmdmStream {
+                    stream,
+                    model: model.id,
+                },
+            );
+            Ok(())
+        })
+    }
 }
 
 /// Supplies poses for the frames after the last supplied ones (the first call supplies frame
-/// 0 on), for a stream with composed joints. Poses supplied at least
-/// `2 x block_frames + 10` frames ahead of what has been handed out make the stream's motion
-/// independent of chunk sizes.
+/// 0 on), for a stream made with composed joints (`SINMDM_INVALID_ARGUMENT` for one without).
+/// Poses supplied at least `2 x block_frames + 10` frames ahead of what has been handed out
+/// make the stream's motion independent of chunk sizes.
 ///
 /// # Safety
 /// `stream` and `model` are live handles (the stream's model); `poses` as its documentation says.
@@ -90,16 +104,19 @@ pub unsafe extern "C" fn sinmdm_stream_supply(
 ) -> SinmdmStatus {
     guard(|| {
         let stream = unsafe { handle(stream, "stream") }?;
-        let model = unsafe { model_arg(model) }?;
+        let model = unsafe { handle(model.cast_mut(), "model") }?;
+        model.check_same(stream.model, "stream")?;
         stream
             .stream
-            .supply(&unsafe { poses_in(model, poses, "poses") }?)?;
+            .supply(&unsafe { poses_in(&model.model, poses, "poses") }?)?;
         Ok(())
     })
 }
 
-/// Makes the next `frames` frames on `model` (the model the stream was made with) and writes
-/// their poses into `buffers`. The motion is the same whatever chunk sizes are asked for.
+/// Makes the next `frames` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) on `model` (the model
+/// the stream was made with) and writes their poses into `buffers`. The motion is the same
+/// whatever chunk sizes are asked for. It runs the network only for frames not yet prepared
+/// by `sinmdm_stream_step`.
 ///
 /// # Safety
 /// `stream` and `model` are live handles; `buffers` as its documentation says.
@@ -113,14 +130,60 @@ pub unsafe extern "C" fn sinmdm_stream_next(
     guard(|| {
         let stream = unsafe { handle(stream, "stream") }?;
         let model = unsafe { handle(model, "model") }?;
+        model.check_same(stream.model, "stream")?;
+        if frames > SINMDM_MAX_SAMPLE_FRAMES {
+            return Err(Failure::invalid(format!(
+                "frames is {frames}; one chunk holds at most {SINMDM_MAX_SAMPLE_FRAMES}"
+            )));
+        }
         let joints = model.model.skeleton().len();
         // Check the buffers before making anything, so a bad one loses no motion.
         unsafe { pose_slices(buffers, frames, joints) }?;
-        if model.model.metadata() != stream.stream.metadata() {
-            return Err(Failure::invalid("the stream was made with another model"));
-        }
         let chunk = stream.stream.next(&mut model.model, frames)?;
         unsafe { poses_out(&chunk.poses(), joints, buffers) }
+    })
+}
+
+/// Prepares frames ahead on `model` (the stream's), spending at most `max_steps` denoising
+/// steps: while fewer than `ahead` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) are ready, the
+/// next block is made a step at a time. A game calls it each frame with a small `max_steps`
+/// and reads with `sinmdm_stream_next`, which then never waits when enough frames are ready;
+/// the motion is the same bits as without preparing. `ready` (if not NULL) gets the frames
+/// ready now; `done` and `total` (if not NULL) the steps of the block in the making (0 of 0
+/// when none is).
+///
+/// # Safety
+/// `stream` and `model` are live handles; `ready`, `done` and `total` NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_stream_step(
+    stream: *mut SinmdmStream,
+    model: *mut SinmdmModel,
+    max_steps: usize,
+    ahead: usize,
+    ready: *mut usize,
+    done: *mut usize,
+    total: *mut usize,
+) -> SinmdmStatus {
+    guard(|| {
+        let stream = unsafe { handle(stream, "stream") }?;
+        let model = unsafe { handle(model, "model") }?;
+        model.check_same(stream.model, "stream")?;
+        if ahead > SINMDM_MAX_SAMPLE_FRAMES {
+            return Err(Failure::invalid(format!(
+                "ahead is {ahead}; at most {SINMDM_MAX_SAMPLE_FRAMES} frames are prepared"
+            )));
+        }
+        let progress = stream.stream.prepare(&mut model.model, max_steps, ahead)?;
+        for (slot, value) in [
+            (ready, stream.stream.ready_frames()),
+            (done, progress.done),
+            (total, progress.total),
+        ] {
+            if !slot.is_null() {
+                unsafe { *slot = value };
+            }
+        }
+        Ok(())
     })
 }
 

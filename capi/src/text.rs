@@ -48,6 +48,30 @@ pub(crate) unsafe fn copy_str(
     Ok(())
 }
 
+/// Copies `values` into the caller's array `buffer` of `capacity` values; `needed` (if not
+/// NULL) gets their count. A NULL `buffer` only asks for the count; a short one writes nothing
+/// and fails with `SINMDM_BUFFER_TOO_SMALL`.
+///
+/// # Safety
+/// `buffer` is NULL or writable for `capacity` values; `needed` is NULL or writable.
+pub(crate) unsafe fn copy_array<T: Copy>(
+    values: &[T],
+    buffer: *mut T,
+    capacity: usize,
+    needed: *mut usize,
+    argument: &str,
+) -> Result<(), Failure> {
+    if !needed.is_null() {
+        unsafe { *needed = values.len() };
+    }
+    if buffer.is_null() {
+        return Ok(());
+    }
+    let out = unsafe { out_slice(buffer, capacity, values.len(), argument) }?;
+    out.copy_from_slice(values);
+    Ok(())
+}
+
 /// A caller's array of `count` values as a slice (empty for a NULL pointer with count 0).
 ///
 /// # Safety
@@ -62,6 +86,11 @@ pub(crate) unsafe fn slice_arg<'a, T>(
     }
     if data.is_null() {
         return Err(Failure::null(argument));
+    }
+    if count > isize::MAX as usize / std::mem::size_of::<T>().max(1) {
+        return Err(Failure::invalid(format!(
+            "{argument} is said to hold {count} values, more than memory can"
+        )));
     }
     Ok(unsafe { std::slice::from_raw_parts(data, count) })
 }

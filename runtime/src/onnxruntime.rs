@@ -8,8 +8,9 @@
 //! 4. next to the library that holds this code, when that is not the executable (the C ABI's
 //!    `sinmdm_c` inside an engine's plugin folder);
 //! 5. by bare name through the system loader's own search (`LD_LIBRARY_PATH`, the `ldconfig`
-//!    cache, `DYLD_LIBRARY_PATH`, or on Windows its DLL search order, which reaches System32:
-//!    Windows 10 and 11 keep an older onnxruntime.dll there that is refused as too old);
+//!    cache, `DYLD_LIBRARY_PATH`, or on Windows its DLL search order, which reaches System32,
+//!    where Windows may keep an onnxruntime.dll of its own and of another release: a program
+//!    ships its own next to its executable so that it is found first);
 //! 6. a developer checkout's `.venv` (made by the project's set-up script), above the working
 //!    directory or the executable.
 //!

@@ -26,7 +26,7 @@ use crate::limits::MAX_SAMPLE_FRAMES;
 use crate::model_file::ModelMetadata;
 use crate::motion::feet::{Anchor, Feet, Kept, PlantOptions, plant_feet};
 use crate::motion::math::{Mat3, Vec3};
-use crate::motion::{FeatureMatrix, LocalMotion, MotionError, Pose, decode, poses};
+use crate::motion::{FeatureMatrix, LocalMotion, Pose, decode, poses};
 use crate::tasks::mask::soft_mask;
 use crate::tasks::{INBETWEEN_RAMP, Progress, TaskError};
 use blocks::{BlockSizes, block_seed};
@@ -250,8 +250,14 @@ impl Stream {
 
     /// Poses for the frames after the last supplied one (the first call supplies frame 0), for
     /// [`StreamOptions::compose`]. Frames without a supplied pose are generated freely.
-    pub fn supply(&mut self, poses: &[Pose]) -> Result<(), MotionError> {
-        self.guide.supply(&self.metadata, poses)
+    pub fn supply(&mut self, poses: &[Pose]) -> Result<(), TaskError> {
+        if self.compose_rows.is_empty() {
+            return Err(TaskError::Stream(
+                "this stream takes no supplied poses: make it with joints or the root to compose"
+                    .into(),
+            ));
+        }
+        Ok(self.guide.supply(&self.metadata, poses)?)
     }
 
     /// The next `frames` frames, making as many blocks as that needs on `denoiser` (the model

@@ -1,0 +1,85 @@
+//! A generated batch and what a host reads from it.
+
+use sinmdm::Generated;
+
+use crate::poses::{SinmdmPoseBuffers, poses_out};
+use crate::status::{Failure, SinmdmStatus, guard};
+use crate::text::handle;
+
+/// A generated batch (opaque).
+pub struct SinmdmResult {
+    pub(crate) generated: Generated,
+}
+
+/// Writes the number of samples in the batch to `count`.
+///
+/// # Safety
+/// `result` is a live handle; `count` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_result_count(
+    result: *const SinmdmResult,
+    count: *mut usize,
+) -> SinmdmStatus {
+    guard(|| {
+        let result = unsafe { handle(result.cast_mut(), "result") }?;
+        *unsafe { handle(count, "count") }? = result.generated.count();
+        Ok(())
+    })
+}
+
+/// Writes the frames per sample to `frames`.
+///
+/// # Safety
+/// `result` is a live handle; `frames` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_result_frames(
+    result: *const SinmdmResult,
+    frames: *mut usize,
+) -> SinmdmStatus {
+    guard(|| {
+        let result = unsafe { handle(result.cast_mut(), "result") }?;
+        *unsafe { handle(frames, "frames") }? = result.generated.frames();
+        Ok(())
+    })
+}
+
+/// Writes sample `sample`'s poses (feet as the sampling asked) into `buffers`.
+///
+/// # Safety
+/// `result` is a live handle; `buffers` as its documentation says.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_result_poses(
+    result: *const SinmdmResult,
+    sample: usize,
+    buffers: *const SinmdmPoseBuffers,
+) -> SinmdmStatus {
+    guard(|| {
+        let result = unsafe { handle(result.cast_mut(), "result") }?;
+        let count = result.generated.count();
+        if sample >= count {
+            return Err(Failure::invalid(format!(
+                "sample {sample} is not in the batch of {count}"
+            )));
+        }
+        let joints = result.generated.layout().skeleton.len();
+        let frames = result.generated.frames();
+        // Check the buffers before decoding anything.
+        unsafe { crate::poses::pose_slices(buffers, frames, joints) }?;
+        let poses = result
+            .generated
+            .poses(sample)
+            .map_err(|e| Failure::new(SinmdmStatus::SinmdmInvalidArgument, e.to_string()))?;
+        unsafe { poses_out(&poses, joints, buffers) }
+    })
+}
+
+/// Frees a batch (NULL is fine).
+///
+/// # Safety
+/// `result` is NULL or a handle from this library, not used again.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_result_free(result: *mut SinmdmResult) {
+    if !result.is_null() {
+        drop(unsafe { Box::from_raw(result) });
+    }
+}
