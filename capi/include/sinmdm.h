@@ -107,7 +107,7 @@
  The largest model `sinmdm_model_open_bytes` takes, in bytes (protobuf's 2 GiB limit on an
  ONNX file).
  */
-#define SINMDM_MAX_MODEL_BYTES ((1 << 31) - 1)
+#define SINMDM_MAX_MODEL_BYTES 2147483647
 
 /*
  A progress callback's answer: go on.

@@ -17,7 +17,7 @@ pub const SINMDM_MAX_RUN_VALUES: usize = 1 << 28;
 pub const SINMDM_MAX_THREADS: usize = 1024;
 /// The largest model `sinmdm_model_open_bytes` takes, in bytes (protobuf's 2 GiB limit on an
 /// ONNX file).
-pub const SINMDM_MAX_MODEL_BYTES: usize = (1 << 31) - 1;
+pub const SINMDM_MAX_MODEL_BYTES: usize = 2_147_483_647;
 
 #[cfg(test)]
 mod tests {
