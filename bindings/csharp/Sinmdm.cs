@@ -1,22 +1,52 @@
 // sinmdm for C# (Unity, Godot .NET, any .NET or Mono program): P/Invoke over the C ABI
-// (capi/include/sinmdm.h). Drop this file into a Unity project's Assets folder and the shared
-// libraries (sinmdm_c and onnxruntime) into Assets/Plugins; see the README's Embedding section.
+// (capi/include/sinmdm.h). In Unity, install the package that scripts/unity_package.sh builds
+// (this file, the native libraries and an assembly definition); elsewhere compile this file
+// with your program and put sinmdm_c and onnxruntime where the loader finds them.
 //
-// Every handle is IDisposable; a failed call throws SinmdmException with the library's message.
-// A model and its streams must be used by one thread at a time; different models may run on
+// Every handle is a SafeHandle: Dispose frees it, and a finalizer frees one that was never
+// disposed. A failed call throws SinmdmException with the library's status and message
+// (SinmdmCancelledException when a progress callback stopped it). A model and the runs and
+// streams made on it must be used by one thread at a time; different models may run on
 // different threads at once. Poses are in the model file's frame (right-handed, its up axis,
 // its units); Coordinates converts them to Unity's (left-handed, Y-up, metres).
 using System;
 using System.Runtime.InteropServices;
 using System.Text;
 
+#if !UNITY_5_3_OR_NEWER
+namespace AOT
+{
+    /// <summary>Marks a static method called from native code (Unity defines this attribute;
+    /// IL2CPP needs it to make the method callable from C).</summary>
+    [AttributeUsage(AttributeTargets.Method)]
+    public sealed class MonoPInvokeCallbackAttribute : Attribute
+    {
+        public MonoPInvokeCallbackAttribute(Type type) { }
+    }
+}
+#endif
+
 namespace Sinmdm
 {
     /// <summary>A failed call: the status code and the library's message.</summary>
     public class SinmdmException : Exception
     {
-        public readonly int Status;
-        public SinmdmException(int status, string message) : base(message) { Status = status; }
+        public readonly Status Status;
+        public SinmdmException(Status status, string message, Exception inner = null) : base(message, inner) { Status = status; }
+    }
+
+    /// <summary>A progress callback stopped the call (it returned false or threw; a thrown
+    /// exception is the InnerException).</summary>
+    public sealed class SinmdmCancelledException : SinmdmException
+    {
+        public SinmdmCancelledException(string message, Exception inner) : base(Status.Cancelled, message, inner) { }
+    }
+
+    /// <summary>What a call did (SinmdmStatus).</summary>
+    public enum Status
+    {
+        Ok = 0, NullArgument = 1, InvalidArgument = 2, BufferTooSmall = 3, UnknownJoint = 4,
+        RuntimeLibrary = 5, BadModel = 6, TaskFailed = 7, Io = 8, Internal = 9, Cancelled = 10,
     }
 
     /// <summary>What is done to the feet of the poses handed out.</summary>
@@ -34,6 +64,28 @@ namespace Sinmdm
         public UIntPtr ClipFrames, ReceptiveField, DiffusionSteps;
     }
 
+    /// <summary>How a task samples: the seed, the crowd size, the steps, the feet and the
+    /// update rule. The same model, sampling and arguments give the same poses everywhere.</summary>
+    public struct Sampling
+    {
+        public ulong Seed;
+        public int Count;
+        public uint Steps;
+        public Feet Feet;
+        public Method Method;
+        public double Eta;
+
+        /// <summary>One sample with the default steps, planted feet, ancestral sampling.</summary>
+        public static Sampling Default(ulong seed) =>
+            new Sampling { Seed = seed, Count = 1, Steps = Runtime.DefaultSteps, Feet = Feet.Planted, Method = Method.Ancestral };
+
+        internal Native.Sampling ToNative()
+        {
+            if (Count < 1) throw new ArgumentOutOfRangeException(nameof(Count), Count, "a batch has at least one sample");
+            return new Native.Sampling { Seed = Seed, Count = (uint)Count, Steps = Steps, Feet = (uint)Feet, Method = (uint)Method, Eta = Eta };
+        }
+    }
+
     /// <summary>Poses as flat arrays: root position (3 per frame), local rotations x,y,z,w
     /// (4 per joint and frame), local translations (3 per joint and frame).</summary>
     public sealed class Poses
@@ -42,6 +94,8 @@ namespace Sinmdm
         public readonly float[] RootPositions, Rotations, Translations;
         public Poses(int frames, int joints)
         {
+            if (frames < 0) throw new ArgumentOutOfRangeException(nameof(frames));
+            if (joints < 1) throw new ArgumentOutOfRangeException(nameof(joints));
             Frames = frames; Joints = joints;
             RootPositions = new float[3 * frames];
             Rotations = new float[4 * joints * frames];
@@ -78,45 +132,76 @@ namespace Sinmdm
             public uint Method; public double Eta;
         }
 
+        [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
+        internal delegate int ProgressFn(IntPtr userdata, UIntPtr done, UIntPtr total);
+
         [DllImport(Lib)] internal static extern IntPtr sinmdm_last_error();
+        [DllImport(Lib)] internal static extern UIntPtr sinmdm_live_handles();
         [DllImport(Lib)] internal static extern int sinmdm_load_onnxruntime(byte[] path);
-        [DllImport(Lib)] internal static extern int sinmdm_model_open(byte[] path, uint threads, out IntPtr model);
-        [DllImport(Lib)] internal static extern int sinmdm_model_open_bytes(byte[] bytes, UIntPtr length, uint threads, out IntPtr model);
+        [DllImport(Lib)] internal static extern int sinmdm_model_open(byte[] path, uint threads, out ModelHandle model);
+        [DllImport(Lib)] internal static extern int sinmdm_model_open_bytes(byte[] bytes, UIntPtr length, uint threads, out ModelHandle model);
         [DllImport(Lib)] internal static extern void sinmdm_model_free(IntPtr model);
-        [DllImport(Lib)] internal static extern int sinmdm_model_info(IntPtr model, out ModelInfo info);
-        [DllImport(Lib)] internal static extern int sinmdm_model_joint_name(IntPtr model, UIntPtr joint, byte[] buffer, UIntPtr capacity, out UIntPtr needed);
-        [DllImport(Lib)] internal static extern int sinmdm_model_find_joint(IntPtr model, byte[] name, out UIntPtr index);
-        [DllImport(Lib)] internal static extern int sinmdm_generate(IntPtr model, ref Sampling sampling, UIntPtr frames, out IntPtr result);
-        [DllImport(Lib)] internal static extern int sinmdm_inbetween(IntPtr model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out IntPtr result);
-        [DllImport(Lib)] internal static extern int sinmdm_expand(IntPtr model, ref Sampling sampling, ref PosesIn reference, UIntPtr prefix, UIntPtr suffix, UIntPtr ramp, out IntPtr result);
-        [DllImport(Lib)] internal static extern int sinmdm_compose(IntPtr model, ref Sampling sampling, ref PosesIn reference, UIntPtr[] joints, UIntPtr jointCount, int root, Span[] spans, UIntPtr spanCount, UIntPtr ramp, out IntPtr result);
-        [DllImport(Lib)] internal static extern int sinmdm_harmonize(IntPtr model, ref Sampling sampling, ref PosesIn content, UIntPtr factor, double freeShare, out IntPtr result);
-        [DllImport(Lib)] internal static extern int sinmdm_stream_supply(IntPtr stream, IntPtr model, ref PosesIn poses);
-        [DllImport(Lib)] internal static extern int sinmdm_result_count(IntPtr result, out UIntPtr count);
-        [DllImport(Lib)] internal static extern int sinmdm_result_frames(IntPtr result, out UIntPtr frames);
-        [DllImport(Lib)] internal static extern int sinmdm_result_poses(IntPtr result, UIntPtr sample, ref PoseBuffers buffers);
+        [DllImport(Lib)] internal static extern int sinmdm_model_info(ModelHandle model, out ModelInfo info);
+        [DllImport(Lib)] internal static extern int sinmdm_model_set_progress(ModelHandle model, ProgressFn callback, IntPtr userdata);
+        [DllImport(Lib)] internal static extern int sinmdm_model_joint_name(ModelHandle model, UIntPtr joint, byte[] buffer, UIntPtr capacity, out UIntPtr needed);
+        [DllImport(Lib)] internal static extern int sinmdm_model_find_joint(ModelHandle model, byte[] name, out UIntPtr index);
+        [DllImport(Lib)] internal static extern int sinmdm_model_parents(ModelHandle model, int[] parents, UIntPtr capacity, out UIntPtr needed);
+        [DllImport(Lib)] internal static extern int sinmdm_generate(ModelHandle model, ref Sampling sampling, UIntPtr frames, out ResultHandle result);
+        [DllImport(Lib)] internal static extern int sinmdm_generate_begin(ModelHandle model, ref Sampling sampling, UIntPtr frames, out RunHandle run);
+        [DllImport(Lib)] internal static extern int sinmdm_inbetween(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out ResultHandle result);
+        [DllImport(Lib)] internal static extern int sinmdm_inbetween_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out RunHandle run);
+        [DllImport(Lib)] internal static extern int sinmdm_expand(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr prefix, UIntPtr suffix, UIntPtr ramp, out ResultHandle result);
+        [DllImport(Lib)] internal static extern int sinmdm_expand_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr prefix, UIntPtr suffix, UIntPtr ramp, out RunHandle run);
+        [DllImport(Lib)] internal static extern int sinmdm_compose(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr[] joints, UIntPtr jointCount, int root, Span[] spans, UIntPtr spanCount, UIntPtr ramp, out ResultHandle result);
+        [DllImport(Lib)] internal static extern int sinmdm_compose_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr[] joints, UIntPtr jointCount, int root, Span[] spans, UIntPtr spanCount, UIntPtr ramp, out RunHandle run);
+        [DllImport(Lib)] internal static extern int sinmdm_harmonize(ModelHandle model, ref Sampling sampling, ref PosesIn content, UIntPtr factor, double freeShare, out ResultHandle result);
+        [DllImport(Lib)] internal static extern int sinmdm_harmonize_begin(ModelHandle model, ref Sampling sampling, ref PosesIn content, UIntPtr factor, double freeShare, out RunHandle run);
+        [DllImport(Lib)] internal static extern int sinmdm_run_step(RunHandle run, ModelHandle model, UIntPtr maxSteps, out UIntPtr done, out UIntPtr total);
+        [DllImport(Lib)] internal static extern int sinmdm_run_finish(RunHandle run, out ResultHandle result);
+        [DllImport(Lib)] internal static extern void sinmdm_run_free(IntPtr run);
+        [DllImport(Lib)] internal static extern int sinmdm_result_count(ResultHandle result, out UIntPtr count);
+        [DllImport(Lib)] internal static extern int sinmdm_result_frames(ResultHandle result, out UIntPtr frames);
+        [DllImport(Lib)] internal static extern int sinmdm_result_poses(ResultHandle result, UIntPtr sample, ref PoseBuffers buffers);
         [DllImport(Lib)] internal static extern void sinmdm_result_free(IntPtr result);
-        [DllImport(Lib)] internal static extern int sinmdm_stream_new(IntPtr model, ref StreamOptions options, out IntPtr stream);
-        [DllImport(Lib)] internal static extern int sinmdm_stream_next(IntPtr stream, IntPtr model, UIntPtr frames, ref PoseBuffers buffers);
+        [DllImport(Lib)] internal static extern int sinmdm_stream_new(ModelHandle model, ref StreamOptions options, out StreamHandle stream);
+        [DllImport(Lib)] internal static extern int sinmdm_stream_supply(StreamHandle stream, ModelHandle model, ref PosesIn poses);
+        [DllImport(Lib)] internal static extern int sinmdm_stream_next(StreamHandle stream, ModelHandle model, UIntPtr frames, ref PoseBuffers buffers);
+        [DllImport(Lib)] internal static extern int sinmdm_stream_step(StreamHandle stream, ModelHandle model, UIntPtr maxSteps, UIntPtr ahead, out UIntPtr ready, out UIntPtr done, out UIntPtr total);
         [DllImport(Lib)] internal static extern void sinmdm_stream_free(IntPtr stream);
-        [DllImport(Lib)] internal static extern int sinmdm_write_bvh(IntPtr model, ref PosesIn poses, byte[] path);
+        [DllImport(Lib)] internal static extern int sinmdm_write_bvh(ModelHandle model, ref PosesIn poses, byte[] path);
 
-        internal static byte[] Utf8(string text) => Encoding.UTF8.GetBytes(text + "\0");
-
-        internal static void Check(int status)
+        internal static byte[] Utf8(string text)
         {
-            if (status == 0) return;
+            if (text == null) throw new ArgumentNullException(nameof(text));
+            return Encoding.UTF8.GetBytes(text + "\0");
+        }
+
+        internal static string LastError()
+        {
             IntPtr message = sinmdm_last_error();
             int length = 0;
             while (Marshal.ReadByte(message, length) != 0) length++;
             var bytes = new byte[length];
             Marshal.Copy(message, bytes, 0, length);
-            throw new SinmdmException(status, Encoding.UTF8.GetString(bytes));
+            return Encoding.UTF8.GetString(bytes);
+        }
+
+        internal static void Check(int status)
+        {
+            if (status == 0) return;
+            throw new SinmdmException((Status)status, LastError());
+        }
+
+        internal static UIntPtr Size(int value, string name)
+        {
+            if (value < 0) throw new ArgumentOutOfRangeException(name, value, "must not be negative");
+            return (UIntPtr)(ulong)value;
         }
 
         /// Pins the arrays of `poses` for the duration of `use`.
         internal static T WithBuffers<T>(Poses poses, Func<PoseBuffers, T> use)
         {
+            if (poses == null) throw new ArgumentNullException(nameof(poses));
             var root = GCHandle.Alloc(poses.RootPositions, GCHandleType.Pinned);
             var rot = GCHandle.Alloc(poses.Rotations, GCHandleType.Pinned);
             var trans = GCHandle.Alloc(poses.Translations, GCHandleType.Pinned);
@@ -137,10 +222,59 @@ namespace Sinmdm
             {
                 Frames = (UIntPtr)poses.Frames, Root = b.Root, Rotations = b.Rotations, Translations = b.Translations,
             }));
+
+        /// Start, end pairs as spans; an odd count or a negative frame is refused.
+        internal static Span[] Spans(int[] pairs, string name)
+        {
+            if (pairs == null) return new Span[0];
+            if (pairs.Length % 2 != 0)
+                throw new ArgumentException("spans are start, end pairs: an even count of numbers, got " + pairs.Length, name);
+            var spans = new Span[pairs.Length / 2];
+            for (int i = 0; i < spans.Length; i++)
+                spans[i] = new Span { Start = Size(pairs[2 * i], name), End = Size(pairs[2 * i + 1], name) };
+            return spans;
+        }
+
+        internal static UIntPtr[] Indices(int[] joints, string name)
+        {
+            if (joints == null) return new UIntPtr[0];
+            return Array.ConvertAll(joints, j => Size(j, name));
+        }
     }
 
-    /// <summary>The onnxruntime shared library to use (call before opening a model, or let the
-    /// library find it through ORT_DYLIB_PATH).</summary>
+    /// <summary>The native handle of a model; freed by Dispose or, if forgotten, by the finalizer.</summary>
+    public sealed class ModelHandle : SafeHandle
+    {
+        public ModelHandle() : base(IntPtr.Zero, true) { }
+        public override bool IsInvalid => handle == IntPtr.Zero;
+        protected override bool ReleaseHandle() { Native.sinmdm_model_free(handle); return true; }
+    }
+
+    /// <summary>The native handle of a run.</summary>
+    public sealed class RunHandle : SafeHandle
+    {
+        public RunHandle() : base(IntPtr.Zero, true) { }
+        public override bool IsInvalid => handle == IntPtr.Zero;
+        protected override bool ReleaseHandle() { Native.sinmdm_run_free(handle); return true; }
+    }
+
+    /// <summary>The native handle of a batch.</summary>
+    public sealed class ResultHandle : SafeHandle
+    {
+        public ResultHandle() : base(IntPtr.Zero, true) { }
+        public override bool IsInvalid => handle == IntPtr.Zero;
+        protected override bool ReleaseHandle() { Native.sinmdm_result_free(handle); return true; }
+    }
+
+    /// <summary>The native handle of a stream.</summary>
+    public sealed class StreamHandle : SafeHandle
+    {
+        public StreamHandle() : base(IntPtr.Zero, true) { }
+        public override bool IsInvalid => handle == IntPtr.Zero;
+        protected override bool ReleaseHandle() { Native.sinmdm_stream_free(handle); return true; }
+    }
+
+    /// <summary>The onnxruntime shared library and the library's own bookkeeping.</summary>
     public static class Runtime
     {
         /// <summary>Respaced sampling steps used unless told otherwise (SINMDM_DEFAULT_STEPS).</summary>
@@ -150,41 +284,101 @@ namespace Sinmdm
         /// slow, the reference quality). 0 gives DefaultSteps.</summary>
         public const uint AllSteps = 4294967295;
 
+        /// <summary>Loads onnxruntime from `path`, or (null) searches for it: ORT_DYLIB_PATH, next
+        /// to the executable, next to sinmdm_c, the system's library path.</summary>
         public static void Load(string path) => Native.Check(Native.sinmdm_load_onnxruntime(path == null ? null : Native.Utf8(path)));
+
+        /// <summary>Native handles alive (models, runs, results, streams): for leak checks.</summary>
+        public static long LiveHandles => (long)(ulong)Native.sinmdm_live_handles();
     }
 
     /// <summary>An open model.</summary>
     public sealed class Model : IDisposable
     {
-        internal IntPtr Handle;
+        internal readonly ModelHandle Handle;
         public readonly ModelInfo Info;
         public int Joints => (int)Info.Joints;
 
-        Model(IntPtr handle)
+        // The progress callback: a static thunk (IL2CPP can call only static methods marked
+        // MonoPInvokeCallback) that finds the model's managed callback through a GCHandle.
+        static readonly Native.ProgressFn Thunk = ProgressThunk;
+        Func<int, int, bool> progress;
+        Exception progressError;
+        GCHandle self;
+
+        Model(ModelHandle handle)
         {
             Handle = handle;
             Native.Check(Native.sinmdm_model_info(handle, out Info));
         }
 
-        /// <summary>Opens a model file; threads 0 uses every core.</summary>
+        /// <summary>Opens a model file; `threads` is how many samples of a batch run at once (0:
+        /// every core); it changes speed, never values.</summary>
         public static Model Open(string path, uint threads = 0)
         {
-            Native.Check(Native.sinmdm_model_open(Native.Utf8(path), threads, out IntPtr handle));
+            int status = Native.sinmdm_model_open(Native.Utf8(path), threads, out ModelHandle handle);
+            if (status != 0) { handle.Dispose(); Native.Check(status); }
             return new Model(handle);
         }
 
-        /// <summary>Opens a model from bytes (a Unity TextAsset's bytes, say).</summary>
+        /// <summary>Opens a model from bytes (a Unity TextAsset's bytes, say); they are copied.</summary>
         public static Model FromBytes(byte[] bytes, uint threads = 0)
         {
-            Native.Check(Native.sinmdm_model_open_bytes(bytes, (UIntPtr)bytes.Length, threads, out IntPtr handle));
+            if (bytes == null) throw new ArgumentNullException(nameof(bytes));
+            int status = Native.sinmdm_model_open_bytes(bytes, (UIntPtr)bytes.Length, threads, out ModelHandle handle);
+            if (status != 0) { handle.Dispose(); Native.Check(status); }
             return new Model(handle);
+        }
+
+        [AOT.MonoPInvokeCallback(typeof(Native.ProgressFn))]
+        static int ProgressThunk(IntPtr userdata, UIntPtr done, UIntPtr total)
+        {
+            // Nothing may unwind into native code: any exception cancels the run and is kept.
+            Model model = null;
+            try
+            {
+                model = (Model)GCHandle.FromIntPtr(userdata).Target;
+                return model.progress((int)done, (int)total) ? 0 : 1;
+            }
+            catch (Exception e)
+            {
+                if (model != null) model.progressError = e;
+                return 1;
+            }
+        }
+
+        /// <summary>Calls `callback(done, total)` after each denoising step of the blocking
+        /// tasks on this model; returning false (or throwing) stops the task, which then throws
+        /// SinmdmCancelledException (the model stays usable). Null removes it.</summary>
+        public void SetProgress(Func<int, int, bool> callback)
+        {
+            progress = callback;
+            if (callback == null)
+            {
+                Native.Check(Native.sinmdm_model_set_progress(Handle, null, IntPtr.Zero));
+                if (self.IsAllocated) self.Free();
+                return;
+            }
+            if (!self.IsAllocated) self = GCHandle.Alloc(this, GCHandleType.Weak);
+            Native.Check(Native.sinmdm_model_set_progress(Handle, Thunk, GCHandle.ToIntPtr(self)));
+        }
+
+        /// <summary>Throws for a failed task, as a cancellation when the callback stopped it.</summary>
+        void CheckTask(int status)
+        {
+            Exception thrown = progressError;
+            progressError = null;
+            if (status == (int)Status.Cancelled)
+                throw new SinmdmCancelledException(Native.LastError(), thrown);
+            Native.Check(status);
         }
 
         public string JointName(int joint)
         {
-            Native.sinmdm_model_joint_name(Handle, (UIntPtr)joint, null, UIntPtr.Zero, out UIntPtr needed);
+            var index = Native.Size(joint, nameof(joint));
+            Native.Check(Native.sinmdm_model_joint_name(Handle, index, null, UIntPtr.Zero, out UIntPtr needed));
             var buffer = new byte[(int)needed];
-            Native.Check(Native.sinmdm_model_joint_name(Handle, (UIntPtr)joint, buffer, needed, out needed));
+            Native.Check(Native.sinmdm_model_joint_name(Handle, index, buffer, needed, out needed));
             return Encoding.UTF8.GetString(buffer, 0, buffer.Length - 1);
         }
 
@@ -194,94 +388,184 @@ namespace Sinmdm
             return (int)index;
         }
 
-        /// <summary>New motion: `count` samples of `frames` frames.</summary>
-        public Result Generate(int frames, ulong seed, int count = 1, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted,
-                               Method method = Method.Ancestral, double eta = 0.0)
+        /// <summary>Every joint's parent index (-1 for the root).</summary>
+        public int[] Parents()
         {
-            var sampling = new Native.Sampling { Seed = seed, Count = (uint)count, Steps = steps, Feet = (uint)feet,
-                                                 Method = (uint)method, Eta = eta };
-            Native.Check(Native.sinmdm_generate(Handle, ref sampling, (UIntPtr)frames, out IntPtr result));
-            return new Result(result, Joints);
+            Native.Check(Native.sinmdm_model_parents(Handle, null, UIntPtr.Zero, out UIntPtr needed));
+            var parents = new int[(int)needed];
+            Native.Check(Native.sinmdm_model_parents(Handle, parents, needed, out needed));
+            return parents;
+        }
+
+        Result Blocking(int status, ResultHandle handle)
+        {
+            if (status != 0) { handle.Dispose(); CheckTask(status); }
+            return new Result(handle, Joints);
+        }
+
+        /// <summary>New motion: `sampling.Count` samples of `frames` frames.</summary>
+        public Result Generate(int frames, Sampling sampling)
+        {
+            var native = sampling.ToNative();
+            int status = Native.sinmdm_generate(Handle, ref native, Native.Size(frames, nameof(frames)), out ResultHandle result);
+            return Blocking(status, result);
+        }
+
+        /// <summary>New motion (the common case in one line).</summary>
+        public Result Generate(int frames, ulong seed, int count = 1, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted,
+                               Method method = Method.Ancestral, double eta = 0.0) =>
+            Generate(frames, new Sampling { Seed = seed, Count = count, Steps = steps, Feet = feet, Method = method, Eta = eta });
+
+        /// <summary>Begins new motion, to step with Run.Step over a game's frames.</summary>
+        public Run BeginGenerate(int frames, Sampling sampling)
+        {
+            var native = sampling.ToNative();
+            int status = Native.sinmdm_generate_begin(Handle, ref native, Native.Size(frames, nameof(frames)), out RunHandle run);
+            return Begun(status, run);
+        }
+
+        Run Begun(int status, RunHandle run)
+        {
+            if (status != 0) { run.Dispose(); Native.Check(status); }
+            return new Run(run, this);
         }
 
         /// <summary>In-betweening: keep the spans of the reference given as start, end pairs
-        /// (end excluded), fill the gaps.</summary>
-        public Result Inbetween(Poses reference, int[] keep, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted)
+        /// (end excluded; an even count of numbers), fill the gaps.</summary>
+        public Result Inbetween(Poses reference, int[] keep, int ramp, Sampling sampling)
         {
-            var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
-            var spans = new Native.Span[keep.Length / 2];
-            for (int i = 0; i < spans.Length; i++)
-                spans[i] = new Native.Span { Start = (UIntPtr)keep[2 * i], End = (UIntPtr)keep[2 * i + 1] };
-            IntPtr result = IntPtr.Zero;
-            Native.WithInput(reference, input =>
-            {
-                Native.Check(Native.sinmdm_inbetween(Handle, ref sampling, ref input, spans, (UIntPtr)spans.Length, (UIntPtr)ramp, out result));
-                return 0;
-            });
-            return new Result(result, Joints);
+            var native = sampling.ToNative();
+            var spans = Native.Spans(keep, nameof(keep));
+            var r = Native.Size(ramp, nameof(ramp));
+            ResultHandle result = null;
+            int status = Native.WithInput(reference, input =>
+                Native.sinmdm_inbetween(Handle, ref native, ref input, spans, (UIntPtr)spans.Length, r, out result));
+            return Blocking(status, result);
+        }
+
+        public Result Inbetween(Poses reference, int[] keep, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted) =>
+            Inbetween(reference, keep, ramp, new Sampling { Seed = seed, Count = 1, Steps = steps, Feet = feet });
+
+        /// <summary>Begins an in-between, to step with Run.Step.</summary>
+        public Run BeginInbetween(Poses reference, int[] keep, int ramp, Sampling sampling)
+        {
+            var native = sampling.ToNative();
+            var spans = Native.Spans(keep, nameof(keep));
+            var r = Native.Size(ramp, nameof(ramp));
+            RunHandle run = null;
+            int status = Native.WithInput(reference, input =>
+                Native.sinmdm_inbetween_begin(Handle, ref native, ref input, spans, (UIntPtr)spans.Length, r, out run));
+            return Begun(status, run);
         }
 
         /// <summary>Expansion: new frames before and after the reference.</summary>
-        public Result Expand(Poses reference, int prefix, int suffix, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted)
+        public Result Expand(Poses reference, int prefix, int suffix, int ramp, Sampling sampling)
         {
-            var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
-            IntPtr result = IntPtr.Zero;
-            Native.WithInput(reference, input =>
-            {
-                Native.Check(Native.sinmdm_expand(Handle, ref sampling, ref input, (UIntPtr)prefix, (UIntPtr)suffix, (UIntPtr)ramp, out result));
-                return 0;
-            });
-            return new Result(result, Joints);
+            var native = sampling.ToNative();
+            UIntPtr p = Native.Size(prefix, nameof(prefix)), s = Native.Size(suffix, nameof(suffix)), r = Native.Size(ramp, nameof(ramp));
+            ResultHandle result = null;
+            int status = Native.WithInput(reference, input =>
+                Native.sinmdm_expand(Handle, ref native, ref input, p, s, r, out result));
+            return Blocking(status, result);
         }
 
-        /// <summary>Composition: the joints (and the root's travel when root) from the reference on
-        /// every frame, the rest of the body generated.</summary>
-        public Result Compose(Poses reference, int[] joints, bool root, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted)
+        public Result Expand(Poses reference, int prefix, int suffix, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted) =>
+            Expand(reference, prefix, suffix, ramp, new Sampling { Seed = seed, Count = 1, Steps = steps, Feet = feet });
+
+        /// <summary>Composition: the joints (and the root's travel when root) from the reference
+        /// on the spans (start, end pairs; null or empty: every frame), the rest generated.</summary>
+        public Result Compose(Poses reference, int[] joints, bool root, int[] spans, int ramp, Sampling sampling)
         {
-            var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
-            var indices = Array.ConvertAll(joints, j => (UIntPtr)j);
-            IntPtr result = IntPtr.Zero;
-            Native.WithInput(reference, input =>
-            {
-                Native.Check(Native.sinmdm_compose(Handle, ref sampling, ref input, indices, (UIntPtr)indices.Length, root ? 1 : 0,
-                                                   null, UIntPtr.Zero, (UIntPtr)ramp, out result));
-                return 0;
-            });
-            return new Result(result, Joints);
+            var native = sampling.ToNative();
+            var indices = Native.Indices(joints, nameof(joints));
+            var kept = Native.Spans(spans, nameof(spans));
+            var r = Native.Size(ramp, nameof(ramp));
+            ResultHandle result = null;
+            int status = Native.WithInput(reference, input =>
+                Native.sinmdm_compose(Handle, ref native, ref input, indices, (UIntPtr)indices.Length, root ? 1 : 0,
+                                      kept, (UIntPtr)kept.Length, r, out result));
+            return Blocking(status, result);
         }
+
+        public Result Compose(Poses reference, int[] joints, bool root, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted) =>
+            Compose(reference, joints, root, null, ramp, new Sampling { Seed = seed, Count = 1, Steps = steps, Feet = feet });
 
         /// <summary>Harmonization (style transfer): the content's low frequencies in the model's style.</summary>
-        public Result Harmonize(Poses content, int factor, double freeShare, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted)
+        public Result Harmonize(Poses content, int factor, double freeShare, Sampling sampling)
         {
-            var sampling = new Native.Sampling { Seed = seed, Count = 1, Steps = steps, Feet = (uint)feet };
-            IntPtr result = IntPtr.Zero;
-            Native.WithInput(content, input =>
-            {
-                Native.Check(Native.sinmdm_harmonize(Handle, ref sampling, ref input, (UIntPtr)factor, freeShare, out result));
-                return 0;
-            });
-            return new Result(result, Joints);
+            var native = sampling.ToNative();
+            var f = Native.Size(factor, nameof(factor));
+            ResultHandle result = null;
+            int status = Native.WithInput(content, input =>
+                Native.sinmdm_harmonize(Handle, ref native, ref input, f, freeShare, out result));
+            return Blocking(status, result);
         }
 
+        public Result Harmonize(Poses content, int factor, double freeShare, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted) =>
+            Harmonize(content, factor, freeShare, new Sampling { Seed = seed, Count = 1, Steps = steps, Feet = feet });
+
         /// <summary>Writes poses of this model's skeleton as a BVH file.</summary>
-        public void WriteBvh(Poses poses, string path) =>
-            Native.WithInput(poses, input => { Native.Check(Native.sinmdm_write_bvh(Handle, ref input, Native.Utf8(path))); return 0; });
+        public void WriteBvh(Poses poses, string path)
+        {
+            var p = Native.Utf8(path);
+            Native.Check(Native.WithInput(poses, input => Native.sinmdm_write_bvh(Handle, ref input, p)));
+        }
 
         public void Dispose()
         {
-            Native.sinmdm_model_free(Handle);
-            Handle = IntPtr.Zero;
+            Handle.Dispose();
+            if (self.IsAllocated) self.Free();
+            GC.SuppressFinalize(this);
         }
+
+        /// <summary>A model never disposed: its native handle is freed by its SafeHandle's own
+        /// finalizer; this frees the callback's GCHandle.</summary>
+        ~Model()
+        {
+            if (self.IsAllocated) self.Free();
+        }
+    }
+
+    /// <summary>A task being run a few steps at a time (a game's frame budget): Step until
+    /// done, then Finish; Dispose before that cancels it. The bits are the one-call task's.</summary>
+    public sealed class Run : IDisposable
+    {
+        readonly RunHandle handle;
+        readonly Model model;
+        public int Done { get; private set; }
+        public int Total { get; private set; }
+        public bool IsFinished => Total > 0 && Done >= Total;
+
+        internal Run(RunHandle handle, Model model) { this.handle = handle; this.model = model; }
+
+        /// <summary>Takes at most `maxSteps` denoising steps; returns whether every step is taken.</summary>
+        public bool Step(int maxSteps)
+        {
+            Native.Check(Native.sinmdm_run_step(handle, model.Handle, Native.Size(maxSteps, nameof(maxSteps)), out UIntPtr done, out UIntPtr total));
+            Done = (int)done;
+            Total = (int)total;
+            return IsFinished;
+        }
+
+        /// <summary>The batch: the motion once every step is taken, a preview before that.</summary>
+        public Result Finish()
+        {
+            int status = Native.sinmdm_run_finish(handle, out ResultHandle result);
+            if (status != 0) { result.Dispose(); Native.Check(status); }
+            return new Result(result, model.Joints);
+        }
+
+        public void Dispose() => handle.Dispose();
     }
 
     /// <summary>A generated batch.</summary>
     public sealed class Result : IDisposable
     {
-        IntPtr handle;
+        readonly ResultHandle handle;
         readonly int joints;
         public readonly int Count, Frames;
 
-        internal Result(IntPtr handle, int joints)
+        internal Result(ResultHandle handle, int joints)
         {
             this.handle = handle;
             this.joints = joints;
@@ -293,49 +577,83 @@ namespace Sinmdm
 
         public Poses Poses(int sample)
         {
+            var index = Native.Size(sample, nameof(sample));
             var poses = new Poses(Frames, joints);
-            Native.WithBuffers(poses, b => { Native.Check(Native.sinmdm_result_poses(handle, (UIntPtr)sample, ref b)); return 0; });
+            Native.Check(Native.WithBuffers(poses, b => Native.sinmdm_result_poses(handle, index, ref b)));
             return poses;
         }
 
-        public void Dispose()
-        {
-            Native.sinmdm_result_free(handle);
-            handle = IntPtr.Zero;
-        }
+        public void Dispose() => handle.Dispose();
     }
 
-    /// <summary>Endless motion, a chunk at a time (the same whatever chunk sizes are asked).</summary>
-    public sealed class Stream : IDisposable
+    /// <summary>How a motion stream makes its motion.</summary>
+    public struct StreamSettings
     {
-        IntPtr handle;
+        public ulong Seed;
+        public uint Steps, BlockFrames;
+        public Feet Feet;
+        public Method Method;
+        public double Eta;
+        /// <summary>Joints taken from poses given with Supply (null: none).</summary>
+        public int[] ComposeJoints;
+        /// <summary>Whether the root's travel and height also come from the supplied poses.</summary>
+        public bool ComposeRoot;
+    }
+
+    /// <summary>Endless motion, a chunk at a time (the same whatever chunk sizes are asked).
+    /// Named so as not to clash with System.IO.Stream.</summary>
+    public sealed class MotionStream : IDisposable
+    {
+        readonly StreamHandle handle;
         readonly Model model;
 
-        public Stream(Model model, ulong seed, uint steps = Runtime.DefaultSteps, uint blockFrames = 0, Feet feet = Feet.Planted,
-                      Method method = Method.Ancestral)
+        public MotionStream(Model model, StreamSettings settings)
         {
+            if (model == null) throw new ArgumentNullException(nameof(model));
             this.model = model;
-            var options = new Native.StreamOptions { Seed = seed, Steps = steps, BlockFrames = blockFrames, Feet = (uint)feet,
-                                                     Method = (uint)method };
-            Native.Check(Native.sinmdm_stream_new(model.Handle, ref options, out handle));
+            var joints = Native.Indices(settings.ComposeJoints, nameof(settings.ComposeJoints));
+            var pinned = GCHandle.Alloc(joints, GCHandleType.Pinned);
+            try
+            {
+                var options = new Native.StreamOptions
+                {
+                    Seed = settings.Seed, Steps = settings.Steps, BlockFrames = settings.BlockFrames, Feet = (uint)settings.Feet,
+                    ComposeJoints = joints.Length > 0 ? pinned.AddrOfPinnedObject() : IntPtr.Zero,
+                    ComposeJointCount = (UIntPtr)joints.Length, ComposeRoot = settings.ComposeRoot ? 1 : 0,
+                    Method = (uint)settings.Method, Eta = settings.Eta,
+                };
+                int status = Native.sinmdm_stream_new(model.Handle, ref options, out handle);
+                if (status != 0) { handle.Dispose(); Native.Check(status); }
+            }
+            finally { pinned.Free(); }
         }
+
+        public MotionStream(Model model, ulong seed, uint steps = Runtime.DefaultSteps, uint blockFrames = 0, Feet feet = Feet.Planted,
+                            Method method = Method.Ancestral, double eta = 0.0)
+            : this(model, new StreamSettings { Seed = seed, Steps = steps, BlockFrames = blockFrames, Feet = feet, Method = method, Eta = eta }) { }
 
         /// <summary>Poses for the frames after the last supplied ones, for a composed stream.</summary>
         public void Supply(Poses poses) =>
-            Native.WithInput(poses, input => { Native.Check(Native.sinmdm_stream_supply(handle, model.Handle, ref input)); return 0; });
+            Native.Check(Native.WithInput(poses, input => Native.sinmdm_stream_supply(handle, model.Handle, ref input)));
+
+        /// <summary>Prepares frames ahead with at most `maxSteps` denoising steps (call it each
+        /// frame); returns the frames ready, so Next for that many runs no network.</summary>
+        public int Prepare(int maxSteps, int ahead)
+        {
+            Native.Check(Native.sinmdm_stream_step(handle, model.Handle, Native.Size(maxSteps, nameof(maxSteps)),
+                                                   Native.Size(ahead, nameof(ahead)), out UIntPtr ready, out UIntPtr done, out UIntPtr total));
+            return (int)ready;
+        }
 
         public Poses Next(int frames)
         {
+            var n = Native.Size(frames, nameof(frames));
             var poses = new Poses(frames, model.Joints);
-            Native.WithBuffers(poses, b => { Native.Check(Native.sinmdm_stream_next(handle, model.Handle, (UIntPtr)frames, ref b)); return 0; });
+            Native.Check(Native.WithBuffers(poses, b => Native.sinmdm_stream_next(handle, model.Handle, n, ref b)));
             return poses;
         }
 
-        public void Dispose()
-        {
-            Native.sinmdm_stream_free(handle);
-            handle = IntPtr.Zero;
-        }
+        public void Dispose() => handle.Dispose();
     }
 
     /// <summary>From the model file's frame (right-handed, its up axis, its units) to Unity's

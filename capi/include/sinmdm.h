@@ -865,6 +865,12 @@ enum SinmdmStatus sinmdm_harmonize(struct SinmdmModel *model,
                                    double free_share,
                                    struct SinmdmResult **out);
 
+/*
+ How many handles (models, runs, results, streams) are alive: given out and not freed. A
+ host can check it for leaks, for example after its last `_free` at shutdown.
+ */
+size_t sinmdm_live_handles(void);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

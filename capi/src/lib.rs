@@ -106,3 +106,4 @@ pub use tasks::{
     sinmdm_generate_begin, sinmdm_harmonize, sinmdm_harmonize_begin, sinmdm_inbetween,
     sinmdm_inbetween_begin,
 };
+pub use text::sinmdm_live_handles;

@@ -217,9 +217,7 @@ pub unsafe extern "C" fn sinmdm_model_set_progress(
 /// `model` is NULL or a handle from `sinmdm_model_open*`, not used again.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn sinmdm_model_free(model: *mut SinmdmModel) {
-    if !model.is_null() {
-        drop(unsafe { Box::from_raw(model) });
-    }
+    unsafe { crate::text::free_handle(model) }
 }
 
 /// Writes the model's facts to `info`.

@@ -79,7 +79,5 @@ pub unsafe extern "C" fn sinmdm_result_poses(
 /// `result` is NULL or a handle from this library, not used again.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn sinmdm_result_free(result: *mut SinmdmResult) {
-    if !result.is_null() {
-        drop(unsafe { Box::from_raw(result) });
-    }
+    unsafe { crate::text::free_handle(result) }
 }

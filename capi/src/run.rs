@@ -76,7 +76,7 @@ pub(crate) unsafe fn blocking(
                         .into_owned(),
                 ));
             }
-            let owned = Box::from_raw(run);
+            let owned = crate::text::take_handle(run);
             let model = handle(model, "model")?;
             let progress = model.progress;
             let mut run = owned.run.expect("a run just begun is live");
@@ -162,7 +162,5 @@ pub unsafe extern "C" fn sinmdm_run_finish(
 /// `run` is NULL or a handle from this library, not used again.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn sinmdm_run_free(run: *mut SinmdmRun) {
-    if !run.is_null() {
-        drop(unsafe { Box::from_raw(run) });
-    }
+    unsafe { crate::text::free_handle(run) }
 }

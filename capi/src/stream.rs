@@ -193,7 +193,5 @@ pub unsafe extern "C" fn sinmdm_stream_step(
 /// `stream` is NULL or a handle from this library, not used again.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn sinmdm_stream_free(stream: *mut SinmdmStream) {
-    if !stream.is_null() {
-        drop(unsafe { Box::from_raw(stream) });
-    }
+    unsafe { crate::text::free_handle(stream) }
 }

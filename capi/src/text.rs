@@ -128,10 +128,41 @@ pub(crate) unsafe fn handle<'a, T>(handle: *mut T, argument: &str) -> Result<&'a
     Ok(unsafe { &mut *handle })
 }
 
+/// Handles given out and not yet freed, of every kind.
+static LIVE_HANDLES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
 /// Writes a new handle to `out`.
 ///
 /// # Safety
 /// `out` is writable (checked for NULL by the caller).
 pub(crate) unsafe fn give<T>(out: *mut *mut T, value: T) {
+    LIVE_HANDLES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     unsafe { *out = Box::into_raw(Box::new(value)) };
+}
+
+/// Frees a handle made by [`give`] (NULL is fine).
+///
+/// # Safety
+/// `handle` is NULL or a handle of type `T` from [`give`], not used again.
+pub(crate) unsafe fn free_handle<T>(handle: *mut T) {
+    if !handle.is_null() {
+        LIVE_HANDLES.fetch_sub(1, std::sync::atomic::Ordering::Relaxed);
+        drop(unsafe { Box::from_raw(handle) });
+    }
+}
+
+/// Takes back a handle made by [`give`] as its value (it no longer counts as live).
+///
+/// # Safety
+/// `handle` is a handle of type `T` from [`give`], not used again.
+pub(crate) unsafe fn take_handle<T>(handle: *mut T) -> Box<T> {
+    LIVE_HANDLES.fetch_sub(1, std::sync::atomic::Ordering::Relaxed);
+    unsafe { Box::from_raw(handle) }
+}
+
+/// How many handles (models, runs, results, streams) are alive: given out and not freed. A
+/// host can check it for leaks, for example after its last `_free` at shutdown.
+#[unsafe(no_mangle)]
+pub extern "C" fn sinmdm_live_handles() -> usize {
+    LIVE_HANDLES.load(std::sync::atomic::Ordering::Relaxed)
 }

@@ -60,3 +60,47 @@ fn the_csharp_binding_gets_the_rust_values_under_mono() {
     assert_same_values(&stdout);
     assert_eq!(sinmdm::bvh::read_bvh(&bvh).unwrap().frame_count(), 40);
 }
+
+/// Compiles `sources` with `mcs` (warnings as errors) into `exe`.
+fn compile_csharp(sources: &[std::path::PathBuf], exe: &std::path::Path) {
+    let status = Command::new("mcs")
+        .arg("-warnaserror+")
+        .arg(format!("-out:{}", exe.display()))
+        .args(sources)
+        .status()
+        .expect("no C# compiler (mcs): run scripts/setup.sh, which installs mono-mcs");
+    assert!(status.success(), "mcs failed on {sources:?}");
+}
+
+#[test]
+fn the_csharp_binding_steps_cancels_and_finalizes_under_mono() {
+    let dir = work_dir("csharp-checks");
+    let exe = dir.join("checks.exe");
+    compile_csharp(
+        &[
+            repo().join("bindings/csharp/Sinmdm.cs"),
+            repo().join("capi/tests/csharp/Checks.cs"),
+        ],
+        &exe,
+    );
+    let output = Command::new("mono")
+        .arg(&exe)
+        .arg(model_path())
+        .env("LD_LIBRARY_PATH", library_dir())
+        .env("ORT_DYLIB_PATH", onnxruntime_path())
+        .output()
+        .expect("no Mono runtime: run scripts/setup.sh, which installs mono-runtime");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success() && stdout.contains(" passed, 0 failed"),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let passed: usize = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("csharp checks: "))
+        .and_then(|l| l.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap();
+    assert!(passed >= 19, "{stdout}");
+}

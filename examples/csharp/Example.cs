@@ -1,9 +1,11 @@
 // A console program over the C# binding: a crowd, an in-between and a stream, each value
 // printed as the bits of its float (the tests compare them with the Rust API's), and a BVH.
+// `using System.IO;` is there on purpose: the binding's names must not clash with System's.
 //
 //   mcs -out:example.exe bindings/csharp/Sinmdm.cs examples/csharp/Example.cs
 //   LD_LIBRARY_PATH=target/release mono example.exe onnx-models/human_walk_cmu.onnx out.bvh
 using System;
+using System.IO;
 using System.Text;
 using Sinmdm;
 
@@ -50,7 +52,7 @@ static class Example
             using (var composed = model.Compose(first, new[] { 1, 2 }, true, 5, seed: 2, steps: 3))
             using (var styled = model.Harmonize(first, 2, 0.02, seed: 2, steps: 3))
                 Console.WriteLine("tasks expand=" + expanded.Frames + " compose=" + composed.Frames + " harmonize=" + styled.Frames);
-            using (var stream = new Stream(model, seed: 11, steps: 3, blockFrames: 30))
+            using (var stream = new MotionStream(model, seed: 11, steps: 3, blockFrames: 30))
             {
                 Print("stream20", stream.Next(20));
                 Print("stream25", stream.Next(25));
@@ -63,7 +65,7 @@ static class Example
             }
             catch (SinmdmException e)
             {
-                Console.WriteLine("unknown joint: status " + e.Status);
+                Console.WriteLine("unknown joint: status " + (int)e.Status);
             }
             model.WriteBvh(first, args[1]);
         }

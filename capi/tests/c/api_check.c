@@ -441,6 +441,11 @@ int main(int argc, char **argv) {
   sinmdm_result_free(between);
   sinmdm_result_free(result);
   sinmdm_model_free(model);
+  checks++;
+  if (sinmdm_live_handles() != 0) {
+    fprintf(stderr, "%zu handles alive after every free\n", sinmdm_live_handles());
+    failures++;
+  }
   if (failures > 0) {
     fprintf(stderr, "%d of %d bad-argument checks failed\n", failures, checks);
     return 1;

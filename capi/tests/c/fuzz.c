@@ -435,6 +435,10 @@ int main(int argc, char **argv) {
   }
   sinmdm_model_free(models[0].handle);
   sinmdm_model_free(models[1].handle);
+  if (sinmdm_live_handles() != 0) {
+    fprintf(stderr, "%zu handles still alive after freeing every one\n", sinmdm_live_handles());
+    return 1;
+  }
   printf("fuzz: %ld cases\n", cases);
   for (int s = 0; s <= 10; s++) printf("status %d: %ld\n", s, counts[s]);
   return 0;
