@@ -37,7 +37,7 @@ if [ ! -x .venv/bin/python ]; then
 fi
 stamp=.venv/.sinmdm-requirements
 if ! cmp -s scripts/requirements.txt "$stamp"; then
-  echo "setup: installing Python packages (onnxruntime, onnx, numpy, bvhio, pytest)"
+  echo "setup: installing Python packages (onnxruntime, onnx, numpy, bvhio, pytest, pyyaml)"
   .venv/bin/python -m pip install --quiet --disable-pip-version-check -r scripts/requirements.txt
   cp scripts/requirements.txt "$stamp"
 fi
