@@ -19,13 +19,12 @@ let request = Request {
 };
 // All at once (the callback sees each step and may stop the run):
 //   let crowd = sinmdm::run(&mut model, &request, &mut |_, _| std::ops::ControlFlow::Continue(()))?;
-// In a game, plan once and run a few steps per frame:
-let plan = sinmdm::plan(model.metadata(), &request)?;
-let mut sampler = plan.sampler()?;
-while !sampler.is_finished() {
-    sampler.step(&mut model)?; // yield to the frame loop here
+// In a game, an owned run (Send + 'static) takes a few steps per frame, same bits:
+let mut run = sinmdm::plan(model.metadata(), &request)?.start()?;
+while !run.step(&mut model, 3)?.is_finished() {
+    // yield to the frame loop here; dropping `run` cancels it
 }
-let crowd = plan.finish(sampler);
+let crowd = run.finish()?;
 let poses = crowd.poses(0)?; // per frame: root position, local rotations (x, y, z, w), translations
 Ok(poses)
 }

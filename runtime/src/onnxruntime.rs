@@ -382,7 +382,7 @@ fn load(asked: Option<&Path>) -> Result<&'static OnnxRuntime, RuntimeLibraryErro
             &checkout_roots(),
         )?,
     };
-    let mut tried = Vec::new();
+    let (mut tried, mut messages) = (Vec::new(), Vec::new());
     for candidate in &list {
         let path = match candidate {
             Candidate::File(p) => p.clone(),
@@ -392,18 +392,21 @@ fn load(asked: Option<&Path>) -> Result<&'static OnnxRuntime, RuntimeLibraryErro
             Ok(environment) => {
                 return Ok(LOADED.get_or_init(|| OnnxRuntime { path, environment }));
             }
-            Err(message) => tried.push(format!("{candidate} ({message})")),
+            Err(message) => {
+                tried.push(format!("{candidate} ({message})"));
+                messages.push(message);
+            }
         }
     }
     match (asked, list.as_slice()) {
         (Some(p), _) => Err(RuntimeLibraryError::LoadFailed {
             path: p.to_path_buf(),
-            message: tried.join("; "),
+            message: messages.join("; "),
         }),
         (None, [Candidate::File(p)]) if std::env::var_os("ORT_DYLIB_PATH").is_some() => {
             Err(RuntimeLibraryError::LoadFailed {
                 path: p.clone(),
-                message: tried.join("; "),
+                message: messages.join("; "),
             })
         }
         _ => Err(RuntimeLibraryError::NotFound {
