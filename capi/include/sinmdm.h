@@ -104,6 +104,18 @@
 #define SINMDM_MAX_THREADS 1024
 
 /*
+ The most spans a task takes (`span_count`): each covers at least one frame of at most
+ `SINMDM_MAX_SAMPLE_FRAMES`.
+ */
+#define SINMDM_MAX_SPANS 100000
+
+/*
+ The most joint indices a composition takes (`joint_count`, `compose_joint_count`): four times
+ the most joints a skeleton may have (repeats are allowed).
+ */
+#define SINMDM_MAX_JOINT_INDICES 16384
+
+/*
  The largest model `sinmdm_model_open_bytes` takes, in bytes (protobuf's 2 GiB limit on an
  ONNX file).
  */

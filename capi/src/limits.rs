@@ -15,6 +15,13 @@ pub const SINMDM_MAX_SAMPLES: usize = 1024;
 pub const SINMDM_MAX_RUN_VALUES: usize = 1 << 28;
 /// The most threads a model runs samples on (`threads` of `sinmdm_model_open*`; 0 = every core).
 pub const SINMDM_MAX_THREADS: usize = 1024;
+/// The most spans a task takes (`span_count`): each covers at least one frame of at most
+/// `SINMDM_MAX_SAMPLE_FRAMES`.
+pub const SINMDM_MAX_SPANS: usize = 100_000;
+/// The most joint indices a composition takes (`joint_count`, `compose_joint_count`): four times
+/// the most joints a skeleton may have (repeats are allowed).
+pub const SINMDM_MAX_JOINT_INDICES: usize = 16_384;
+
 /// The largest model `sinmdm_model_open_bytes` takes, in bytes (protobuf's 2 GiB limit on an
 /// ONNX file).
 pub const SINMDM_MAX_MODEL_BYTES: usize = 2_147_483_647;
@@ -31,5 +38,7 @@ mod tests {
         assert_eq!(SINMDM_MAX_SAMPLES, limits::MAX_SAMPLES);
         assert_eq!(SINMDM_MAX_RUN_VALUES, limits::MAX_RUN_VALUES);
         assert_eq!(SINMDM_MAX_THREADS, limits::MAX_THREADS);
+        assert_eq!(SINMDM_MAX_SPANS, limits::MAX_SAMPLE_FRAMES);
+        assert_eq!(SINMDM_MAX_JOINT_INDICES, 4 * limits::MAX_JOINTS);
     }
 }

@@ -2,12 +2,11 @@
 
 use sinmdm::{Stream, StreamCompose, StreamOptions};
 
-use crate::limits::SINMDM_MAX_SAMPLE_FRAMES;
+use crate::limits::{SINMDM_MAX_JOINT_INDICES, SINMDM_MAX_SAMPLE_FRAMES};
 use crate::model::SinmdmModel;
 use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, pose_slices, poses_in, poses_out};
 use crate::sampling::{feet_arg, method_arg, steps_arg};
 use crate::status::{Failure, SinmdmStatus, guard, guard_out};
-use crate::tasks::MAX_JOINT_INDICES;
 use crate::text::{give, handle, slice_arg};
 
 /// A stream (opaque): motion handed out a chunk at a time, forever, in flat memory.
@@ -56,9 +55,9 @@ pub unsafe extern "C" fn sinmdm_stream_new(
         guard_out(out, |out| {
             let model = handle(model.cast_mut(), "model")?;
             let o = *handle(options.cast_mut(), "options")?;
-            if o.compose_joint_count > MAX_JOINT_INDICES {
+            if o.compose_joint_count > SINMDM_MAX_JOINT_INDICES {
                 return Err(Failure::invalid(format!(
-                    "compose_joint_count is {}; at most {MAX_JOINT_INDICES} joint indices are taken",
+                    "compose_joint_count is {}; at most {SINMDM_MAX_JOINT_INDICES} joint indices are taken",
                     o.compose_joint_count
                 )));
             }

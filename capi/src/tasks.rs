@@ -3,7 +3,7 @@
 
 use sinmdm::{Span, Task, features_from_poses};
 
-use crate::limits::SINMDM_MAX_SAMPLE_FRAMES;
+use crate::limits::{SINMDM_MAX_JOINT_INDICES, SINMDM_MAX_SPANS};
 use crate::model::SinmdmModel;
 use crate::poses::{SinmdmPoses, poses_in};
 use crate::result::SinmdmResult;
@@ -11,13 +11,6 @@ use crate::run::{SinmdmRun, begin, blocking};
 use crate::sampling::{SinmdmSampling, SinmdmSpan, request};
 use crate::status::{Failure, SinmdmStatus};
 use crate::text::{handle, slice_arg};
-
-/// Most spans a task takes: each covers at least one frame of at most
-/// `SINMDM_MAX_SAMPLE_FRAMES`.
-const MAX_SPANS: usize = SINMDM_MAX_SAMPLE_FRAMES;
-/// Most joint indices a composition takes (a skeleton has at most 4096 joints; repeats are
-/// allowed, so this is generous).
-pub(crate) const MAX_JOINT_INDICES: usize = 4 * sinmdm::limits::MAX_JOINTS;
 
 /// The sampling settings behind a pointer.
 ///
@@ -40,14 +33,14 @@ unsafe fn reference_features(
     Ok(features_from_poses(&model.model.metadata().layout, &poses)?)
 }
 
-/// Spans from a caller array, at most [`MAX_SPANS`] of them.
+/// Spans from a caller array, at most `SINMDM_MAX_SPANS` of them.
 ///
 /// # Safety
 /// `spans` is readable for `count` spans (or NULL with 0).
 unsafe fn spans(spans: *const SinmdmSpan, count: usize) -> Result<Vec<Span>, Failure> {
-    if count > MAX_SPANS {
+    if count > SINMDM_MAX_SPANS {
         return Err(Failure::invalid(format!(
-            "span_count is {count}; at most {MAX_SPANS} spans fit in the longest sample"
+            "span_count is {count}; at most {SINMDM_MAX_SPANS} spans fit in the longest sample"
         )));
     }
     Ok(unsafe { slice_arg(spans, count, "spans") }?
@@ -212,9 +205,9 @@ pub unsafe extern "C" fn sinmdm_compose_begin(
     unsafe {
         begin(model, out, |m| {
             let sampling = sampling_arg(sampling)?;
-            if joint_count > MAX_JOINT_INDICES {
+            if joint_count > SINMDM_MAX_JOINT_INDICES {
                 return Err(Failure::invalid(format!(
-                    "joint_count is {joint_count}; at most {MAX_JOINT_INDICES} joint indices are taken"
+                    "joint_count is {joint_count}; at most {SINMDM_MAX_JOINT_INDICES} joint indices are taken"
                 )));
             }
             let task = Task::Compose {

@@ -1,4 +1,4 @@
-//! The C# binding under Mono: `bindings/csharp/Sinmdm.cs` and the console example
+//! The C# binding under Mono: `bindings/csharp/Sinmdm.cs` (with `Sinmdm.Native.cs`) and the console example
 //! `examples/csharp/Example.cs` are compiled with `mcs` (warnings as errors) and run with
 //! `mono`; every value must be bit for bit the Rust API's for the same arguments.
 
@@ -31,6 +31,7 @@ fn the_csharp_binding_gets_the_rust_values_under_mono() {
         .arg("-warnaserror+")
         .arg(format!("-out:{}", exe.display()))
         .arg(repo().join("bindings/csharp/Sinmdm.cs"))
+        .arg(repo().join("bindings/csharp/Sinmdm.Native.cs"))
         .arg(repo().join("examples/csharp/Example.cs"))
         .status()
         .expect("no C# compiler (mcs): run scripts/setup.sh, which installs mono-mcs");
@@ -79,6 +80,7 @@ fn the_csharp_binding_steps_cancels_and_finalizes_under_mono() {
     compile_csharp(
         &[
             repo().join("bindings/csharp/Sinmdm.cs"),
+            repo().join("bindings/csharp/Sinmdm.Native.cs"),
             repo().join("capi/tests/csharp/Checks.cs"),
         ],
         &exe,

@@ -83,7 +83,7 @@ def test_npm_pack_takes_the_package(package, tmp_path):
     tarball = tmp_path / done.stdout.strip().splitlines()[-1]
     with tarfile.open(tarball) as t:
         names = set(t.getnames())
-    for needed in ["package/package.json", "package/Runtime/Sinmdm.cs", "package/Runtime/Sinmdm.Runtime.asmdef",
+    for needed in ["package/package.json", "package/Runtime/Sinmdm.cs", "package/Runtime/Sinmdm.Native.cs", "package/Runtime/Sinmdm.Runtime.asmdef",
                    "package/Plugins/Linux/x86_64/libsinmdm_c.so", "package/Plugins/Linux/x86_64/libsinmdm_c.so.meta"]:
         assert needed in names, needed
 
@@ -100,6 +100,7 @@ def test_runtime_compiles_against_the_unity_stub(package, tmp_path):
 def test_the_mono_checks_run_from_the_package_layout(package, tmp_path):
     exe = tmp_path / "checks.exe"
     done = subprocess.run(["mcs", "-warnaserror+", f"-out:{exe}", str(package / "Runtime" / "Sinmdm.cs"),
+                           str(package / "Runtime" / "Sinmdm.Native.cs"),
                            str(ROOT / "capi" / "tests" / "csharp" / "Checks.cs")], capture_output=True, text=True)
     assert done.returncode == 0, done.stdout + done.stderr
     plugins = package / "Plugins" / "Linux" / "x86_64"

@@ -142,7 +142,7 @@ static size_t any_span_count(void) {
     spans[i].start = coin() ? pick(50) : any_size(SINMDM_MAX_SAMPLE_FRAMES);
     spans[i].end = coin() ? spans[i].start + pick(30) : any_size(SINMDM_MAX_SAMPLE_FRAMES);
   }
-  size_t count_pool[] = {0, 1, 2, 8, SINMDM_MAX_SAMPLE_FRAMES + 1, SIZE_MAX};
+  size_t count_pool[] = {0, 1, 2, 8, SINMDM_MAX_SPANS + 1, SIZE_MAX};
   return count_pool[pick(sizeof count_pool / sizeof count_pool[0])];
 }
 /* A span array the count says, or NULL (only counts up to 8 point at real memory). */
@@ -154,7 +154,7 @@ static const SinmdmSpan *span_array(size_t count) {
 static size_t joint_indices[8];
 static size_t any_joint_count(void) {
   for (size_t i = 0; i < 8; i++) joint_indices[i] = coin() ? pick(40) : any_size(4096);
-  size_t pool[] = {0, 1, 3, 8, 4 * 4096 + 1, SIZE_MAX};
+  size_t pool[] = {0, 1, 3, 8, SINMDM_MAX_JOINT_INDICES + 1, SIZE_MAX};
   return pool[pick(sizeof pool / sizeof pool[0])];
 }
 static const size_t *joint_array(size_t count) {
