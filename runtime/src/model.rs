@@ -306,73 +306,61 @@ impl Model {
         self.sessions_for(workers)?;
         let mut out = Array3::<f32>::zeros((b, f, n));
         let path = self.path.as_path();
-        if workers == 1 {
-            let session = &mut self.sessions[0];
-            for (sample, target) in out.outer_iter_mut().enumerate() {
-                denoise_one(
-                    session,
-                    path,
-                    x_t.index_axis(Axis(0), sample),
-                    t[sample],
-                    target,
-                )?;
-            }
-            return Ok(out);
-        }
-        // Sample i goes to thread i mod W; each thread has its own session, and the first one
-        // is the calling thread.
-        let mut shares: Vec<Vec<(usize, ndarray::ArrayViewMut2<'_, f32>)>> =
-            (0..workers).map(|_| Vec::new()).collect();
+        // Sample i goes to thread i mod W; each thread has its own session, and the first share
+        // runs on the calling thread.
+        let mut shares: Vec<Share<'_>> = (0..workers).map(|_| Vec::new()).collect();
         for (sample, target) in out.outer_iter_mut().enumerate() {
             shares[sample % workers].push((sample, target));
         }
-        let sessions = &mut self.sessions[..workers];
-        let results: Vec<Result<(), ModelError>> = std::thread::scope(|scope| {
-            let mut shares = shares.into_iter();
-            let mut sessions = sessions.iter_mut();
-            let own = (sessions.next(), shares.next());
-            let handles: Vec<_> = sessions
+        let mut sessions = self.sessions[..workers].iter_mut();
+        let mut shares = shares.into_iter();
+        let (Some(own_session), Some(own_share)) = (sessions.next(), shares.next()) else {
+            return Ok(out);
+        };
+        std::thread::scope(|scope| {
+            let others: Vec<_> = sessions
                 .zip(shares)
                 .map(|(session, share)| {
-                    scope.spawn(move || {
-                        for (sample, target) in share {
-                            denoise_one(
-                                session,
-                                path,
-                                x_t.index_axis(Axis(0), sample),
-                                t[sample],
-                                target,
-                            )?;
-                        }
-                        Ok(())
-                    })
+                    scope.spawn(move || denoise_share(session, path, x_t, t, share))
                 })
                 .collect();
-            let mut results = Vec::with_capacity(workers);
-            if let (Some(session), Some(share)) = own {
-                results.push(share.into_iter().try_for_each(|(sample, target)| {
-                    denoise_one(
-                        session,
-                        path,
-                        x_t.index_axis(Axis(0), sample),
-                        t[sample],
-                        target,
-                    )
-                }));
-            }
-            for handle in handles {
-                results.push(handle.join().unwrap_or_else(|_| {
+            let mut result = denoise_share(own_session, path, x_t, t, own_share);
+            for other in others {
+                let joined = other.join().unwrap_or_else(|_| {
                     Err(ModelError::Run {
                         path: path.to_path_buf(),
                         message: "a denoising thread panicked".into(),
                     })
-                }));
+                });
+                result = result.and(joined);
             }
-            results
-        });
-        results.into_iter().collect::<Result<Vec<()>, _>>()?;
+            result
+        })?;
         Ok(out)
     }
+}
+
+/// The samples one thread denoises: each sample's index and the output it fills.
+type Share<'a> = Vec<(usize, ndarray::ArrayViewMut2<'a, f32>)>;
+
+/// Denoises a share of a batch, sample by sample, through one session.
+fn denoise_share(
+    session: &mut Session,
+    path: &Path,
+    x_t: ArrayView3<'_, f32>,
+    t: &[i64],
+    share: Share<'_>,
+) -> Result<(), ModelError> {
+    for (sample, target) in share {
+        denoise_one(
+            session,
+            path,
+            x_t.index_axis(Axis(0), sample),
+            t[sample],
+            target,
+        )?;
+    }
+    Ok(())
 }
 
 /// One sample `[F, N]` at diffusion step `t` through `session`, written into `target`.
