@@ -21,13 +21,24 @@ command -v cc >/dev/null || missing+=(gcc)
 command -v valgrind >/dev/null || missing+=(valgrind)
 command -v mcs >/dev/null || missing+=(mono-mcs)
 command -v mono >/dev/null || missing+=(mono-runtime)
-if [ ${#missing[@]} -gt 0 ]; then
+# A real single-node Slurm for the library's cluster test (the daemons run as test processes).
+cluster=()
+command -v slurmctld >/dev/null || cluster+=(slurmctld)
+command -v slurmd >/dev/null || cluster+=(slurmd)
+command -v sbatch >/dev/null || cluster+=(slurm-client)
+command -v munged >/dev/null || cluster+=(munge)
+if [ ${#missing[@]} -gt 0 ] || [ ${#cluster[@]} -gt 0 ]; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
-    echo "setup: installing ${missing[*]}"
+    echo "setup: installing ${missing[*]} ${cluster[*]}"
     apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+    if [ ${#missing[@]} -gt 0 ]; then
+      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+    fi
+    if [ ${#cluster[@]} -gt 0 ]; then
+      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${cluster[@]}" >/dev/null
+    fi
   else
-    echo "setup: the C ABI tests need ${missing[*]}; install them (as root: apt-get install ${missing[*]})" >&2
+    echo "setup: the C ABI and cluster tests need ${missing[*]} ${cluster[*]}; install them as root with apt-get" >&2
   fi
 fi
 

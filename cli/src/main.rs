@@ -6,6 +6,7 @@ mod convert;
 mod eval;
 mod info;
 mod inspect;
+mod library;
 mod render;
 mod reorient;
 mod sampling;
@@ -66,6 +67,10 @@ pub enum Command {
     /// Write a clip's features in a model's layout as JSON (input of the Python reference).
     #[command(after_help = info::ENCODE_EXAMPLES)]
     Encode(info::EncodeArgs),
+    /// A motion library trained as an array job (`sinmdm-train --manifest`): status, report,
+    /// batch generation.
+    #[command(after_help = library::EXAMPLES)]
+    Library(library::LibraryArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -84,6 +89,7 @@ fn main() -> std::process::ExitCode {
         Command::Reorient(args) => reorient::run(&args),
         Command::Convert(args) => convert::run(&args),
         Command::Encode(args) => info::encode(&args),
+        Command::Library(args) => library::run(&args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

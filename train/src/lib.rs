@@ -11,6 +11,7 @@ pub mod config;
 pub mod data;
 pub mod error;
 pub mod export;
+pub mod library_task;
 pub mod loss;
 pub mod loss_log;
 pub mod loss_plot;

@@ -24,6 +24,9 @@ use sinmdm_train::{QnaUnet, RunEnd, TrainConfig, Trainer};
 ///   sinmdm-train CLIP.bvh --config configs/paper.yaml --dry-run   (sizes only)
 ///   sinmdm-train character.glb --clip-anim Walk --out runs/walk   (one animation of a glTF file)
 ///   sinmdm-train mixamo_walk.fbx --out runs/walk                  (an FBX clip, e.g. from Mixamo)
+///   sinmdm-train --manifest library.yaml --index 3     (clip 3 of a library: one array task;
+///                                   the index may also come from SLURM_ARRAY_TASK_ID or
+///                                   JOB_COMPLETION_INDEX)
 #[derive(Parser, Debug)]
 #[command(name = "sinmdm-train", version, verbatim_doc_comment)]
 struct Args {
@@ -73,6 +76,58 @@ struct Args {
     /// Compute device: cpu, or cuda / wgpu when built with that feature.
     #[arg(long, default_value = "cpu")]
     device: String,
+    /// A library manifest (YAML): run one task of it, training, exporting and evaluating one
+    /// clip into its own folder; a current model is not trained again, a killed task resumes.
+    #[arg(long, value_name = "LIBRARY.yaml", conflicts_with_all = ["clip", "out", "resume", "export", "minutes", "config"])]
+    manifest: Option<PathBuf>,
+    /// The task (clip) index in --manifest, from 0; default: SLURM_ARRAY_TASK_ID, then
+    /// JOB_COMPLETION_INDEX (a Kubernetes Indexed Job's).
+    #[arg(long, requires = "manifest")]
+    index: Option<usize>,
+}
+
+/// One task of a library array job.
+fn library_task(args: &Args, manifest: &std::path::Path) -> Result<()> {
+    use sinmdm_train::library_task::{TaskEnd, run_task};
+    let index = sinmdm_library::task_index(args.index, |v| std::env::var(v).ok())?;
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst))
+            .context("installing the Ctrl-C handler")?;
+    }
+    let device = device(&args.device)?.autodiff();
+    let mut last = std::time::Instant::now();
+    let end = run_task(manifest, index, device, &stop, |report| {
+        if last.elapsed().as_secs_f64() >= 10.0 || report.step == report.total {
+            last = std::time::Instant::now();
+            eprintln!(
+                "task {index}: step {}/{}  loss {:.4}  {:.1} min",
+                report.step,
+                report.total,
+                report.loss,
+                report.seconds / 60.0
+            );
+        }
+    })
+    .with_context(|| format!("task {index} of {}", manifest.display()))?;
+    match end {
+        TaskEnd::UpToDate(model) => eprintln!("task {index}: up to date ({})", model.display()),
+        TaskEnd::Trained { model, resumed } => eprintln!(
+            "task {index}: {} {}",
+            if resumed {
+                "resumed and finished"
+            } else {
+                "trained"
+            },
+            model.display()
+        ),
+        TaskEnd::Interrupted => {
+            eprintln!("task {index}: interrupted; run it again to resume from its checkpoint");
+            std::process::exit(130);
+        }
+    }
+    Ok(())
 }
 
 fn device(name: &str) -> Result<Device> {
@@ -236,6 +291,9 @@ fn main() -> Result<()> {
     }
     if args.dry_run {
         return dry_run(&args);
+    }
+    if let Some(manifest) = &args.manifest {
+        return library_task(&args, manifest);
     }
     let Some(out) = &args.out else {
         bail!("--out is required: the run folder for checkpoints and logs");
