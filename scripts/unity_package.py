@@ -180,8 +180,8 @@ def main(argv=None):
         "noEngineReferences": False,
     }
     write(os.path.join(root, "Runtime", "Sinmdm.Runtime.asmdef"), json.dumps(asmdef, indent=2) + "\n")
-    for source in ("Sinmdm.cs", "Sinmdm.Native.cs"):
-        shutil.copyfile(os.path.join(REPO, "bindings", "csharp", source), os.path.join(root, "Runtime", source))
+    for source in sorted(glob.glob(os.path.join(REPO, "bindings", "csharp", "*.cs"))):
+        shutil.copyfile(source, os.path.join(root, "Runtime", os.path.basename(source)))
     shutil.copyfile(os.path.join(REPO, "bindings", "unity", "SinmdmAnimator.cs"), os.path.join(root, "Runtime", "SinmdmAnimator.cs"))
     os.makedirs(os.path.join(root, plugins), exist_ok=True)
     shutil.copyfile(built, os.path.join(root, plugins, library))
@@ -205,7 +205,7 @@ def main(argv=None):
     write(
         os.path.join(root, "README.md"),
         "# sinmdm for Unity\n\n"
-        "New, varied motion at run time from a model trained on one clip. `Runtime/Sinmdm.cs` and `Sinmdm.Native.cs` are the C# binding "
+        "New, varied motion at run time from a model trained on one clip. `Runtime/Sinmdm*.cs` are the C# binding "
         "(models, tasks, stepped runs, endless streams, progress and cancel); `Runtime/SinmdmAnimator.cs` plays a "
         "stream on a character's bones, preparing frames a few denoising steps per frame so no frame waits. "
         "The sample `Walker` uses the shipped CMU walk.\n\n"

@@ -63,6 +63,8 @@ namespace Sinmdm
         [DllImport(Lib)] internal static extern int sinmdm_model_joint_name(ModelHandle model, UIntPtr joint, byte[] buffer, UIntPtr capacity, out UIntPtr needed);
         [DllImport(Lib)] internal static extern int sinmdm_model_find_joint(ModelHandle model, byte[] name, out UIntPtr index);
         [DllImport(Lib)] internal static extern int sinmdm_model_parents(ModelHandle model, int[] parents, UIntPtr capacity, out UIntPtr needed);
+        [DllImport(Lib)] internal static extern int sinmdm_model_rest_offsets(ModelHandle model, float[] offsets, UIntPtr capacity, out UIntPtr needed);
+        [DllImport(Lib)] internal static extern int sinmdm_model_contact_joints(ModelHandle model, UIntPtr[] joints, UIntPtr capacity, out UIntPtr needed);
         [DllImport(Lib)] internal static extern int sinmdm_generate(ModelHandle model, ref Sampling sampling, UIntPtr frames, out ResultHandle result);
         [DllImport(Lib)] internal static extern int sinmdm_generate_begin(ModelHandle model, ref Sampling sampling, UIntPtr frames, out RunHandle run);
         [DllImport(Lib)] internal static extern int sinmdm_inbetween(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out ResultHandle result);

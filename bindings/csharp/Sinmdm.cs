@@ -213,6 +213,24 @@ namespace Sinmdm
             return parents;
         }
 
+        /// <summary>Every joint's rest offset from its parent: x, y, z per joint (file units).</summary>
+        public float[] RestOffsets()
+        {
+            Native.Check(Native.sinmdm_model_rest_offsets(Handle, null, UIntPtr.Zero, out UIntPtr needed));
+            var offsets = new float[(int)needed];
+            Native.Check(Native.sinmdm_model_rest_offsets(Handle, offsets, needed, out needed));
+            return offsets;
+        }
+
+        /// <summary>The contact joints' indices (feet, paws).</summary>
+        public int[] ContactJoints()
+        {
+            Native.Check(Native.sinmdm_model_contact_joints(Handle, null, UIntPtr.Zero, out UIntPtr needed));
+            var joints = new UIntPtr[(int)needed];
+            Native.Check(Native.sinmdm_model_contact_joints(Handle, joints, needed, out needed));
+            return Array.ConvertAll(joints, j => (int)j);
+        }
+
         Result Blocking(int status, ResultHandle handle)
         {
             if (status != 0) { handle.Dispose(); CheckTask(status); }
@@ -288,6 +306,17 @@ namespace Sinmdm
         public Result Expand(Poses reference, int prefix, int suffix, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted) =>
             Expand(reference, prefix, suffix, ramp, new Sampling { Seed = seed, Count = 1, Steps = steps, Feet = feet });
 
+        /// <summary>Begins an expansion, to step with Run.Step.</summary>
+        public Run BeginExpand(Poses reference, int prefix, int suffix, int ramp, Sampling sampling)
+        {
+            var native = sampling.ToNative();
+            UIntPtr p = Native.Size(prefix, nameof(prefix)), s = Native.Size(suffix, nameof(suffix)), r = Native.Size(ramp, nameof(ramp));
+            RunHandle run = null;
+            int status = Native.WithInput(reference, input =>
+                Native.sinmdm_expand_begin(Handle, ref native, ref input, p, s, r, out run));
+            return Begun(status, run);
+        }
+
         /// <summary>Composition: the joints (and the root's travel when root) from the reference
         /// on the spans (start, end pairs; null or empty: every frame), the rest generated.</summary>
         public Result Compose(Poses reference, int[] joints, bool root, int[] spans, int ramp, Sampling sampling)
@@ -306,6 +335,20 @@ namespace Sinmdm
         public Result Compose(Poses reference, int[] joints, bool root, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted) =>
             Compose(reference, joints, root, null, ramp, new Sampling { Seed = seed, Count = 1, Steps = steps, Feet = feet });
 
+        /// <summary>Begins a composition, to step with Run.Step.</summary>
+        public Run BeginCompose(Poses reference, int[] joints, bool root, int[] spans, int ramp, Sampling sampling)
+        {
+            var native = sampling.ToNative();
+            var indices = Native.Indices(joints, nameof(joints));
+            var kept = Native.Spans(spans, nameof(spans));
+            var r = Native.Size(ramp, nameof(ramp));
+            RunHandle run = null;
+            int status = Native.WithInput(reference, input =>
+                Native.sinmdm_compose_begin(Handle, ref native, ref input, indices, (UIntPtr)indices.Length, root ? 1 : 0,
+                                            kept, (UIntPtr)kept.Length, r, out run));
+            return Begun(status, run);
+        }
+
         /// <summary>Harmonization (style transfer): the content's low frequencies in the model's style.</summary>
         public Result Harmonize(Poses content, int factor, double freeShare, Sampling sampling)
         {
@@ -319,6 +362,17 @@ namespace Sinmdm
 
         public Result Harmonize(Poses content, int factor, double freeShare, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted) =>
             Harmonize(content, factor, freeShare, new Sampling { Seed = seed, Count = 1, Steps = steps, Feet = feet });
+
+        /// <summary>Begins a harmonization, to step with Run.Step.</summary>
+        public Run BeginHarmonize(Poses content, int factor, double freeShare, Sampling sampling)
+        {
+            var native = sampling.ToNative();
+            var f = Native.Size(factor, nameof(factor));
+            RunHandle run = null;
+            int status = Native.WithInput(content, input =>
+                Native.sinmdm_harmonize_begin(Handle, ref native, ref input, f, freeShare, out run));
+            return Begun(status, run);
+        }
 
         /// <summary>Writes poses of this model's skeleton as a BVH file.</summary>
         public void WriteBvh(Poses poses, string path)
@@ -470,31 +524,5 @@ namespace Sinmdm
         }
 
         public void Dispose() => handle.Dispose();
-    }
-
-    /// <summary>From the model file's frame (right-handed, its up axis, its units) to Unity's
-    /// (left-handed, Y-up, metres).</summary>
-    public static class Coordinates
-    {
-        /// <summary>A position: turned so the file's up is +Y, X mirrored, scaled to metres
-        /// (`metresPerUnit`: 0.01 for a file in centimetres).</summary>
-        public static void ToUnityPosition(ModelInfo info, float[] xyz, int offset, float metresPerUnit)
-        {
-            float x = xyz[offset], y = xyz[offset + 1], z = xyz[offset + 2];
-            if (info.UpZ > 0.5) { float t = y; y = z; z = -t; }  // Z-up: (x, y, z) -> (x, z, -y)
-            xyz[offset] = -x * metresPerUnit;
-            xyz[offset + 1] = y * metresPerUnit;
-            xyz[offset + 2] = z * metresPerUnit;
-        }
-
-        /// <summary>A rotation x,y,z,w, turned the same way, then mirrored in X.</summary>
-        public static void ToUnityRotation(ModelInfo info, float[] xyzw, int offset)
-        {
-            float x = xyzw[offset], y = xyzw[offset + 1], z = xyzw[offset + 2];
-            if (info.UpZ > 0.5) { float t = y; y = z; z = -t; }
-            xyzw[offset] = x;
-            xyzw[offset + 1] = -y;
-            xyzw[offset + 2] = -z;
-        }
     }
 }

@@ -1,4 +1,4 @@
-//! The C# binding under Mono: `bindings/csharp/Sinmdm.cs` (with `Sinmdm.Native.cs`) and the console example
+//! The C# binding under Mono: `bindings/csharp/*.cs` and the console example
 //! `examples/csharp/Example.cs` are compiled with `mcs` (warnings as errors) and run with
 //! `mono`; every value must be bit for bit the Rust API's for the same arguments.
 
@@ -30,8 +30,7 @@ fn the_csharp_binding_gets_the_rust_values_under_mono() {
     let status = Command::new("mcs")
         .arg("-warnaserror+")
         .arg(format!("-out:{}", exe.display()))
-        .arg(repo().join("bindings/csharp/Sinmdm.cs"))
-        .arg(repo().join("bindings/csharp/Sinmdm.Native.cs"))
+        .args(binding_sources())
         .arg(repo().join("examples/csharp/Example.cs"))
         .status()
         .expect("no C# compiler (mcs): run scripts/setup.sh, which installs mono-mcs");
@@ -62,6 +61,18 @@ fn the_csharp_binding_gets_the_rust_values_under_mono() {
     assert_eq!(sinmdm::bvh::read_bvh(&bvh).unwrap().frame_count(), 40);
 }
 
+/// The binding's files (`bindings/csharp/*.cs`).
+fn binding_sources() -> Vec<std::path::PathBuf> {
+    let mut files: Vec<_> = std::fs::read_dir(repo().join("bindings/csharp"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "cs"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 2, "{files:?}");
+    files
+}
+
 /// Compiles `sources` with `mcs` (warnings as errors) into `exe`.
 fn compile_csharp(sources: &[std::path::PathBuf], exe: &std::path::Path) {
     let status = Command::new("mcs")
@@ -79,10 +90,10 @@ fn the_csharp_binding_steps_cancels_and_finalizes_under_mono() {
     let exe = dir.join("checks.exe");
     compile_csharp(
         &[
-            repo().join("bindings/csharp/Sinmdm.cs"),
-            repo().join("bindings/csharp/Sinmdm.Native.cs"),
-            repo().join("capi/tests/csharp/Checks.cs"),
-        ],
+            binding_sources(),
+            vec![repo().join("capi/tests/csharp/Checks.cs")],
+        ]
+        .concat(),
         &exe,
     );
     let output = Command::new("mono")

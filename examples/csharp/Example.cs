@@ -2,7 +2,7 @@
 // printed as the bits of its float (the tests compare them with the Rust API's), and a BVH.
 // `using System.IO;` is there on purpose: the binding's names must not clash with System's.
 //
-//   mcs -out:example.exe bindings/csharp/Sinmdm.cs bindings/csharp/Sinmdm.Native.cs examples/csharp/Example.cs
+//   mcs -out:example.exe bindings/csharp/*.cs examples/csharp/Example.cs
 //   LD_LIBRARY_PATH=target/release mono example.exe onnx-models/human_walk_cmu.onnx out.bvh
 using System;
 using System.IO;

@@ -83,6 +83,17 @@ static class Checks
             try { model.JointName(100000); Expect(false, "a joint out of range throws"); }
             catch (SinmdmException e) { Expect(e.Status == Status.InvalidArgument, "a joint out of range is InvalidArgument"); }
             Expect(model.Parents().Length == model.Joints && model.Parents()[0] == -1, "parents by size query");
+            Expect(model.RestOffsets().Length == 3 * model.Joints, "rest offsets by size query");
+            Expect(model.ContactJoints().Length == (int)model.Info.ContactJoints, "contact joints by size query");
+            foreach (var begun in new Func<Run>[] {
+                () => model.BeginExpand(once, 5, 5, 3, sampling),
+                () => model.BeginCompose(once, new[] { 1, 2 }, true, new[] { 0, 20 }, 3, sampling),
+                () => model.BeginHarmonize(once, 2, 0.1, sampling) })
+                using (var run = begun())
+                {
+                    while (!run.Step(4)) { }
+                    using (var result = run.Finish()) Expect(result.Frames >= 40, "a begun task steps to its end");
+                }
 
             var settings = new StreamSettings { Seed = 11, Steps = 3, BlockFrames = 30, Feet = Feet.Planted };
             using (var blocking = new MotionStream(model, settings))
