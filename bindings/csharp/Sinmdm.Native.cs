@@ -52,42 +52,42 @@ namespace Sinmdm
         [UnmanagedFunctionPointer(CallingConvention.Cdecl)]
         internal delegate int ProgressFn(IntPtr userdata, UIntPtr done, UIntPtr total);
 
-        [DllImport(Lib)] internal static extern IntPtr sinmdm_last_error();
-        [DllImport(Lib)] internal static extern UIntPtr sinmdm_live_handles();
-        [DllImport(Lib)] internal static extern int sinmdm_load_onnxruntime(byte[] path);
-        [DllImport(Lib)] internal static extern int sinmdm_model_open(byte[] path, uint threads, out ModelHandle model);
-        [DllImport(Lib)] internal static extern int sinmdm_model_open_bytes(byte[] bytes, UIntPtr length, uint threads, out ModelHandle model);
-        [DllImport(Lib)] internal static extern void sinmdm_model_free(IntPtr model);
-        [DllImport(Lib)] internal static extern int sinmdm_model_info(ModelHandle model, out ModelInfo info);
-        [DllImport(Lib)] internal static extern int sinmdm_model_set_progress(ModelHandle model, ProgressFn callback, IntPtr userdata);
-        [DllImport(Lib)] internal static extern int sinmdm_model_joint_name(ModelHandle model, UIntPtr joint, byte[] buffer, UIntPtr capacity, out UIntPtr needed);
-        [DllImport(Lib)] internal static extern int sinmdm_model_find_joint(ModelHandle model, byte[] name, out UIntPtr index);
-        [DllImport(Lib)] internal static extern int sinmdm_model_parents(ModelHandle model, int[] parents, UIntPtr capacity, out UIntPtr needed);
-        [DllImport(Lib)] internal static extern int sinmdm_model_rest_offsets(ModelHandle model, float[] offsets, UIntPtr capacity, out UIntPtr needed);
-        [DllImport(Lib)] internal static extern int sinmdm_model_contact_joints(ModelHandle model, UIntPtr[] joints, UIntPtr capacity, out UIntPtr needed);
-        [DllImport(Lib)] internal static extern int sinmdm_generate(ModelHandle model, ref Sampling sampling, UIntPtr frames, out ResultHandle result);
-        [DllImport(Lib)] internal static extern int sinmdm_generate_begin(ModelHandle model, ref Sampling sampling, UIntPtr frames, out RunHandle run);
-        [DllImport(Lib)] internal static extern int sinmdm_inbetween(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out ResultHandle result);
-        [DllImport(Lib)] internal static extern int sinmdm_inbetween_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out RunHandle run);
-        [DllImport(Lib)] internal static extern int sinmdm_expand(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr prefix, UIntPtr suffix, UIntPtr ramp, out ResultHandle result);
-        [DllImport(Lib)] internal static extern int sinmdm_expand_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr prefix, UIntPtr suffix, UIntPtr ramp, out RunHandle run);
-        [DllImport(Lib)] internal static extern int sinmdm_compose(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr[] joints, UIntPtr jointCount, int root, Span[] spans, UIntPtr spanCount, UIntPtr ramp, out ResultHandle result);
-        [DllImport(Lib)] internal static extern int sinmdm_compose_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr[] joints, UIntPtr jointCount, int root, Span[] spans, UIntPtr spanCount, UIntPtr ramp, out RunHandle run);
-        [DllImport(Lib)] internal static extern int sinmdm_harmonize(ModelHandle model, ref Sampling sampling, ref PosesIn content, UIntPtr factor, double freeShare, out ResultHandle result);
-        [DllImport(Lib)] internal static extern int sinmdm_harmonize_begin(ModelHandle model, ref Sampling sampling, ref PosesIn content, UIntPtr factor, double freeShare, out RunHandle run);
-        [DllImport(Lib)] internal static extern int sinmdm_run_step(RunHandle run, ModelHandle model, UIntPtr maxSteps, out UIntPtr done, out UIntPtr total);
-        [DllImport(Lib)] internal static extern int sinmdm_run_finish(RunHandle run, out ResultHandle result);
-        [DllImport(Lib)] internal static extern void sinmdm_run_free(IntPtr run);
-        [DllImport(Lib)] internal static extern int sinmdm_result_count(ResultHandle result, out UIntPtr count);
-        [DllImport(Lib)] internal static extern int sinmdm_result_frames(ResultHandle result, out UIntPtr frames);
-        [DllImport(Lib)] internal static extern int sinmdm_result_poses(ResultHandle result, UIntPtr sample, ref PoseBuffers buffers);
-        [DllImport(Lib)] internal static extern void sinmdm_result_free(IntPtr result);
-        [DllImport(Lib)] internal static extern int sinmdm_stream_new(ModelHandle model, ref StreamOptions options, out StreamHandle stream);
-        [DllImport(Lib)] internal static extern int sinmdm_stream_supply(StreamHandle stream, ModelHandle model, ref PosesIn poses);
-        [DllImport(Lib)] internal static extern int sinmdm_stream_next(StreamHandle stream, ModelHandle model, UIntPtr frames, ref PoseBuffers buffers);
-        [DllImport(Lib)] internal static extern int sinmdm_stream_step(StreamHandle stream, ModelHandle model, UIntPtr maxSteps, UIntPtr ahead, out UIntPtr ready, out UIntPtr done, out UIntPtr total);
-        [DllImport(Lib)] internal static extern void sinmdm_stream_free(IntPtr stream);
-        [DllImport(Lib)] internal static extern int sinmdm_write_bvh(ModelHandle model, ref PosesIn poses, byte[] path);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern IntPtr sinmdm_last_error();
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern UIntPtr sinmdm_live_handles();
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_load_onnxruntime(byte[] path);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_model_open(byte[] path, uint threads, out ModelHandle model);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_model_open_bytes(byte[] bytes, UIntPtr length, uint threads, out ModelHandle model);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern void sinmdm_model_free(IntPtr model);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_model_info(ModelHandle model, out ModelInfo info);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_model_set_progress(ModelHandle model, ProgressFn callback, IntPtr userdata);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_model_joint_name(ModelHandle model, UIntPtr joint, byte[] buffer, UIntPtr capacity, out UIntPtr needed);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_model_find_joint(ModelHandle model, byte[] name, out UIntPtr index);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_model_parents(ModelHandle model, int[] parents, UIntPtr capacity, out UIntPtr needed);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_model_rest_offsets(ModelHandle model, float[] offsets, UIntPtr capacity, out UIntPtr needed);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_model_contact_joints(ModelHandle model, UIntPtr[] joints, UIntPtr capacity, out UIntPtr needed);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_generate(ModelHandle model, ref Sampling sampling, UIntPtr frames, out ResultHandle result);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_generate_begin(ModelHandle model, ref Sampling sampling, UIntPtr frames, out RunHandle run);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_inbetween(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out ResultHandle result);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_inbetween_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out RunHandle run);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_expand(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr prefix, UIntPtr suffix, UIntPtr ramp, out ResultHandle result);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_expand_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr prefix, UIntPtr suffix, UIntPtr ramp, out RunHandle run);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_compose(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr[] joints, UIntPtr jointCount, int root, Span[] spans, UIntPtr spanCount, UIntPtr ramp, out ResultHandle result);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_compose_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr[] joints, UIntPtr jointCount, int root, Span[] spans, UIntPtr spanCount, UIntPtr ramp, out RunHandle run);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_harmonize(ModelHandle model, ref Sampling sampling, ref PosesIn content, UIntPtr factor, double freeShare, out ResultHandle result);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_harmonize_begin(ModelHandle model, ref Sampling sampling, ref PosesIn content, UIntPtr factor, double freeShare, out RunHandle run);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_run_step(RunHandle run, ModelHandle model, UIntPtr maxSteps, out UIntPtr done, out UIntPtr total);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_run_finish(RunHandle run, out ResultHandle result);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern void sinmdm_run_free(IntPtr run);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_result_count(ResultHandle result, out UIntPtr count);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_result_frames(ResultHandle result, out UIntPtr frames);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_result_poses(ResultHandle result, UIntPtr sample, ref PoseBuffers buffers);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern void sinmdm_result_free(IntPtr result);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_stream_new(ModelHandle model, ref StreamOptions options, out StreamHandle stream);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_stream_supply(StreamHandle stream, ModelHandle model, ref PosesIn poses);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_stream_next(StreamHandle stream, ModelHandle model, UIntPtr frames, ref PoseBuffers buffers);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_stream_step(StreamHandle stream, ModelHandle model, UIntPtr maxSteps, UIntPtr ahead, out UIntPtr ready, out UIntPtr done, out UIntPtr total);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern void sinmdm_stream_free(IntPtr stream);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_write_bvh(ModelHandle model, ref PosesIn poses, byte[] path);
 
         internal static byte[] Utf8(string text)
         {
@@ -136,11 +136,18 @@ namespace Sinmdm
             finally { root.Free(); rot.Free(); trans.Free(); }
         }
 
-        internal static T WithInput<T>(Poses poses, Func<PosesIn, T> use) =>
-            WithBuffers(poses, b => use(new PosesIn
+        /// Poses handed to the library for a skeleton of `joints` joints: the library reads as many
+        /// values as the model's skeleton needs, so poses of another skeleton are refused here.
+        internal static T WithInput<T>(Poses poses, int joints, Func<PosesIn, T> use)
+        {
+            if (poses == null) throw new ArgumentNullException(nameof(poses));
+            if (poses.Joints != joints)
+                throw new ArgumentException("the poses have " + poses.Joints + " joints, the model's skeleton " + joints, nameof(poses));
+            return WithBuffers(poses, b => use(new PosesIn
             {
                 Frames = (UIntPtr)poses.Frames, Root = b.Root, Rotations = b.Rotations, Translations = b.Translations,
             }));
+        }
 
         /// Start, end pairs as spans; an odd count or a negative frame is refused.
         internal static Span[] Spans(int[] pairs, string name)

@@ -234,7 +234,11 @@ namespace Sinmdm
         Result Blocking(int status, ResultHandle handle)
         {
             if (status != 0) { handle.Dispose(); CheckTask(status); }
-            return new Result(handle, Joints);
+            // A callback that threw on the last step did not stop the run; what it threw is
+            // dropped here so that it is not taken for the cause of a later cancel.
+            progressError = null;
+            try { return new Result(handle, Joints); }
+            catch { handle.Dispose(); throw; }
         }
 
         /// <summary>New motion: `sampling.Count` samples of `frames` frames.</summary>
@@ -272,7 +276,7 @@ namespace Sinmdm
             var spans = Native.Spans(keep, nameof(keep));
             var r = Native.Size(ramp, nameof(ramp));
             ResultHandle result = null;
-            int status = Native.WithInput(reference, input =>
+            int status = Native.WithInput(reference, Joints, input =>
                 Native.sinmdm_inbetween(Handle, ref native, ref input, spans, (UIntPtr)spans.Length, r, out result));
             return Blocking(status, result);
         }
@@ -287,7 +291,7 @@ namespace Sinmdm
             var spans = Native.Spans(keep, nameof(keep));
             var r = Native.Size(ramp, nameof(ramp));
             RunHandle run = null;
-            int status = Native.WithInput(reference, input =>
+            int status = Native.WithInput(reference, Joints, input =>
                 Native.sinmdm_inbetween_begin(Handle, ref native, ref input, spans, (UIntPtr)spans.Length, r, out run));
             return Begun(status, run);
         }
@@ -298,7 +302,7 @@ namespace Sinmdm
             var native = sampling.ToNative();
             UIntPtr p = Native.Size(prefix, nameof(prefix)), s = Native.Size(suffix, nameof(suffix)), r = Native.Size(ramp, nameof(ramp));
             ResultHandle result = null;
-            int status = Native.WithInput(reference, input =>
+            int status = Native.WithInput(reference, Joints, input =>
                 Native.sinmdm_expand(Handle, ref native, ref input, p, s, r, out result));
             return Blocking(status, result);
         }
@@ -312,7 +316,7 @@ namespace Sinmdm
             var native = sampling.ToNative();
             UIntPtr p = Native.Size(prefix, nameof(prefix)), s = Native.Size(suffix, nameof(suffix)), r = Native.Size(ramp, nameof(ramp));
             RunHandle run = null;
-            int status = Native.WithInput(reference, input =>
+            int status = Native.WithInput(reference, Joints, input =>
                 Native.sinmdm_expand_begin(Handle, ref native, ref input, p, s, r, out run));
             return Begun(status, run);
         }
@@ -326,7 +330,7 @@ namespace Sinmdm
             var kept = Native.Spans(spans, nameof(spans));
             var r = Native.Size(ramp, nameof(ramp));
             ResultHandle result = null;
-            int status = Native.WithInput(reference, input =>
+            int status = Native.WithInput(reference, Joints, input =>
                 Native.sinmdm_compose(Handle, ref native, ref input, indices, (UIntPtr)indices.Length, root ? 1 : 0,
                                       kept, (UIntPtr)kept.Length, r, out result));
             return Blocking(status, result);
@@ -343,7 +347,7 @@ namespace Sinmdm
             var kept = Native.Spans(spans, nameof(spans));
             var r = Native.Size(ramp, nameof(ramp));
             RunHandle run = null;
-            int status = Native.WithInput(reference, input =>
+            int status = Native.WithInput(reference, Joints, input =>
                 Native.sinmdm_compose_begin(Handle, ref native, ref input, indices, (UIntPtr)indices.Length, root ? 1 : 0,
                                             kept, (UIntPtr)kept.Length, r, out run));
             return Begun(status, run);
@@ -355,7 +359,7 @@ namespace Sinmdm
             var native = sampling.ToNative();
             var f = Native.Size(factor, nameof(factor));
             ResultHandle result = null;
-            int status = Native.WithInput(content, input =>
+            int status = Native.WithInput(content, Joints, input =>
                 Native.sinmdm_harmonize(Handle, ref native, ref input, f, freeShare, out result));
             return Blocking(status, result);
         }
@@ -369,7 +373,7 @@ namespace Sinmdm
             var native = sampling.ToNative();
             var f = Native.Size(factor, nameof(factor));
             RunHandle run = null;
-            int status = Native.WithInput(content, input =>
+            int status = Native.WithInput(content, Joints, input =>
                 Native.sinmdm_harmonize_begin(Handle, ref native, ref input, f, freeShare, out run));
             return Begun(status, run);
         }
@@ -378,7 +382,7 @@ namespace Sinmdm
         public void WriteBvh(Poses poses, string path)
         {
             var p = Native.Utf8(path);
-            Native.Check(Native.WithInput(poses, input => Native.sinmdm_write_bvh(Handle, ref input, p)));
+            Native.Check(Native.WithInput(poses, Joints, input => Native.sinmdm_write_bvh(Handle, ref input, p)));
         }
 
         public void Dispose()
@@ -504,7 +508,7 @@ namespace Sinmdm
 
         /// <summary>Poses for the frames after the last supplied ones, for a composed stream.</summary>
         public void Supply(Poses poses) =>
-            Native.Check(Native.WithInput(poses, input => Native.sinmdm_stream_supply(handle, model.Handle, ref input)));
+            Native.Check(Native.WithInput(poses, model.Joints, input => Native.sinmdm_stream_supply(handle, model.Handle, ref input)));
 
         /// <summary>Prepares frames ahead with at most `maxSteps` denoising steps (call it each
         /// frame); returns the frames ready, so Next for that many runs no network.</summary>

@@ -709,7 +709,9 @@ enum SinmdmStatus sinmdm_stream_next(struct SinmdmStream *stream,
  steps: while fewer than `ahead` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) are ready, the
  next block is made a step at a time. A game calls it each frame with a small `max_steps`
  and reads with `sinmdm_stream_next`, which then never waits when enough frames are ready;
- the motion is the same bits as without preparing. `ready` (if not NULL) gets the frames
+ the motion is the same bits as without preparing (for a stream with composed joints, when
+ poses are supplied at least `ahead + 2 x block_frames + 10` frames past those handed out).
+ `ready` (if not NULL) gets the frames
  ready now; `done` and `total` (if not NULL) the steps of the block in the making (0 of 0
  when none is).
 

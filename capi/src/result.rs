@@ -68,7 +68,8 @@ pub unsafe extern "C" fn sinmdm_result_poses(
         let poses = result
             .generated
             .poses(sample)
-            .map_err(|e| Failure::new(SinmdmStatus::SinmdmInvalidArgument, e.to_string()))?;
+            // The batch was made by the network: motion it cannot give is a failed run.
+            .map_err(|e| Failure::new(SinmdmStatus::SinmdmTaskFailed, e.to_string()))?;
         unsafe { poses_out(&poses, joints, buffers) }
     })
 }

@@ -9,6 +9,15 @@ use crate::sampling::{feet_arg, method_arg, steps_arg};
 use crate::status::{Failure, SinmdmStatus, guard, guard_out};
 use crate::text::{give, handle, slice_arg};
 
+/// An error of a stream's block, whose arguments were checked when the stream was made: motion
+/// that cannot be decoded came from the network, so it is a failed run, not a bad argument.
+fn made_by_the_run(e: sinmdm::TaskError) -> Failure {
+    match e {
+        sinmdm::TaskError::Motion(m) => Failure::new(SinmdmStatus::SinmdmTaskFailed, m.to_string()),
+        other => Failure::from(other),
+    }
+}
+
 /// A stream (opaque): motion handed out a chunk at a time, forever, in flat memory.
 pub struct SinmdmStream {
     stream: Stream,
@@ -138,7 +147,10 @@ pub unsafe extern "C" fn sinmdm_stream_next(
         let joints = model.model.skeleton().len();
         // Check the buffers before making anything, so a bad one loses no motion.
         unsafe { pose_slices(buffers, frames, joints) }?;
-        let chunk = stream.stream.next(&mut model.model, frames)?;
+        let chunk = stream
+            .stream
+            .next(&mut model.model, frames)
+            .map_err(made_by_the_run)?;
         unsafe { poses_out(&chunk.poses(), joints, buffers) }
     })
 }
@@ -147,7 +159,9 @@ pub unsafe extern "C" fn sinmdm_stream_next(
 /// steps: while fewer than `ahead` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) are ready, the
 /// next block is made a step at a time. A game calls it each frame with a small `max_steps`
 /// and reads with `sinmdm_stream_next`, which then never waits when enough frames are ready;
-/// the motion is the same bits as without preparing. `ready` (if not NULL) gets the frames
+/// the motion is the same bits as without preparing (for a stream with composed joints, when
+/// poses are supplied at least `ahead + 2 x block_frames + 10` frames past those handed out).
+/// `ready` (if not NULL) gets the frames
 /// ready now; `done` and `total` (if not NULL) the steps of the block in the making (0 of 0
 /// when none is).
 ///
@@ -172,7 +186,10 @@ pub unsafe extern "C" fn sinmdm_stream_step(
                 "ahead is {ahead}; at most {SINMDM_MAX_SAMPLE_FRAMES} frames are prepared"
             )));
         }
-        let progress = stream.stream.prepare(&mut model.model, max_steps, ahead)?;
+        let progress = stream
+            .stream
+            .prepare(&mut model.model, max_steps, ahead)
+            .map_err(made_by_the_run)?;
         for (slot, value) in [
             (ready, stream.stream.ready_frames()),
             (done, progress.done),

@@ -102,9 +102,10 @@ pub unsafe extern "C" fn sinmdm_inbetween_begin(
     unsafe {
         begin(model, out, |m| {
             let sampling = sampling_arg(sampling)?;
+            let keep = spans(keep, span_count)?;
             let task = Task::Inbetween {
                 reference: reference_features(m, reference, "reference")?,
-                keep: spans(keep, span_count)?,
+                keep,
                 ramp,
             };
             request(&sampling, task)
@@ -210,11 +211,13 @@ pub unsafe extern "C" fn sinmdm_compose_begin(
                     "joint_count is {joint_count}; at most {SINMDM_MAX_JOINT_INDICES} joint indices are taken"
                 )));
             }
+            let joints = slice_arg(joints, joint_count, "joints")?.to_vec();
+            let spans = spans(spans_in, span_count)?;
             let task = Task::Compose {
                 reference: reference_features(m, reference, "reference")?,
-                joints: slice_arg(joints, joint_count, "joints")?.to_vec(),
+                joints,
                 root: root != 0,
-                spans: spans(spans_in, span_count)?,
+                spans,
                 ramp,
             };
             request(&sampling, task)

@@ -83,8 +83,8 @@ pub const DEFAULT_SAMPLES: usize = 4;
 
 fn valid_name(name: &str) -> bool {
     !name.is_empty()
-        && name != "."
-        && name != ".."
+        && !name.starts_with('.')
+        && !name.ends_with('.')
         && name
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
@@ -111,6 +111,8 @@ impl Manifest {
                 base.join(p)
             }
         };
+        // Compared lower-cased: on a case-insensitive file system `Walk` and `walk` would share
+        // a folder.
         let mut names = BTreeSet::new();
         let mut clips = Vec::with_capacity(file.clips.len());
         for (index, mut entry) in file.clips.into_iter().enumerate() {
@@ -129,7 +131,7 @@ impl Manifest {
                     "clips[{index}]: '{name}' is not a folder name (letters, digits, '-', '_', '.'); set `name`"
                 )));
             }
-            if !names.insert(name.clone()) {
+            if !names.insert(name.to_lowercase()) {
                 return Err(bad(format!(
                     "clips[{index}]: the name '{name}' is taken by another clip; set `name` so that every task has a folder of its own"
                 )));

@@ -75,9 +75,16 @@ impl TaskFolder {
             .map(|s| s.trim().to_string())
     }
 
-    /// Whether the folder holds a finished model of `fingerprint`.
+    /// Whether the folder holds a finished model of `fingerprint`: the model, and a status
+    /// that says done for that fingerprint (written last, after the evaluation and the card, so
+    /// a task killed between the model and its card is not taken for finished).
     pub fn is_current(&self, fingerprint: &str) -> bool {
-        self.model().is_file() && self.recorded_fingerprint().as_deref() == Some(fingerprint)
+        let done = matches!(
+            crate::status::TaskStatus::read(&self.status()),
+            Ok(Some(s)) if s.state == crate::status::State::Done && s.fingerprint == fingerprint
+        );
+        done && self.model().is_file()
+            && self.recorded_fingerprint().as_deref() == Some(fingerprint)
     }
 
     /// Decides what the task does, and makes the folder ready for it: a stale folder (another
@@ -128,6 +135,22 @@ mod tests {
         std::fs::create_dir_all(folder.run()).unwrap();
         assert_eq!(folder.prepare("a", always).unwrap(), Plan::Resume);
         std::fs::write(folder.model(), b"model").unwrap();
+        // A model without a done status (killed before its card) is not finished: resume.
+        assert_eq!(folder.prepare("a", always).unwrap(), Plan::Resume);
+        let status = crate::status::TaskStatus {
+            state: crate::status::State::Done,
+            name: "x".into(),
+            clip: "x.bvh".into(),
+            fingerprint: "a".into(),
+            started: 0,
+            finished: Some(1),
+            training_seconds: None,
+            steps: None,
+            error: None,
+            host: None,
+            pid: None,
+        };
+        status.write(&folder.status()).unwrap();
         assert_eq!(folder.prepare("a", always).unwrap(), Plan::UpToDate);
         assert_eq!(folder.prepare("b", always).unwrap(), Plan::Fresh);
         assert!(!folder.model().exists() && !folder.run().exists());

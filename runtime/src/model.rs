@@ -318,13 +318,25 @@ impl Model {
             return Ok(out);
         };
         std::thread::scope(|scope| {
-            let others: Vec<_> = sessions
-                .zip(shares)
-                .map(|(session, share)| {
-                    scope.spawn(move || denoise_share(session, path, x_t, t, share))
-                })
-                .collect();
-            let mut result = denoise_share(own_session, path, x_t, t, own_share);
+            // A share whose thread the system refuses runs on the calling thread: the values
+            // are the same wherever a sample runs.
+            let mut result = Ok(());
+            let mut others = Vec::new();
+            for (session, share) in sessions.zip(shares) {
+                let spawned = std::thread::Builder::new()
+                    .name("sinmdm-denoise".into())
+                    .spawn_scoped(scope, move || denoise_share(session, path, x_t, t, share));
+                match spawned {
+                    Ok(handle) => others.push(handle),
+                    Err(_) => {
+                        result = result.and(Err(ModelError::Run {
+                            path: path.to_path_buf(),
+                            message: "the system refused a thread for the batch".into(),
+                        }))
+                    }
+                }
+            }
+            result = result.and(denoise_share(own_session, path, x_t, t, own_share));
             for other in others {
                 let joined = other.join().unwrap_or_else(|_| {
                     Err(ModelError::Run {

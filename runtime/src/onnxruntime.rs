@@ -369,7 +369,9 @@ fn load(asked: Option<&Path>) -> Result<&'static OnnxRuntime, RuntimeLibraryErro
         return check(runtime);
     }
     let list = match asked {
-        Some(p) if p.is_file() => vec![Candidate::File(p.to_path_buf())],
+        Some(p) if p.is_file() => vec![Candidate::File(
+            std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()),
+        )],
         Some(p) => {
             return Err(RuntimeLibraryError::LoadFailed {
                 path: p.to_path_buf(),
@@ -392,9 +394,14 @@ fn load(asked: Option<&Path>) -> Result<&'static OnnxRuntime, RuntimeLibraryErro
             Ok(environment) => {
                 return Ok(LOADED.get_or_init(|| OnnxRuntime { path, environment }));
             }
-            Err(message) => {
+            Err(Attempt::NotLoaded(message)) => {
                 tried.push(format!("{candidate} ({message})"));
                 messages.push(message);
+            }
+            // The library loaded (and stays loaded: one per process) but would not start:
+            // trying another would only reuse it.
+            Err(Attempt::Failed(message)) => {
+                return Err(RuntimeLibraryError::LoadFailed { path, message });
             }
         }
     }
@@ -416,16 +423,31 @@ fn load(asked: Option<&Path>) -> Result<&'static OnnxRuntime, RuntimeLibraryErro
     }
 }
 
+/// Why a candidate library did not give an environment.
+enum Attempt {
+    /// It could not be loaded (missing, not a library, too old): the search goes on.
+    NotLoaded(String),
+    /// It loaded but the environment would not start: the process keeps it, so the search ends.
+    Failed(String),
+}
+
 /// Loads the library at `path` (a bare name goes to the system loader) and makes the process's
 /// environment; the loader's or onnxruntime's words on failure (a release older than
-/// [`ONNXRUNTIME_OLDEST`] is refused here).
-fn start_environment(path: &Path) -> Result<ort::environment::Environment, String> {
+/// [`ONNXRUNTIME_OLDEST`] is refused before it is kept).
+fn start_environment(path: &Path) -> Result<ort::environment::Environment, Attempt> {
+    // ort resolves a bare name against the executable's folder and asks for that folder, which
+    // cannot be had everywhere; there the system loader is not tried.
+    if !path.is_absolute() && std::env::current_exe().is_err() {
+        return Err(Attempt::NotLoaded(
+            "the executable's folder is unknown here, so the system loader is not asked".into(),
+        ));
+    }
     ort::init_from(path)
-        .map_err(|e| e.to_string())?
+        .map_err(|e| Attempt::NotLoaded(e.to_string()))?
         .with_name("sinmdm")
         .with_telemetry(false)
         .build()
-        .map_err(|e| e.to_string())
+        .map_err(|e| Attempt::Failed(e.to_string()))
 }
 
 fn same_file(a: &Path, b: &Path) -> bool {

@@ -244,7 +244,16 @@ pub fn run_task(
     let outcome = train_export_evaluate(&manifest, &entry, &folder, plan, device, stop, on_step);
     match &outcome {
         Ok(TaskEnd::Trained { .. }) | Ok(TaskEnd::UpToDate(_)) => {}
-        Ok(TaskEnd::Interrupted) => return outcome,
+        Ok(TaskEnd::Interrupted) => {
+            // Stopped by a signal (a scheduler's time limit or preemption): the checkpoint
+            // stays for the next try, and the status says so.
+            status.state = State::Failed;
+            status.error =
+                Some("interrupted; submit the task again to resume from its checkpoint".into());
+            status.finished = Some(now());
+            status.write(&folder.status())?;
+            return outcome;
+        }
         Err(e) => {
             status.state = State::Failed;
             status.error = Some(e.to_string());

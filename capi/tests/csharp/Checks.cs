@@ -76,6 +76,8 @@ static class Checks
 
             try { model.Inbetween(once, new[] { 0, 10, 30 }, 5, sampling); Expect(false, "odd keep refused"); }
             catch (ArgumentException) { passed++; }
+            try { model.Expand(new Poses(40, model.Joints - 1), 5, 5, 3, sampling); Expect(false, "poses of another skeleton refused"); }
+            catch (ArgumentException) { passed++; }
             try { model.Generate(-5, sampling); Expect(false, "negative frames refused"); }
             catch (ArgumentOutOfRangeException) { passed++; }
             try { model.Generate(40, new Sampling { Seed = 1, Count = 0 }); Expect(false, "zero samples refused"); }

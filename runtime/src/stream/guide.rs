@@ -8,12 +8,16 @@ use ndarray::{Array2, s};
 use crate::model_file::ModelMetadata;
 use crate::motion::{MotionError, Pose, features_from_poses, motion_from_poses};
 
-/// Supplied poses by stream frame.
+/// Supplied poses by stream frame. Pose `i` supplied in all belongs to stream frame `i`, always:
+/// poses for frames already past every block that could use them are dropped on arrival, never
+/// moved to later frames.
 #[derive(Debug, Clone, Default)]
 pub struct Guide {
     /// The stream frame of `poses[0]`.
     first: usize,
     poses: VecDeque<Pose>,
+    /// Frames before this one are no longer needed by any block.
+    floor: usize,
 }
 
 impl Guide {
@@ -27,17 +31,20 @@ impl Guide {
         let layout = &metadata.layout;
         motion_from_poses(&layout.skeleton, layout.fps, poses)?;
         self.poses.extend(poses.iter().cloned());
+        self.drop_below_floor();
         Ok(())
     }
 
     /// Forgets poses before stream frame `frame`.
     pub fn forget_before(&mut self, frame: usize) {
-        while self.first < frame && !self.poses.is_empty() {
+        self.floor = self.floor.max(frame);
+        self.drop_below_floor();
+    }
+
+    fn drop_below_floor(&mut self) {
+        while self.first < self.floor && !self.poses.is_empty() {
             self.poses.pop_front();
             self.first += 1;
-        }
-        if self.poses.is_empty() {
-            self.first = self.first.max(frame);
         }
     }
 

@@ -315,7 +315,10 @@ impl Stream {
     /// fewer than `ahead` frames are ready, it steps the next block's run (starting it if
     /// needed) and queues its frames once it finishes. A game calls it every frame with a
     /// small `max_steps` and reads with [`Stream::next`], which then never waits when enough
-    /// frames are ready. The motion is the same bits as a stream read without preparing.
+    /// frames are ready. The motion is the same bits as a stream read without preparing. A
+    /// stream with composed joints starts a block's guidance from the poses supplied when the
+    /// block starts: supply at least `ahead` + [`Stream::lookahead`] frames past those handed out
+    /// before preparing, or blocks are guided by fewer poses than a later start would see.
     /// Returns the progress of the block in the making (`0 of 0` when none is).
     pub fn prepare<D: Denoiser>(
         &mut self,
@@ -428,7 +431,9 @@ impl Stream {
         let n = window.frames;
         let normalized = sampler.into_sample().index_axis_move(Axis(0), 0);
         let keep = sizes.context + sizes.ramp;
-        self.carried = Some(normalized.slice(s![.., n - keep..]).to_owned());
+        // Nothing of the stream changes until every fallible step has passed: a block that
+        // cannot be decoded leaves the stream as it was (the same block is made again).
+        let carried = normalized.slice(s![.., n - keep..]).to_owned();
         let raw = self.metadata.normalizer.denormalize(normalized.view());
 
         // Decode the context and the final frames; carry the root on from the last chunk.
@@ -436,6 +441,7 @@ impl Stream {
         let layout = &self.metadata.layout;
         let joints = layout.skeleton.len();
         let mut motion = decode(layout, raw.slice(s![.., ..done.end]))?;
+        let mut last_root = self.last_root;
         if let Some(root) = &layout.root {
             let r = root.joint;
             if let (Some(last), true) = (self.last_root, done.start > 0) {
@@ -445,7 +451,7 @@ impl Stream {
                     *t += offset;
                 }
             }
-            self.last_root = Some(motion.translations[(done.end - 1) * joints + r]);
+            last_root = Some(motion.translations[(done.end - 1) * joints + r]);
         }
         if self.feet == Feet::Planted {
             if let Some(tail) = &self.tail {
@@ -471,6 +477,8 @@ impl Stream {
             };
             motion = plant_feet(layout, &motion, &labels, &kept, &options)?.0;
         }
+        self.carried = Some(carried);
+        self.last_root = last_root;
         for frame in done.clone() {
             let range = frame * joints..(frame + 1) * joints;
             self.ready.push_back(Frame {
