@@ -28,6 +28,19 @@ pub enum Standing {
     Stale,
 }
 
+impl Standing {
+    /// The word for it, as in the JSON report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Standing::Pending => "pending",
+            Standing::Running => "running",
+            Standing::Failed => "failed",
+            Standing::Done => "done",
+            Standing::Stale => "stale",
+        }
+    }
+}
+
 /// One clip's line of the report.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Row {
@@ -127,9 +140,7 @@ fn cell(value: Option<f64>, digits: usize) -> String {
 pub fn status_text(rows: &[Row]) -> String {
     let mut out = String::new();
     for row in rows {
-        let state = serde_json::to_value(row.standing).ok();
-        let state = state.as_ref().and_then(|v| v.as_str()).unwrap_or("?");
-        out.push_str(&format!("{:<24} {state}", row.name));
+        out.push_str(&format!("{:<24} {}", row.name, row.standing.name()));
         if let Some(error) = &row.error {
             out.push_str(&format!(": {}", error.lines().next().unwrap_or("")));
         }
@@ -154,11 +165,10 @@ pub fn markdown(rows: &[Row]) -> String {
         "| clip | state | coverage (%) | global div. | local div. | harmonic mean | replay (s) | steps | training (min) |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
-        let state = serde_json::to_value(r.standing).ok();
         out.push_str(&format!(
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.name,
-            state.as_ref().and_then(|v| v.as_str()).unwrap_or("?"),
+            r.standing.name(),
             cell(r.coverage, 1),
             cell(r.global_diversity, 3),
             cell(r.local_diversity, 3),
@@ -221,4 +231,22 @@ pub fn write_report(
         written.push(path);
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Standing;
+
+    #[test]
+    fn the_words_are_the_json_reports() {
+        for s in [
+            Standing::Pending,
+            Standing::Running,
+            Standing::Failed,
+            Standing::Done,
+            Standing::Stale,
+        ] {
+            assert_eq!(serde_json::to_value(s).unwrap(), s.name());
+        }
+    }
 }

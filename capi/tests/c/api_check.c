@@ -87,17 +87,22 @@ static void poses_free(Poses *p) {
   free(p->trans);
 }
 
+/* Generates with `sampling` and writes sample 0 into `poses` (of the frames asked for). */
+static void generate_into(SinmdmModel *model, const SinmdmSampling *sampling, Poses *poses) {
+  SinmdmResult *result = NULL;
+  CHECK_OK(sinmdm_generate(model, sampling, poses->frames, &result));
+  SinmdmPoseBuffers buffers = buffers_of(poses);
+  CHECK_OK(sinmdm_result_poses(result, 0, &buffers));
+  sinmdm_result_free(result);
+}
+
 /* Generates `frames` frames with `sampling` and prints the first sample under `label`. */
 static void print_generated(SinmdmModel *model, const SinmdmSampling *sampling, size_t frames,
                             size_t joints, const char *label) {
-  SinmdmResult *result = NULL;
-  CHECK_OK(sinmdm_generate(model, sampling, frames, &result));
   Poses poses = poses_alloc(frames, joints);
-  SinmdmPoseBuffers buffers = buffers_of(&poses);
-  CHECK_OK(sinmdm_result_poses(result, 0, &buffers));
+  generate_into(model, sampling, &poses);
   print_poses(label, &poses);
   poses_free(&poses);
-  sinmdm_result_free(result);
 }
 
 /* A progress callback that cancels once `*userdata` steps are done. */
@@ -138,13 +143,7 @@ static void finish_into(SinmdmRun *run, Poses *out) {
 static void check_stepping(SinmdmModel *model, size_t joints, const SinmdmPoses *reference) {
   SinmdmSampling sampling = {13, 1, 7, SINMDM_FEET_PLANTED, SINMDM_METHOD_ANCESTRAL, 0.0};
   Poses once = poses_alloc(40, joints);
-  {
-    SinmdmResult *result = NULL;
-    CHECK_OK(sinmdm_generate(model, &sampling, 40, &result));
-    SinmdmPoseBuffers b = buffers_of(&once);
-    CHECK_OK(sinmdm_result_poses(result, 0, &b));
-    sinmdm_result_free(result);
-  }
+  generate_into(model, &sampling, &once);
   size_t per_call[3] = {1, 3, SIZE_MAX};
   for (int i = 0; i < 3; i++) {
     SinmdmRun *run = NULL;
@@ -207,13 +206,7 @@ static void check_stepping(SinmdmModel *model, size_t joints, const SinmdmPoses 
   expect_true(cancelled == NULL, "a cancelled call gives no result");
   stop_at = SIZE_MAX;
   Poses after = poses_alloc(40, joints);
-  {
-    SinmdmResult *result = NULL;
-    CHECK_OK(sinmdm_generate(model, &sampling, 40, &result));
-    SinmdmPoseBuffers b = buffers_of(&after);
-    CHECK_OK(sinmdm_result_poses(result, 0, &b));
-    sinmdm_result_free(result);
-  }
+  generate_into(model, &sampling, &after);
   expect_true(same_poses(&after, &once), "the model after a cancel gives the same motion");
   CHECK_OK(sinmdm_model_set_progress(model, NULL, NULL));
   poses_free(&after);
