@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use ndarray::{Array3, ArrayView3, Axis};
 use ort::session::Session;
 use ort::session::builder::GraphOptimizationLevel;
-use ort::value::Tensor;
+use ort::value::TensorRef;
 use thiserror::Error;
 
 use crate::limits::MAX_THREADS;
@@ -388,12 +388,18 @@ fn denoise_one(
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    let data: Vec<f32> = match x_t.as_slice() {
-        Some(s) => s.to_vec(),
-        None => x_t.iter().copied().collect(),
+    // A contiguous sample is lent to onnxruntime as it is (no copy); any other is copied.
+    let copied: Vec<f32>;
+    let data = match x_t.as_slice() {
+        Some(s) => s,
+        None => {
+            copied = x_t.iter().copied().collect();
+            &copied
+        }
     };
-    let xs = Tensor::from_array(([1, f, n], data.into_boxed_slice())).map_err(run_failed)?;
-    let ts = Tensor::from_array(([1], vec![t].into_boxed_slice())).map_err(run_failed)?;
+    let xs = TensorRef::from_array_view(([1, f, n], data)).map_err(run_failed)?;
+    let steps = [t];
+    let ts = TensorRef::from_array_view(([1], &steps[..])).map_err(run_failed)?;
     let outputs = session
         .run(ort::inputs![INPUT_FEATURES => xs, INPUT_STEP => ts])
         .map_err(run_failed)?;

@@ -16,6 +16,6 @@ target/release/sinmdm-train tests/data/bvh/human_walk_cmu_131_01.bvh --config "$
 cargo bench -q -p sinmdm --bench sampling -- "$work/paper.onnx" "$frames" "$threads" 2>/dev/null
 start=$(date +%s.%N)
 .venv/bin/python -m sinmdm_reference generate -m "$work/paper.onnx" --frames "$frames" \
-    --steps all --threads "$threads" -o "$work/python.json" 2>/dev/null
+    --steps all -o "$work/python.json" 2>/dev/null
 end=$(date +%s.%N)
 echo "Python reference (numpy + onnxruntime), 1 sample of 1000 steps: $(echo "$end - $start" | bc) s"

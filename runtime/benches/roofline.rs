@@ -1,0 +1,253 @@
+//! What sampling costs beyond its network, side by side in one process:
+//!
+//! - **loop**: one sample of all 1 000 steps through the runtime (`plan(..).run`, raw feet)
+//!   against a bare onnxruntime loop over the same file (a session opened as the runtime opens
+//!   its own: one intra-op thread, full graph optimisation, no spinning; its output fed back as
+//!   the next input), in alternating paired rounds; the median of the per-round ratios. For
+//!   reference it also times the bare loop on onnxruntime's own two-thread pool (what a Python
+//!   loop with default options gets, at the price of values that depend on the thread count).
+//! - **stream**: a stream's 1-second chunks at the default options (mean, median, worst), the
+//!   share of its time spent inside the network, and the worst chunk when the stream is
+//!   prepared a few steps per chunk ([`Stream::prepare`]) as a game would.
+//! - **crowd**: 20 samples at the default steps, in process.
+//!
+//! `cargo bench -p sinmdm --bench roofline -- [MODEL.onnx] [FRAMES] [ROUNDS]` (default: the
+//! shipped walk, 498 frames, 5 rounds). `scripts/bench_roofline.sh` runs it with the GEMM
+//! roofline and the whole-process crowd of `scripts/lab/profile_network.py`.
+
+use std::ops::ControlFlow;
+use std::time::Instant;
+
+use ndarray::{Array3, ArrayView3};
+use ort::session::Session;
+use ort::session::builder::GraphOptimizationLevel;
+use ort::value::Tensor;
+use sinmdm::network::{INPUT_FEATURES, INPUT_STEP, OUTPUT_FEATURES};
+use sinmdm::{
+    Denoiser, Feet, Model, ModelError, ModelOptions, Request, Stream, StreamOptions, Task,
+};
+
+fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// A bare loop: `steps` calls of one session, each call's output the next call's input.
+struct BareLoop {
+    session: Session,
+    features: usize,
+    frames: usize,
+}
+
+impl BareLoop {
+    fn open(path: &str, threads: usize, features: usize, frames: usize) -> BareLoop {
+        let rt = sinmdm::init_onnxruntime().expect("onnxruntime");
+        let session = Session::builder(rt.environment())
+            .and_then(|s| Ok(s.with_optimization_level(GraphOptimizationLevel::All)?))
+            .and_then(|s| Ok(s.with_intra_threads(threads)?))
+            .and_then(|s| Ok(s.with_inter_threads(1)?))
+            .and_then(|s| Ok(s.with_intra_op_spinning(false)?))
+            .and_then(|mut s| s.commit_from_file(path))
+            .expect("session");
+        BareLoop {
+            session,
+            features,
+            frames,
+        }
+    }
+
+    /// Seconds for `steps` calls.
+    fn run(&mut self, steps: usize) -> f64 {
+        let shape = [1, self.features, self.frames];
+        let mut x = vec![0.5f32; self.features * self.frames];
+        let start = Instant::now();
+        for k in (0..steps).rev() {
+            let xs = Tensor::from_array((shape, std::mem::take(&mut x))).expect("input");
+            let ts = Tensor::from_array(([1usize], vec![k as i64])).expect("step");
+            let out = self
+                .session
+                .run(ort::inputs![INPUT_FEATURES => xs, INPUT_STEP => ts])
+                .expect("run");
+            let (_, v) = out[OUTPUT_FEATURES]
+                .try_extract_tensor::<f32>()
+                .expect("x0");
+            x = v.to_vec();
+        }
+        std::hint::black_box(x[0]);
+        start.elapsed().as_secs_f64()
+    }
+}
+
+/// The model, with the time spent in its calls counted.
+struct Timed<'a> {
+    model: &'a mut Model,
+    inside: f64,
+}
+
+impl Denoiser for Timed<'_> {
+    type Error = ModelError;
+    fn features(&self) -> usize {
+        self.model.features()
+    }
+    fn denoise(&mut self, x_t: ArrayView3<'_, f32>, t: &[i64]) -> Result<Array3<f32>, ModelError> {
+        let start = Instant::now();
+        let out = self.model.denoise(x_t, t);
+        self.inside += start.elapsed().as_secs_f64();
+        out
+    }
+}
+
+fn generate(model: &mut Model, count: usize, frames: usize, steps: Option<usize>) -> f64 {
+    let request = Request {
+        task: Task::Generate { frames },
+        count,
+        seed: 7,
+        steps,
+        feet: Feet::Raw,
+        method: Default::default(),
+    };
+    let plan = sinmdm::plan(model.metadata(), &request).expect("plan");
+    let start = Instant::now();
+    let out = plan
+        .run(model, &mut |_, _| ControlFlow::Continue(()))
+        .expect("run");
+    std::hint::black_box(out.normalized[[0, 0, 0]]);
+    start.elapsed().as_secs_f64()
+}
+
+fn loop_against_bare(path: &str, frames: usize, rounds: usize) {
+    let mut model = Model::open(path, &ModelOptions { threads: Some(1) }).expect("model");
+    let f = model.features();
+    let steps = model.metadata().diffusion.steps;
+    let mut bare = BareLoop::open(path, 1, f, frames);
+    let mut pool = BareLoop::open(path, 2, f, frames);
+    bare.run(5);
+    pool.run(5);
+    generate(&mut model, 1, frames, Some(5));
+    let (mut ours, mut bares, mut pools, mut ratios) = (vec![], vec![], vec![], vec![]);
+    for round in 0..rounds {
+        let (o, b) = if round % 2 == 0 {
+            let o = generate(&mut model, 1, frames, None);
+            (o, bare.run(steps))
+        } else {
+            let b = bare.run(steps);
+            (generate(&mut model, 1, frames, None), b)
+        };
+        ours.push(o);
+        bares.push(b);
+        ratios.push(o / b);
+        pools.push(pool.run(steps));
+    }
+    let (lo, hi) = ratios
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
+    println!(
+        "loop, 1 sample x {frames} frames x {steps} steps (median of {rounds} paired rounds):"
+    );
+    println!(
+        "  runtime {:.3} s, bare onnxruntime loop (the runtime's session options) {:.3} s: ratio {:.3} (rounds {lo:.3} to {hi:.3})",
+        median(&ours),
+        median(&bares),
+        median(&ratios)
+    );
+    println!(
+        "  bare loop on onnxruntime's two-thread pool {:.3} s: runtime / pool {:.3} (values depend on the thread count)",
+        median(&pools),
+        median(&ours) / median(&pools)
+    );
+}
+
+fn stream_chunks(path: &str, seconds: usize) {
+    let mut model = Model::open(path, &ModelOptions::default()).expect("model");
+    let second = model.fps().round() as usize;
+    let mut stream = Stream::new(model.metadata(), StreamOptions::default()).expect("stream");
+    let mut times = Vec::new();
+    let mut timed = Timed {
+        model: &mut model,
+        inside: 0.0,
+    };
+    let start = Instant::now();
+    for _ in 0..seconds {
+        let t = Instant::now();
+        std::hint::black_box(stream.next(&mut timed, second).expect("chunk").frames());
+        times.push(t.elapsed().as_secs_f64());
+    }
+    let total = start.elapsed().as_secs_f64();
+    let worst = times.iter().copied().fold(0.0, f64::max);
+    println!(
+        "stream, {seconds} 1-second chunks at the default options (blocks of {} frames):",
+        stream.sizes().block
+    );
+    println!(
+        "  mean {:.2} ms, median {:.2} ms, worst {:.1} ms per chunk; {:.1} % of the time inside the network",
+        total / seconds as f64 * 1e3,
+        median(&times) * 1e3,
+        worst * 1e3,
+        timed.inside / total * 100.0
+    );
+    // The same stream prepared a few steps per chunk (as a game's frame loop would): the
+    // steps per chunk that keep a block ahead, and the worst chunk then.
+    let mut stream = Stream::new(model.metadata(), StreamOptions::default()).expect("stream");
+    let block = stream.sizes().block;
+    let steps = stream.block_progress().total.max(sinmdm::DEFAULT_STEPS);
+    let per_chunk = (steps * second).div_ceil(block) + 1;
+    let mut times = Vec::new();
+    let start = Instant::now();
+    for _ in 0..seconds {
+        let t = Instant::now();
+        std::hint::black_box(stream.next(&mut model, second).expect("chunk").frames());
+        stream
+            .prepare(&mut model, per_chunk, block + second)
+            .expect("prepare");
+        times.push(t.elapsed().as_secs_f64());
+    }
+    let total = start.elapsed().as_secs_f64();
+    let mut sorted = times.clone();
+    sorted.sort_by(f64::total_cmp);
+    println!(
+        "  prepared {per_chunk} steps per chunk: mean {:.2} ms, worst {:.1} ms (the first chunk pays its block), worst after it {:.1} ms",
+        total / seconds as f64 * 1e3,
+        sorted[sorted.len() - 1] * 1e3,
+        times[1..].iter().copied().fold(0.0, f64::max) * 1e3
+    );
+}
+
+fn crowd(path: &str, frames: usize, rounds: usize) {
+    let mut model = Model::open(path, &ModelOptions::default()).expect("model");
+    generate(&mut model, 2, frames, Some(2));
+    let times: Vec<f64> = (0..rounds.min(3))
+        .map(|_| generate(&mut model, 20, frames, Some(sinmdm::DEFAULT_STEPS)))
+        .collect();
+    println!(
+        "crowd, 20 samples x {frames} frames x {} steps on {} threads, in process: {:.3} s (median of {})",
+        sinmdm::DEFAULT_STEPS,
+        model.threads(),
+        median(&times),
+        times.len()
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    let path = args
+        .first()
+        .filter(|p| !p.is_empty())
+        .cloned()
+        .unwrap_or_else(|| {
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../onnx-models/human_walk_cmu.onnx"
+            )
+            .to_string()
+        });
+    let frames: usize = args.get(1).map_or(498, |s| s.parse().expect("FRAMES"));
+    let rounds: usize = args.get(2).map_or(5, |s| s.parse().expect("ROUNDS"));
+    println!("model {path}");
+    loop_against_bare(&path, frames, rounds);
+    stream_chunks(&path, 180);
+    crowd(&path, frames, rounds);
+}
