@@ -27,77 +27,15 @@ if [ $# -ge 1 ]; then work=$1; else work=$(mktemp -d); own_work=1; fi
 mkdir -p "$work"
 work=$(cd "$work" && pwd)
 bin="$repo/target/release"
-pids=()
-cleanup() {
-  if [ -n "${SLURM_CONF:-}" ] && [ -f "$SLURM_CONF" ]; then
-    scancel --full --signal=KILL --user=root >/dev/null 2>&1 || true
-    for _ in $(seq 1 20); do
-      [ -z "$(squeue -h 2>/dev/null)" ] && break
-      sleep 0.5
-    done
-  fi
-  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
-  for pid in "${pids[@]}"; do wait "$pid" 2>/dev/null || true; done
-}
-trap cleanup EXIT
+# shellcheck source=tests/cluster/slurm_node.sh
+. "$repo/tests/cluster/slurm_node.sh"
+trap slurm_node_stop EXIT
 fail() {
   echo "FAIL: $*" >&2
   for log in "$work"/slurm/*.log; do echo "--- $log" >&2; tail -n 20 "$log" >&2; done
   exit 1
 }
-
-# munge: a root-owned key of mode 0600, a socket folder of mode 0755.
-mkdir -p "$work/munge" "$work/slurm/state" "$work/slurm/spool"
-chmod 755 "$work" "$work/munge"
-dd if=/dev/urandom of="$work/munge/munge.key" bs=1024 count=1 status=none
-chmod 600 "$work/munge/munge.key"
-socket="$work/munge/munge.socket"
-munged -F --key-file="$work/munge/munge.key" --socket="$socket" --pid-file="$work/munge/munged.pid" \
-  --log-file="$work/slurm/munged.log" --seed-file="$work/munge/munged.seed" >/dev/null 2>&1 &
-pids+=($!)
-
-export SLURM_CONF="$work/slurm/slurm.conf"
-cat > "$SLURM_CONF" <<CONF
-ClusterName=sinmdmtest
-SlurmctldHost=localhost(127.0.0.1)
-SlurmctldPort=16917
-SlurmdPort=16918
-SlurmUser=root
-AuthType=auth/munge
-AuthInfo=socket=$socket
-CredType=cred/munge
-StateSaveLocation=$work/slurm/state
-SlurmdSpoolDir=$work/slurm/spool
-SlurmctldPidFile=$work/slurm/slurmctld.pid
-SlurmdPidFile=$work/slurm/slurmd.pid
-SlurmctldLogFile=$work/slurm/slurmctld.log
-SlurmdLogFile=$work/slurm/slurmd.log
-ProctrackType=proctrack/linuxproc
-TaskPlugin=task/none
-JobAcctGatherType=jobacct_gather/none
-JobCompType=jobcomp/filetxt
-JobCompLoc=$work/slurm/jobcomp.log
-SchedulerType=sched/backfill
-SelectType=select/cons_tres
-SelectTypeParameters=CR_CPU
-ReturnToService=2
-MpiDefault=none
-KillWait=5
-NodeName=localhost NodeAddr=127.0.0.1 CPUs=2 RealMemory=16000 State=UNKNOWN
-PartitionName=main Nodes=localhost Default=YES MaxTime=INFINITE State=UP
-CONF
-for _ in $(seq 1 50); do [ -S "$socket" ] && break; sleep 0.1; done
-[ -S "$socket" ] || fail "munged did not start"
-slurmctld -D -f "$SLURM_CONF" >/dev/null 2>&1 &
-pids+=($!)
-slurmd -D -f "$SLURM_CONF" >/dev/null 2>&1 &
-pids+=($!)
-for _ in $(seq 1 60); do
-  sinfo -h -o %t 2>/dev/null | grep -q idle && break
-  sleep 0.5
-done
-sinfo -h -o %t 2>/dev/null | grep -q idle || fail "the node did not come up"
-echo "slurm: up"
+slurm_node_start "$work"
 
 # The library: four shipped clips, a short training (one of them long enough to be killed).
 lib="$work/lib"
@@ -237,5 +175,5 @@ grep -q "| walk | done |" "$work/report/report.md" || fail "no table"
 echo "5. a failed clip is reported with its error; report.md and contact_sheet.png written"
 echo "slurm library: all checks passed"
 trap - EXIT
-cleanup
+slurm_node_stop
 if [ "$own_work" = 1 ]; then rm -rf "$work"; fi
