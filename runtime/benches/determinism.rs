@@ -8,12 +8,14 @@
 //! `cargo bench -p sinmdm --bench determinism -- [MODEL.onnx] [FRAMES] [THREADS]` (default: the
 //! shipped walk, 498 frames, 2 threads).
 
+mod common;
+
 use std::ops::ControlFlow;
 use std::time::Instant;
 
+use common::{median, open_session};
 use ndarray::{Array3, ArrayView3};
 use ort::session::Session;
-use ort::session::builder::GraphOptimizationLevel;
 use ort::value::Tensor;
 use sinmdm::network::{INPUT_FEATURES, INPUT_STEP, OUTPUT_FEATURES};
 use sinmdm::{Denoiser, Feet, Model, ModelError, ModelOptions, Request, Task};
@@ -26,14 +28,7 @@ struct BatchSession {
 
 impl BatchSession {
     fn open(path: &str, threads: usize, features: usize) -> BatchSession {
-        let rt = sinmdm::init_onnxruntime().expect("onnxruntime");
-        let session = Session::builder(rt.environment())
-            .and_then(|s| Ok(s.with_optimization_level(GraphOptimizationLevel::All)?))
-            .and_then(|s| Ok(s.with_intra_threads(threads)?))
-            .and_then(|s| Ok(s.with_inter_threads(1)?))
-            .and_then(|s| Ok(s.with_intra_op_spinning(false)?))
-            .and_then(|mut s| s.commit_from_file(path))
-            .expect("session");
+        let session = open_session(path, threads);
         BatchSession { session, features }
     }
 }
@@ -57,11 +52,6 @@ impl Denoiser for BatchSession {
             .expect("x0");
         Ok(Array3::from_shape_vec((b, f, n), v.to_vec()).expect("shape"))
     }
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
 }
 
 fn request(count: usize, frames: usize) -> Request {
@@ -185,7 +175,7 @@ fn main() {
             std::hint::black_box(generated.normalized[[0, 0, 0]]);
             news.push(start.elapsed().as_secs_f64());
         }
-        let (o, n) = (median(&mut olds), median(&mut news));
+        let (o, n) = (median(&olds), median(&news));
         println!("| {count} | {o:.3} | {n:.3} | {:.2} |", n / o);
     }
 }

@@ -5,14 +5,12 @@
 //! `cargo bench -p sinmdm --bench feet [-- MODEL.onnx]` (default: the shipped walk model)
 
 use std::ops::ControlFlow;
+mod common;
+
 use std::time::Instant;
 
+use common::median;
 use sinmdm::{Feet, Model, ModelOptions, Request, Task};
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 fn main() {
     let path = std::env::args()
@@ -52,7 +50,7 @@ fn main() {
         }
         planted.push(t.elapsed().as_secs_f64());
     }
-    let (s, r, p) = (median(sampling), median(raw), median(planted));
+    let (s, r, p) = (median(&sampling), median(&raw), median(&planted));
     println!("{path}: 20 samples x {frames} frames, 100 steps (median of 3)");
     println!("  sampling           {s:8.3} s");
     println!("  decoding, raw      {r:8.3} s");

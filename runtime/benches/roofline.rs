@@ -18,20 +18,13 @@
 use std::ops::ControlFlow;
 use std::time::Instant;
 
-use ndarray::{Array3, ArrayView3};
+mod common;
+
+use common::{Timed, median, open_session};
 use ort::session::Session;
-use ort::session::builder::GraphOptimizationLevel;
 use ort::value::Tensor;
 use sinmdm::network::{INPUT_FEATURES, INPUT_STEP, OUTPUT_FEATURES};
-use sinmdm::{
-    Denoiser, Feet, Model, ModelError, ModelOptions, Request, Stream, StreamOptions, Task,
-};
-
-fn median(values: &[f64]) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
+use sinmdm::{Feet, Model, ModelOptions, Request, Stream, StreamOptions, Task};
 
 /// A bare loop: `steps` calls of one session, each call's output the next call's input.
 struct BareLoop {
@@ -42,14 +35,7 @@ struct BareLoop {
 
 impl BareLoop {
     fn open(path: &str, threads: usize, features: usize, frames: usize) -> BareLoop {
-        let rt = sinmdm::init_onnxruntime().expect("onnxruntime");
-        let session = Session::builder(rt.environment())
-            .and_then(|s| Ok(s.with_optimization_level(GraphOptimizationLevel::All)?))
-            .and_then(|s| Ok(s.with_intra_threads(threads)?))
-            .and_then(|s| Ok(s.with_inter_threads(1)?))
-            .and_then(|s| Ok(s.with_intra_op_spinning(false)?))
-            .and_then(|mut s| s.commit_from_file(path))
-            .expect("session");
+        let session = open_session(path, threads);
         BareLoop {
             session,
             features,
@@ -76,25 +62,6 @@ impl BareLoop {
         }
         std::hint::black_box(x[0]);
         start.elapsed().as_secs_f64()
-    }
-}
-
-/// The model, with the time spent in its calls counted.
-struct Timed<'a> {
-    model: &'a mut Model,
-    inside: f64,
-}
-
-impl Denoiser for Timed<'_> {
-    type Error = ModelError;
-    fn features(&self) -> usize {
-        self.model.features()
-    }
-    fn denoise(&mut self, x_t: ArrayView3<'_, f32>, t: &[i64]) -> Result<Array3<f32>, ModelError> {
-        let start = Instant::now();
-        let out = self.model.denoise(x_t, t);
-        self.inside += start.elapsed().as_secs_f64();
-        out
     }
 }
 
@@ -190,7 +157,10 @@ fn stream_chunks(path: &str, seconds: usize) {
     // steps per chunk that keep a block ahead, and the worst chunk then.
     let mut stream = Stream::new(model.metadata(), StreamOptions::default()).expect("stream");
     let block = stream.sizes().block;
-    let steps = stream.block_progress().total.max(sinmdm::DEFAULT_STEPS);
+    // No block is under way yet, so the steps per block come from the options.
+    let steps = StreamOptions::default()
+        .steps
+        .unwrap_or(model.metadata().diffusion.steps);
     let per_chunk = (steps * second).div_ceil(block) + 1;
     let mut times = Vec::new();
     let start = Instant::now();

@@ -4,13 +4,16 @@
 //! `cargo bench -p sinmdm --bench sampling -- MODEL.onnx [FRAMES] [THREADS]`; without a model it
 //! uses `SINMDM_BENCH_MODEL`. `scripts/lab/bench_runtime.sh` makes a paper-size (C 256) model first.
 
+mod common;
+
 use std::time::Instant;
 
-use ndarray::{Array3, ArrayView3};
+use common::{Timed, median};
+use ndarray::Array3;
 use ort::session::Session;
 use ort::value::Tensor;
 use sinmdm::diffusion::Schedule;
-use sinmdm::diffusion::sampler::{Denoiser, Guidance, Sampler};
+use sinmdm::diffusion::sampler::{Guidance, Sampler};
 use sinmdm::network::{INPUT_FEATURES, INPUT_STEP, OUTPUT_FEATURES};
 use sinmdm::{Model, ModelOptions};
 
@@ -56,30 +59,6 @@ impl BareSession {
         let (_, v) = out[OUTPUT_FEATURES].try_extract_tensor::<f32>().unwrap();
         std::hint::black_box(v[0]);
     }
-}
-
-/// The model, timing the time spent inside onnxruntime.
-struct Timed<'a> {
-    model: &'a mut Model,
-    inside: f64,
-}
-
-impl Denoiser for Timed<'_> {
-    type Error = sinmdm::ModelError;
-    fn features(&self) -> usize {
-        self.model.features()
-    }
-    fn denoise(&mut self, x_t: ArrayView3<'_, f32>, t: &[i64]) -> Result<Array3<f32>, Self::Error> {
-        let start = Instant::now();
-        let out = self.model.denoise(x_t, t);
-        self.inside += start.elapsed().as_secs_f64();
-        out
-    }
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
 }
 
 fn main() {
@@ -182,15 +161,15 @@ fn main() {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
                 (a.min(v), b.max(v))
             });
-        let per_step = median(&mut loops);
+        let per_step = median(&loops);
         println!(
             "| {batch} | {steps} | {:.2} ms | {:.2} ms | {:+.1} % ({:+.1} to {:+.1}) | {:.1} % | {:.2} s | {:.0} |",
-            median(&mut bares) * 1e3,
+            median(&bares) * 1e3,
             per_step * 1e3,
-            median(&mut overheads) * 100.0,
+            median(&overheads) * 100.0,
             lo * 100.0,
             hi * 100.0,
-            median(&mut outside) * 100.0,
+            median(&outside) * 100.0,
             per_step * steps as f64,
             peak_memory_mib().unwrap_or(f64::NAN)
         );

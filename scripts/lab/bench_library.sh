@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
-# A motion library on this machine, two ways, side by side: every clip of a folder (default: the
-# shared clips, ../shared/data/bvh) trained with one configuration (default: the default)
+# A motion library on this machine, two ways, side by side: every clip of a folder (the README's
+# figure used the project's shared clips) trained with one configuration (default: the default)
 #   1. through a Slurm job array on a single-node Slurm (tests/cluster/slurm_node.sh), at most 2
 #      tasks at once with one thread each (--array=0-N%2 --cpus-per-task=1);
 #   2. one after another with two threads each (sinmdm-train --manifest M --index i --threads 2).
 # Prints the wall time of both and each clip's training minutes (from `sinmdm library report`).
 # The default configuration takes about an hour per leg on 2 cores: run it with nothing else on
 # the machine (it refuses to start while another sinmdm-train runs).
-# Usage: scripts/lab/bench_library.sh [CLIPS_DIR] [CONFIG.yaml] [WORK_DIR]
+# Usage: scripts/lab/bench_library.sh CLIPS_DIR [CONFIG.yaml] [WORK_DIR]
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
-clips=$(cd "${1:-$repo/../shared/data/bvh}" && pwd)
+[ $# -ge 1 ] || { echo "usage: $0 CLIPS_DIR [CONFIG.yaml] [WORK_DIR]" >&2; exit 2; }
+[ -d "$1" ] || { echo "no folder of clips at $1" >&2; exit 2; }
+clips=$(cd "$1" && pwd)
 config=${2:-}
 if [ $# -ge 3 ]; then work=$3; mkdir -p "$work"; else work=$(mktemp -d); fi
 work=$(cd "$work" && pwd)
