@@ -48,7 +48,7 @@ if [ ! -x .venv/bin/python ]; then
 fi
 stamp=.venv/.sinmdm-requirements
 if ! cmp -s scripts/requirements.txt "$stamp"; then
-  echo "setup: installing Python packages (onnxruntime, onnx, numpy, bvhio, pytest, pyyaml)"
+  echo "setup: installing Python packages (onnxruntime, onnx, numpy, bvhio, pytest, pyyaml, librosa)"
   .venv/bin/python -m pip install --quiet --disable-pip-version-check -r scripts/requirements.txt
   cp scripts/requirements.txt "$stamp"
 fi

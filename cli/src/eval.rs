@@ -73,6 +73,11 @@ pub struct EvalArgs {
     /// Do not show the progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Dance instead of free generation when music is given (--music, --beats or --bpm; the
+    /// clip is the reference): the scores then include the beat-hit rate and the Beat Align
+    /// Score, each beside its random-phase control.
+    #[command(flatten)]
+    dance: crate::dance::DanceOptions,
 }
 
 /// The JSON file `--json` writes.
@@ -94,6 +99,8 @@ struct EvalFile<'a> {
     planted_report: &'a Report,
     feet: &'a FeetReport,
     replay: &'a ReplayReport,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    beats: Option<sinmdm_eval::BeatScores>,
 }
 
 pub(crate) fn run(args: &EvalArgs) -> Result<()> {
@@ -142,8 +149,30 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         );
     }
 
+    if args.stream && args.dance.has_music() {
+        bail!("--stream and a dance's music (--music, --beats, --bpm) do not go together");
+    }
+    let dance = if args.dance.has_music() {
+        let dance = crate::dance::build_dance(
+            &model.metadata().layout,
+            clip.clone(),
+            &args.dance,
+            Some(frames),
+            frames,
+            args.seed,
+        )?;
+        dance.describe();
+        if let Some(path) = &args.dance.beats_out {
+            dance.write_beats(path)?;
+        }
+        Some(dance)
+    } else {
+        None
+    };
     let request = Request {
-        task: Task::Generate { frames },
+        task: dance
+            .as_ref()
+            .map_or(Task::Generate { frames }, |d| d.task.clone()),
         count: args.samples,
         seed: args.seed,
         steps,
@@ -269,6 +298,18 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         replay.tolerance, replay.mean_seconds, replay.max_seconds
     );
 
+    let beats = match &dance {
+        Some(dance) => {
+            let motions = (0..generated.count())
+                .map(|i| generated.motion(i))
+                .collect::<Result<Vec<_>, _>>()?;
+            let scores = dance.scores(&motions, args.seed);
+            println!();
+            crate::dance::print_scores(&scores);
+            Some(sinmdm_eval::mean_beat_scores(&scores))
+        }
+        None => None,
+    };
     if let Some(path) = &args.features_json {
         write_features(path, layout, generated.features.view())?;
         eprintln!("wrote {}", path.display());
@@ -291,6 +332,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             planted_report: &planted_report,
             feet: &feet,
             replay: &replay,
+            beats,
         };
         let text = serde_json::to_string_pretty(&file)?;
         write_atomically(path, text.as_bytes())

@@ -1,8 +1,10 @@
 //! The `sinmdm` command line: argument parsing and printing; the work is done by the libraries
 //! (`sinmdm`, `sinmdm-render`, `sinmdm-eval`).
 
+mod beats;
 mod clip_files;
 mod convert;
+mod dance;
 mod eval;
 mod info;
 mod inspect;
@@ -43,9 +45,17 @@ pub enum Command {
     /// Keep chosen joints (a body part) and/or the root motion of a reference, generate the rest.
     #[command(after_help = tasks::COMPOSE_EXAMPLES)]
     Compose(tasks::ComposeArgs),
+    /// A dance as long as a piece of music: the reference's poses at its beats land on the
+    /// music's beats, everything between them new.
+    #[command(after_help = dance::EXAMPLES)]
+    Dance(dance::DanceArgs),
     /// Style transfer: a content clip's low frequencies in the style the model learned.
     #[command(after_help = tasks::HARMONIZE_EXAMPLES)]
     Harmonize(tasks::HarmonizeArgs),
+    /// The tempo and beats of a piece of music (WAV), or of a motion clip; a click track to hear
+    /// them.
+    #[command(after_help = beats::EXAMPLES)]
+    Beats(beats::BeatsArgs),
     /// Draw clips (BVH, glTF) as stick figures: an animated GIF, or a PNG contact sheet.
     #[command(after_help = render::EXAMPLES)]
     Render(render::RenderArgs),
@@ -82,9 +92,11 @@ fn main() -> std::process::ExitCode {
         Command::Expand(args) => tasks::expand(&args),
         Command::Compose(args) => tasks::compose(&args),
         Command::Harmonize(args) => tasks::harmonize(&args),
+        Command::Dance(args) => dance::run(&args),
         Command::Stream(args) => stream::run(&args),
         Command::Eval(args) => eval::run(&args),
         Command::Info(args) => info::info(&args),
+        Command::Beats(args) => beats::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Reorient(args) => reorient::run(&args),
         Command::Convert(args) => convert::run(&args),

@@ -29,6 +29,7 @@
 
 #![warn(missing_docs)]
 
+pub mod beat_align;
 mod feet;
 mod model_eval;
 mod patched_nn;
@@ -45,6 +46,7 @@ use sinmdm::motion::{ColumnKind, FeatureLayout, LocalMotion, encode_motion};
 
 pub use report::{RarelyMade, Report, SampleScores, Stat, harmonic_mean, normalised_scores};
 
+pub use beat_align::{BeatScores, beat_scores, mean_beat_scores};
 pub use feet::{
     FeetReference, FeetReport, FeetScores, GROUND_BAND, PENETRATION_TOLERANCE, SKATING_SPEED,
     SPEED_WINDOW, SampleFeet, mean_scores,

@@ -65,6 +65,16 @@ def main(argv=None):
     ha.add_argument("--content", required=True)
     ha.add_argument("--factor", type=int, default=tasks.HARMONIZE_FACTOR)
     ha.add_argument("--free-share", type=float, default=tasks.HARMONIZE_FREE_SHARE)
+    da = common(sub.add_parser("dance"))
+    da.add_argument("--reference", required=True)
+    da.add_argument("--reference-beats", required=True, help="frames of the reference, comma-separated")
+    da.add_argument("--target-beats", required=True, help="frames of the output, comma-separated")
+    da.add_argument("--frames", type=int, required=True)
+    da.add_argument("--hold", type=int, default=tasks.DANCE_HOLD)
+    da.add_argument("--ramp", type=int, default=tasks.DANCE_RAMP)
+    da.add_argument("--order", choices=["reference", "shuffled"], default="reference")
+    da.add_argument("--level", choices=["auto", "every", "every-other", "half"], default="auto")
+    da.add_argument("--root", choices=["kept", "free"], default="kept")
     st = common(sub.add_parser("stream"))
     st.add_argument("--frames", type=int, required=True)
     st.add_argument("--block", type=int, default=None)
@@ -110,6 +120,13 @@ def main(argv=None):
                 joints += tasks.subtree(layout, top)
             spans = [tasks.parse_span(s, fps, ref.shape[1]) for s in args.frames]
             frames, inpainting = tasks.plan_compose(model, ref, joints, args.root, spans, args.ramp)
+        elif args.command == "dance":
+            ref = reference(args.reference)
+            frames_list = lambda text: [int(v) for v in text.split(",") if v.strip()]
+            frames, inpainting = tasks.plan_dance(
+                model, ref, frames_list(args.reference_beats), frames_list(args.target_beats),
+                args.frames, args.hold, args.ramp, args.order, args.level, args.root == "kept",
+                args.seed)
         else:
             ref = reference(args.content)
             frames, harmonization = tasks.plan_harmonize(model, ref, args.factor, args.free_share)

@@ -154,3 +154,112 @@ def plan_harmonize(model, content, factor=HARMONIZE_FACTOR, free_share=HARMONIZE
     if not 0.0 <= free_share <= 1.0:
         raise TaskError(f"the free share must be between 0 and 1, got {free_share}")
     return y.shape[1], (y, factor, free_share)
+
+
+DANCE_TEMPO_RANGE = (0.75, 1.25)
+DANCE_HOLD = 3
+DANCE_RAMP = 3
+DANCE_ORDER_STREAM = 2_000_000
+
+
+def _median_interval(beats):
+    gaps = sorted(b - a for a, b in zip(beats, beats[1:]))
+    return float(gaps[len(gaps) // 2])
+
+
+def _check_beats(beats, frames, what):
+    if len(beats) < 2:
+        raise TaskError(f"{what} need at least two beats to have a tempo, got {len(beats)}")
+    for a, b in zip(beats, beats[1:]):
+        if b <= a:
+            raise TaskError(f"{what} must increase: frame {b} comes after frame {a}")
+    if beats[-1] >= frames:
+        raise TaskError(f"{what} reach frame {beats[-1]}, past the {frames} frames they belong to")
+
+
+def _beats_at_level(level, beats):
+    if level in ("auto", "every"):
+        return list(beats)
+    if level == "every-other":
+        return list(beats[::2])
+    out = []
+    for a, b in zip(beats, beats[1:]):
+        out.append(a)
+        mid = (a + b) // 2
+        if mid > a:
+            out.append(mid)
+    out.append(beats[-1])
+    return out
+
+
+def keyframe_order(usable, count, order, seed):
+    """Passes over the usable reference beats, in order or each shuffled (Fisher-Yates from
+    the portable words of DANCE_ORDER_STREAM), as runtime/src/tasks/dance.rs."""
+    from .noise import _words
+    out = []
+    cycle = 0
+    while len(out) < count:
+        p = list(range(usable))
+        if order == "shuffled" and usable > 1:
+            words = _words(seed, DANCE_ORDER_STREAM, (cycle + 1) * usable)
+            for i in range(usable - 1, 0, -1):
+                # Word index cycle * usable + i is element cycle * usable + i of 0-based words.
+                j = int(words[cycle * usable + i]) % (i + 1)
+                p[i], p[j] = p[j], p[i]
+        out.extend(p[: count - len(out)])
+        cycle += 1
+    return out
+
+
+def place_keyframes(reference_frames, reference_beats, target_beats, frames, hold, ramp, order,
+                    level, seed):
+    """(level, ratio, hold, ramp, [(target, reference)]) of a dance."""
+    _check_beats(reference_beats, reference_frames, "the reference's beats")
+    _check_beats(target_beats, frames, "the music's beats")
+    ref_interval = _median_interval(reference_beats)
+    levels = ["every", "every-other", "half"] if level == "auto" else [level]
+    best = None
+    for lv in levels:
+        beats = _beats_at_level(lv, target_beats)
+        if len(beats) < 2:
+            continue
+        ratio = _median_interval(beats) / ref_interval
+        if best is None or abs(np.log(ratio)) < abs(np.log(best[2])):
+            best = (lv, beats, ratio)
+    if best is None:
+        raise TaskError(f"the music's beats at level {level} leave fewer than two beats")
+    lv, beats, ratio = best
+    low, high = DANCE_TEMPO_RANGE
+    if not low <= ratio <= high:
+        raise TaskError(f"the music's beats are {ratio:.2f}x the reference's; the model learned {low}-{high}x")
+    closest = min(b - a for a, b in zip(beats, beats[1:]))
+    hold = min(hold, max(closest - 2, 0) // 2)
+    ramp = min(ramp, hold + 1)
+    usable = [r for r in reference_beats if r >= hold and r + hold < reference_frames]
+    if not usable:
+        raise TaskError(f"no beat of the reference has {hold} frames on both sides")
+    picks = keyframe_order(len(usable), len(beats), order, seed)
+    return lv, ratio, hold, ramp, [(t, usable[k]) for t, k in zip(beats, picks)]
+
+
+def plan_dance(model, reference, reference_beats, target_beats, frames, hold=DANCE_HOLD,
+               ramp=DANCE_RAMP, order="reference", level="auto", root=True, seed=0):
+    if ramp > MAX_SAMPLE_FRAMES:
+        raise TaskError(f"a ramp of {ramp} frames is too wide")
+    y = model.normalize(reference)
+    if not 1 <= frames <= MAX_SAMPLE_FRAMES:
+        raise TaskError(f"a sample of {frames} frames is not possible")
+    _, _, h, ramp, keys = place_keyframes(y.shape[1], reference_beats, target_beats, frames, hold,
+                                          ramp, order, level, seed)
+    target = np.zeros((y.shape[0], frames), dtype=np.float32)
+    keep = np.zeros(frames, dtype=bool)
+    for t, r in keys:
+        for u in range(max(t - h, 0), min(t + h, frames - 1) + 1):
+            target[:, u] = y[:, r + u - t]
+            keep[u] = True
+    weights = soft_mask(keep, ramp)
+    root_rows = len(model.layout["root"]["axes"]) if model.layout.get("root") else 0
+    mask = np.zeros(target.shape, dtype=np.float32)
+    first = 0 if root else root_rows
+    mask[first:] = weights
+    return frames, (target, mask)

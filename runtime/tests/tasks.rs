@@ -469,3 +469,71 @@ fn metadata_problems_are_named() {
     assert!(e.to_string().contains("missing field `normalizer`"), "{e}");
     assert!(sinmdm::model_file::parse_metadata(path, lookup(Some("1"), Some(good))).is_ok());
 }
+
+#[test]
+fn dance_lands_the_reference_beat_poses_exactly_on_the_music_beats() {
+    use sinmdm::tasks::{BeatLevel, DanceBeats, KeyOrder, place_keyframes};
+    let mut m = model();
+    let reference = walk(&m, 200);
+    let y = m.metadata().normalizer.normalize(reference.view());
+    let root_rows = m
+        .metadata()
+        .layout
+        .root
+        .as_ref()
+        .map_or(0, |r| r.axes.len());
+    assert!(root_rows > 0, "the walk model has root features");
+    for (order, root) in [(KeyOrder::Reference, true), (KeyOrder::Shuffled, false)] {
+        let beats = DanceBeats {
+            reference_beats: (0..7).map(|k| 20 + 25 * k).collect(),
+            target_beats: (0..9).map(|k| 5 + 27 * k).collect(),
+            frames: 240,
+            hold: 3,
+            ramp: 3,
+            order,
+            level: BeatLevel::Auto,
+        };
+        let placement = place_keyframes(200, &beats, 3).unwrap();
+        assert_eq!(placement.level, BeatLevel::Every);
+        assert_eq!(placement.keys.len(), 9);
+        let out = run(
+            &mut m,
+            Task::Dance {
+                reference: reference.clone(),
+                beats,
+                root,
+            },
+            2,
+            12,
+        );
+        let first_kept = if root { 0 } else { root_rows };
+        for sample in out.normalized.outer_iter() {
+            for key in &placement.keys {
+                let made = sample.column(key.target);
+                let wanted = y.column(key.reference);
+                let worst = (first_kept..y.nrows())
+                    .map(|r| (made[r] - wanted[r]).abs())
+                    .fold(0.0f32, f32::max);
+                assert!(
+                    worst <= 1e-5,
+                    "{order:?}: output frame {} is {worst} from reference frame {}",
+                    key.target,
+                    key.reference
+                );
+                if !root {
+                    let root_diff: f32 = (0..root_rows).map(|r| (made[r] - wanted[r]).abs()).sum();
+                    assert!(
+                        root_diff > 1e-4,
+                        "the free root was copied at {}",
+                        key.target
+                    );
+                }
+            }
+            // Between the windows the motion is generated, not copied.
+            let between: f32 = (placement.keys[3].target + 6..placement.keys[4].target - 6)
+                .map(|f| (&sample.column(f) - &y.column(f)).mapv(f32::abs).sum())
+                .sum();
+            assert!(between > 1.0, "{order:?}: the gap is a copy ({between})");
+        }
+    }
+}

@@ -200,3 +200,31 @@ def test_outputs_are_bvh_files_of_the_model_skeleton(tmp_path):
         assert [j.Name for j, _, _ in clip.Root.layout()] == [j.Name for j, _, _ in source.Root.layout()]
         assert clip.FrameCount == 60
         assert abs(clip.FrameTime - 1 / 30) < 1e-6
+
+
+@pytest.mark.parametrize("order,root", [("reference", "kept"), ("shuffled", "free")])
+def test_rust_and_python_agree_on_a_dance(order, root, references):
+    """`sinmdm dance` records the beats it used (--beats-out); the Python reference, given the
+    same beats in frames, places the same keyframes and makes the same features, bit for bit."""
+    work = references["work"]
+    case = f"dance-{order}-{root}"
+    rust_json, py_json, used = (work / f"{case}-rust.json", work / f"{case}-python.json",
+                                work / f"{case}-beats.json")
+    common = ["-m", MODEL, "--seed", 5, "--steps", 15, "--count", 2]
+    dance = ["--order", order, "--root", root, "--hold", 2, "--ramp", 2]
+    done = rust("dance", *common, *dance, "--reference", WALK, "--bpm", 100, "--offset", 0.3,
+                "--seconds", 8, "--beats-out", used, "-o", work / f"{case}.bvh", "--features-json",
+                rust_json, "--quiet")
+    assert done.returncode == 0, done.stderr
+    beats = json.loads(used.read_text())
+    assert len(beats["keyframes"]) >= 6
+    done = python("dance", *common, *dance, "--reference", references["walk"],
+                  "--reference-beats", ",".join(map(str, beats["reference_beats"])),
+                  "--target-beats", ",".join(map(str, beats["music_beats"])),
+                  "--frames", beats["frames"], "-o", py_json)
+    assert done.returncode == 0, done.stderr
+    a, b = load(rust_json), load(py_json)
+    assert a.shape == b.shape == (2, a.shape[1], beats["frames"])
+    diff = float(np.abs(a - b).max())
+    print(f"{case}: max abs diff {diff}")
+    assert diff == 0.0, f"{case}: max |diff| {diff}"

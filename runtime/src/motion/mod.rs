@@ -1,6 +1,7 @@
 //! The motion representation: skeletons, rotations, forward kinematics, and the feature vector
 //! the model learns (SPEC section 2).
 
+pub mod beats;
 pub mod clip;
 pub mod contacts;
 pub mod features;
@@ -17,6 +18,7 @@ pub mod skeleton;
 pub mod up;
 pub mod up_detect;
 
+pub use beats::{KinematicBeats, kinematic_beats};
 pub use clip::{ChannelClip, LocalMotion, fps_from_frame_time};
 pub use contacts::ContactConfig;
 pub use features::{

@@ -6,6 +6,7 @@
 //! then runs on any [`Denoiser`](crate::diffusion::Denoiser) and gives a [`Generated`] batch in
 //! the model's feature layout.
 
+mod dance;
 mod generated;
 mod joints;
 pub mod mask;
@@ -21,6 +22,10 @@ use crate::diffusion::{Method, ScheduleError};
 use crate::model::ModelError;
 use crate::motion::feet::Feet;
 use crate::motion::{FeatureMatrix, MotionError};
+pub use dance::{
+    BeatLevel, DANCE_HOLD, DANCE_ORDER_STREAM, DANCE_RAMP, DANCE_TEMPO_RANGE, DanceBeats, KeyOrder,
+    Keyframe, Placement, keyframe_order, place_keyframes,
+};
 pub use generated::Generated;
 pub use joints::{joints_by_name, subtree};
 pub use mask::Span;
@@ -143,6 +148,9 @@ pub enum TaskError {
     /// Stream options that cannot work together.
     #[error("{0}")]
     Stream(String),
+    /// Dance beats that cannot be placed.
+    #[error("{0}")]
+    Dance(String),
 }
 
 impl From<Infallible> for TaskError {
@@ -204,6 +212,17 @@ pub enum Task {
         spans: Vec<Span>,
         /// Soft border at span ends, in frames.
         ramp: usize,
+    },
+    /// Dance: windows of the reference around its beats placed on the music's beats (see
+    /// [`place_keyframes`]), the motion between them generated.
+    Dance {
+        /// Raw reference features `[F, N]`.
+        reference: FeatureMatrix,
+        /// The beats on both sides and how keyframes are placed on them.
+        beats: DanceBeats,
+        /// Whether the root's travel and height in each window come from the reference (its
+        /// heading stays with the top joint's rotation either way).
+        root: bool,
     },
     /// Style transfer: the content's low frequencies in the model's style.
     Harmonize {

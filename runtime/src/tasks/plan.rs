@@ -8,7 +8,7 @@ use ndarray::Array2;
 use super::Generated;
 use super::mask::{Span, covered, soft_mask};
 use super::run::Run;
-use super::{Request, Task, TaskError};
+use super::{Placement, Request, Task, TaskError, place_keyframes};
 use crate::diffusion::sampler::{Denoiser, Guidance, Harmonization, Inpainting, Sampler};
 use crate::diffusion::{Method, SamplerError, Schedule};
 use crate::limits::{MAX_RAMP_FRAMES, MAX_RUN_VALUES, MAX_SAMPLE_FRAMES, MAX_SAMPLES};
@@ -28,9 +28,16 @@ pub struct Plan {
     schedule: Schedule,
     feet: Feet,
     method: Method,
+    placement: Option<Placement>,
 }
 
 impl Plan {
+    /// Where a dance's keyframes went (level, tempo ratio, hold, keyframes); `None` for other
+    /// tasks.
+    pub fn placement(&self) -> Option<&Placement> {
+        self.placement.as_ref()
+    }
+
     /// Samples in the batch.
     pub fn count(&self) -> usize {
         self.count
@@ -250,8 +257,53 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
         Some(s) => Schedule::respaced(metadata.diffusion.steps, s)?,
         None => Schedule::cosine(metadata.diffusion.steps)?,
     };
+    let mut placement = None;
     let (frames, guidance) = match &request.task {
         Task::Generate { frames } => (*frames, Guidance::default()),
+        Task::Dance {
+            reference,
+            beats,
+            root,
+        } => {
+            let y = normalized(metadata, reference)?;
+            check_length(beats.frames)?;
+            check_ramp(beats.ramp)?;
+            let placed = place_keyframes(y.ncols(), beats, request.seed)?;
+            let n = beats.frames;
+            let h = placed.hold;
+            let mut target = Array2::<f32>::zeros((f, n));
+            let mut keep = vec![false; n];
+            for key in &placed.keys {
+                // Frames of the window that fall inside the output.
+                let first = key.target.saturating_sub(h);
+                let last = (key.target + h).min(n - 1);
+                let from = key.reference + first - key.target;
+                let to = key.reference + last - key.target;
+                target
+                    .slice_mut(ndarray::s![.., first..=last])
+                    .assign(&y.slice(ndarray::s![.., from..=to]));
+                keep[first..=last].fill(true);
+            }
+            let weights = soft_mask(&keep, placed.ramp);
+            let root_rows = metadata.layout.root.as_ref().map_or(0, |r| r.axes.len());
+            let rows: Vec<usize> = if *root {
+                (0..f).collect()
+            } else {
+                (root_rows..f).collect()
+            };
+            let mask = frame_mask(f, &weights, Some(&rows));
+            placement = Some(placed);
+            (
+                n,
+                Guidance {
+                    inpainting: Some(Inpainting {
+                        reference: target,
+                        mask,
+                    }),
+                    harmonization: None,
+                },
+            )
+        }
         Task::Inbetween {
             reference,
             keep,
@@ -416,5 +468,6 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
         schedule,
         feet: request.feet,
         method: request.method,
+        placement,
     })
 }
