@@ -45,6 +45,14 @@ pub enum BeatsError {
         /// Its length.
         seconds: f64,
     },
+    /// A motion in which no regular beat stands out (fewer than two speed minima on a beat).
+    #[error(
+        "no dance beat in {seconds:.1} s of motion: fewer than two speed minima fall on a regular beat"
+    )]
+    NoMotionBeats {
+        /// Its length.
+        seconds: f64,
+    },
     /// A bad line in a beat file.
     #[error("{path}, line {line}: {reason}")]
     BeatFile {

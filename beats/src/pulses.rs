@@ -3,6 +3,8 @@
 //! found as a song's are, treating each event as an onset: a Gaussian pulse of
 //! [`PULSE_SECONDS`], so events a frame or two off the beat (as a dancer's are) still line up.
 
+use sinmdm::motion::{KinematicBeats, LocalMotion, kinematic_beats};
+
 use crate::onset::OnsetEnvelope;
 use crate::{BeatsError, TrackerOptions, grid, tempo, track};
 
@@ -47,7 +49,8 @@ pub fn regular_beats(
         frame_rate,
         start: 0.0,
     };
-    let period = tempo::estimate_period(&envelope, options)?;
+    let period = tempo::estimate_period(&envelope, options)
+        .map_err(|_| BeatsError::NoMotionBeats { seconds })?;
     let beats = track::beat_frames(&envelope.values, period, options.tightness);
     let snap = period / 4.0;
     let mut snapped: Vec<usize> = beats
@@ -62,7 +65,7 @@ pub fn regular_beats(
         .collect();
     snapped.dedup();
     if snapped.len() < 2 {
-        return Err(BeatsError::NoBeats { seconds });
+        return Err(BeatsError::NoMotionBeats { seconds });
     }
     let times: Vec<f64> = beats.iter().map(|&b| b as f64).collect();
     let interval = if times.len() >= 2 {
@@ -74,6 +77,23 @@ pub fn regular_beats(
         bpm: 60.0 * frame_rate / interval,
         frames: snapped,
     })
+}
+
+/// A motion's kinematic beats (every speed minimum) and those on its dance's beat: the dance
+/// task's reference beats.
+pub fn motion_beats(motion: &LocalMotion) -> Result<(KinematicBeats, RegularBeats), BeatsError> {
+    let minima = kinematic_beats(motion);
+    let seconds = motion.frame_count() as f64 / motion.fps;
+    if minima.frames.len() < 2 {
+        return Err(BeatsError::NoMotionBeats { seconds });
+    }
+    let regular = regular_beats(
+        &minima.frames,
+        motion.frame_count(),
+        motion.fps,
+        &TrackerOptions::default(),
+    )?;
+    Ok((minima, regular))
 }
 
 #[cfg(test)]

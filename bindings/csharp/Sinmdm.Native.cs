@@ -42,6 +42,15 @@ namespace Sinmdm
         internal struct Span { public UIntPtr Start, End; }
 
         [StructLayout(LayoutKind.Sequential)]
+        internal struct Dance
+        {
+            public IntPtr ReferenceBeats; public UIntPtr ReferenceBeatCount;
+            public IntPtr MusicBeats; public UIntPtr MusicBeatCount;
+            public UIntPtr Frames, Hold, Ramp;
+            public uint Order, Level, KeepRoot;
+        }
+
+        [StructLayout(LayoutKind.Sequential)]
         internal struct StreamOptions
         {
             public ulong Seed; public uint Steps, BlockFrames, Feet;
@@ -67,6 +76,9 @@ namespace Sinmdm
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_model_contact_joints(ModelHandle model, UIntPtr[] joints, UIntPtr capacity, out UIntPtr needed);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_generate(ModelHandle model, ref Sampling sampling, UIntPtr frames, out ResultHandle result);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_generate_begin(ModelHandle model, ref Sampling sampling, UIntPtr frames, out RunHandle run);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_dance(ModelHandle model, ref Sampling sampling, ref PosesIn reference, ref Dance dance, out ResultHandle result);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_dance_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, ref Dance dance, out RunHandle run);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_dance_reference_beats(ModelHandle model, ref PosesIn reference, UIntPtr[] beats, UIntPtr capacity, out UIntPtr needed);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_inbetween(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out ResultHandle result);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_inbetween_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out RunHandle run);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_expand(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr prefix, UIntPtr suffix, UIntPtr ramp, out ResultHandle result);
@@ -159,6 +171,28 @@ namespace Sinmdm
             for (int i = 0; i < spans.Length; i++)
                 spans[i] = new Span { Start = Size(pairs[2 * i], name), End = Size(pairs[2 * i + 1], name) };
             return spans;
+        }
+
+        /// Pins a dance's beat arrays for the duration of `use`; negative frames are refused.
+        internal static T WithDance<T>(DanceSettings dance, Func<Dance, T> use)
+        {
+            if (dance == null) throw new ArgumentNullException(nameof(dance));
+            var reference = Indices(dance.ReferenceBeats, nameof(dance.ReferenceBeats));
+            var music = Indices(dance.MusicBeats, nameof(dance.MusicBeats));
+            var r = GCHandle.Alloc(reference, GCHandleType.Pinned);
+            var m = GCHandle.Alloc(music, GCHandleType.Pinned);
+            try
+            {
+                return use(new Dance
+                {
+                    ReferenceBeats = r.AddrOfPinnedObject(), ReferenceBeatCount = (UIntPtr)reference.Length,
+                    MusicBeats = m.AddrOfPinnedObject(), MusicBeatCount = (UIntPtr)music.Length,
+                    Frames = Size(dance.Frames, nameof(dance.Frames)), Hold = Size(dance.Hold, nameof(dance.Hold)),
+                    Ramp = Size(dance.Ramp, nameof(dance.Ramp)),
+                    Order = (uint)dance.Order, Level = (uint)dance.Level, KeepRoot = dance.KeepRoot ? 1u : 0u,
+                });
+            }
+            finally { r.Free(); m.Free(); }
         }
 
         internal static UIntPtr[] Indices(int[] joints, string name)

@@ -75,6 +75,31 @@ namespace Sinmdm
 
     /// <summary>Poses as flat arrays: root position (3 per frame), local rotations x,y,z,w
     /// (4 per joint and frame), local translations (3 per joint and frame).</summary>
+    /// <summary>The order of a dance's keyframes.</summary>
+    public enum DanceOrder : uint { Reference = 0, Shuffled = 1 }
+
+    /// <summary>Which of the music's beats carry a dance's keyframes.</summary>
+    public enum BeatLevel : uint { Auto = 0, Every = 1, EveryOther = 2, Half = 3 }
+
+    /// <summary>A dance's beats (frames at the model's rate, increasing) and placement.</summary>
+    public sealed class DanceSettings
+    {
+        /// <summary>The reference's beats (Model.DanceReferenceBeats gives them).</summary>
+        public int[] ReferenceBeats;
+        /// <summary>The music's beats, frames of the output.</summary>
+        public int[] MusicBeats;
+        /// <summary>Frames of the output.</summary>
+        public int Frames;
+        /// <summary>Half-width of each keyframe window in frames; 0 for the library's default.</summary>
+        public int Hold;
+        /// <summary>Soft border on the kept side of each window, in frames.</summary>
+        public int Ramp = 3;
+        public DanceOrder Order = DanceOrder.Reference;
+        public BeatLevel Level = BeatLevel.Auto;
+        /// <summary>Whether the root's travel and height in each window come from the reference.</summary>
+        public bool KeepRoot = true;
+    }
+
     public sealed class Poses
     {
         public readonly int Frames, Joints;
@@ -293,6 +318,41 @@ namespace Sinmdm
             RunHandle run = null;
             int status = Native.WithInput(reference, Joints, input =>
                 Native.sinmdm_inbetween_begin(Handle, ref native, ref input, spans, (UIntPtr)spans.Length, r, out run));
+            return Begun(status, run);
+        }
+
+        /// <summary>The beats of `reference` that a dance places: its speed minima on its own beat (frames).</summary>
+        public int[] DanceReferenceBeats(Poses reference)
+        {
+            UIntPtr needed = UIntPtr.Zero;
+            Native.Check(Native.WithInput(reference, Joints, input =>
+                Native.sinmdm_dance_reference_beats(Handle, ref input, null, UIntPtr.Zero, out needed)));
+            var beats = new UIntPtr[(int)needed];
+            Native.Check(Native.WithInput(reference, Joints, input =>
+                Native.sinmdm_dance_reference_beats(Handle, ref input, beats, (UIntPtr)beats.Length, out needed)));
+            return Array.ConvertAll(beats, b => (int)b);
+        }
+
+        /// <summary>A dance: the reference's poses at its beats placed on the music's beats, the rest generated.</summary>
+        public Result Dance(Poses reference, DanceSettings dance, Sampling sampling)
+        {
+            var native = sampling.ToNative();
+            ResultHandle result = null;
+            int status = Native.WithDance(dance, d => Native.WithInput(reference, Joints, input =>
+                Native.sinmdm_dance(Handle, ref native, ref input, ref d, out result)));
+            return Blocking(status, result);
+        }
+
+        public Result Dance(Poses reference, DanceSettings dance, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted) =>
+            Dance(reference, dance, new Sampling { Seed = seed, Count = 1, Steps = steps, Feet = feet });
+
+        /// <summary>Begins a dance, to step with Run.Step.</summary>
+        public Run BeginDance(Poses reference, DanceSettings dance, Sampling sampling)
+        {
+            var native = sampling.ToNative();
+            RunHandle run = null;
+            int status = Native.WithDance(dance, d => Native.WithInput(reference, Joints, input =>
+                Native.sinmdm_dance_begin(Handle, ref native, ref input, ref d, out run)));
             return Begun(status, run);
         }
 

@@ -76,6 +76,47 @@
 #include <stdlib.h>
 
 /*
+ Keyframe order: the reference's own, over and over (the default).
+ */
+#define SINMDM_DANCE_ORDER_REFERENCE 0
+
+/*
+ Keyframe order: each pass over the reference's beats in an order drawn from the seed.
+ */
+#define SINMDM_DANCE_ORDER_SHUFFLED 1
+
+/*
+ Beat level: the one that brings the music's tempo nearest the reference's (the default).
+ */
+#define SINMDM_DANCE_LEVEL_AUTO 0
+
+/*
+ Beat level: every music beat carries a keyframe.
+ */
+#define SINMDM_DANCE_LEVEL_EVERY 1
+
+/*
+ Beat level: every other music beat, from the first.
+ */
+#define SINMDM_DANCE_LEVEL_EVERY_OTHER 2
+
+/*
+ Beat level: every music beat and the frame half-way to the next.
+ */
+#define SINMDM_DANCE_LEVEL_HALF 3
+
+/*
+ Default half-width of a keyframe window, in frames (`hold` of 0 takes it too); the
+ library's `DANCE_HOLD`, which a test keeps equal.
+ */
+#define SINMDM_DANCE_HOLD 5
+
+/*
+ Default soft border of a keyframe window, in frames (the library's `DANCE_RAMP`).
+ */
+#define SINMDM_DANCE_RAMP 3
+
+/*
  The longest sample a task makes, and the longest stream chunk or block, in frames
  (`SinmdmPoses.frames`, `frames` of `sinmdm_generate` and `sinmdm_stream_next`, a task's
  length after expansion).
@@ -245,6 +286,109 @@ typedef struct SinmdmRun SinmdmRun;
 typedef struct SinmdmStream SinmdmStream;
 
 /*
+ Poses given to the library, `frames` of them for the model's `joints` joints, as flat
+ arrays in the model file's frame and units.
+ */
+typedef struct SinmdmPoses {
+  /*
+   Frames.
+   */
+  size_t frames;
+  /*
+   The root joint's position per frame: `3 x frames` floats.
+   */
+  const float *root_positions;
+  /*
+   Every joint's local rotation per frame, `x, y, z, w`: `4 x joints x frames` floats.
+   */
+  const float *rotations;
+  /*
+   Every joint's local translation per frame: `3 x joints x frames` floats, or NULL for
+   the rest offsets (what a skeleton without stretching has).
+   */
+  const float *translations;
+} SinmdmPoses;
+
+/*
+ Sampling settings shared by every task. The same model, settings and arguments give the same
+ poses, here, in Rust and in the Python reference.
+ */
+typedef struct SinmdmSampling {
+  /*
+   Seed of the portable noise.
+   */
+  uint64_t seed;
+  /*
+   Samples in the batch (a crowd when more than 1).
+   */
+  uint32_t count;
+  /*
+   Respaced denoising steps; 0 for `SINMDM_DEFAULT_STEPS`, `SINMDM_ALL_STEPS` for all of
+   the model's T.
+   */
+  uint32_t steps;
+  /*
+   `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
+   */
+  uint32_t feet;
+  /*
+   `SINMDM_METHOD_ANCESTRAL` (0, the default), `SINMDM_METHOD_DDIM` or `SINMDM_METHOD_DPM2M`.
+   */
+  uint32_t method;
+  /*
+   DDIM's share of the ancestral noise, 0 to 1 (ignored by the other methods).
+   */
+  double eta;
+} SinmdmSampling;
+
+/*
+ A dance's beats and placement. Beat frames are at the model's frame rate, increasing.
+ */
+typedef struct SinmdmDance {
+  /*
+   The reference's beats (frames of the reference poses), e.g. from
+   `sinmdm_dance_reference_beats`.
+   */
+  const size_t *reference_beats;
+  /*
+   Values in `reference_beats`.
+   */
+  size_t reference_beat_count;
+  /*
+   The music's beats (frames of the output).
+   */
+  const size_t *music_beats;
+  /*
+   Values in `music_beats`.
+   */
+  size_t music_beat_count;
+  /*
+   Frames of the output.
+   */
+  size_t frames;
+  /*
+   Half-width of each keyframe window in frames; 0 takes `SINMDM_DANCE_HOLD`.
+   */
+  size_t hold;
+  /*
+   Soft border on the kept side of each window, in frames (at most `hold + 1` is used).
+   */
+  size_t ramp;
+  /*
+   `SINMDM_DANCE_ORDER_*`.
+   */
+  uint32_t order;
+  /*
+   `SINMDM_DANCE_LEVEL_*`.
+   */
+  uint32_t level;
+  /*
+   1: the root's travel and height in each window come from the reference; 0: generated.
+   */
+  uint32_t keep_root;
+} SinmdmDance;
+
+/*
  A progress callback: called after each denoising step of a blocking task on the model it was
  set on, with the host's `userdata` first, then the steps done and the steps in all. Return
  `SINMDM_PROGRESS_CONTINUE` to go on, or `SINMDM_PROGRESS_CANCEL` (any value but 0) to stop:
@@ -294,30 +438,6 @@ typedef struct SinmdmModelInfo {
    */
   size_t diffusion_steps;
 } SinmdmModelInfo;
-
-/*
- Poses given to the library, `frames` of them for the model's `joints` joints, as flat
- arrays in the model file's frame and units.
- */
-typedef struct SinmdmPoses {
-  /*
-   Frames.
-   */
-  size_t frames;
-  /*
-   The root joint's position per frame: `3 x frames` floats.
-   */
-  const float *root_positions;
-  /*
-   Every joint's local rotation per frame, `x, y, z, w`: `4 x joints x frames` floats.
-   */
-  const float *rotations;
-  /*
-   Every joint's local translation per frame: `3 x joints x frames` floats, or NULL for
-   the rest offsets (what a skeleton without stretching has).
-   */
-  const float *translations;
-} SinmdmPoses;
 
 /*
  Caller-owned arrays the library fills with poses; capacities are in floats. Needed: root
@@ -395,38 +515,6 @@ typedef struct SinmdmStreamOptions {
 } SinmdmStreamOptions;
 
 /*
- Sampling settings shared by every task. The same model, settings and arguments give the same
- poses, here, in Rust and in the Python reference.
- */
-typedef struct SinmdmSampling {
-  /*
-   Seed of the portable noise.
-   */
-  uint64_t seed;
-  /*
-   Samples in the batch (a crowd when more than 1).
-   */
-  uint32_t count;
-  /*
-   Respaced denoising steps; 0 for `SINMDM_DEFAULT_STEPS`, `SINMDM_ALL_STEPS` for all of
-   the model's T.
-   */
-  uint32_t steps;
-  /*
-   `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
-   */
-  uint32_t feet;
-  /*
-   `SINMDM_METHOD_ANCESTRAL` (0, the default), `SINMDM_METHOD_DDIM` or `SINMDM_METHOD_DPM2M`.
-   */
-  uint32_t method;
-  /*
-   DDIM's share of the ancestral noise, 0 to 1 (ignored by the other methods).
-   */
-  double eta;
-} SinmdmSampling;
-
-/*
  A span of frames `start..end` (end excluded).
  */
 typedef struct SinmdmSpan {
@@ -443,6 +531,48 @@ typedef struct SinmdmSpan {
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
+
+/*
+ Writes the beats of the `reference` poses that a dance places (its speed minima on the
+ dance's own beat; frames of the reference) to `beats`, which holds `capacity` values;
+ `needed` (if not NULL) gets their count, also for a NULL `beats` (a size query).
+
+ # Safety
+ `model` is a live handle; `reference` readable; `beats` NULL or writable for `capacity`
+ values; `needed` NULL or writable.
+ */
+enum SinmdmStatus sinmdm_dance_reference_beats(const struct SinmdmModel *model,
+                                               const struct SinmdmPoses *reference,
+                                               size_t *beats,
+                                               size_t capacity,
+                                               size_t *needed);
+
+/*
+ Begins a dance (see `sinmdm_dance` and `sinmdm_run_step`).
+
+ # Safety
+ As `sinmdm_dance`.
+ */
+enum SinmdmStatus sinmdm_dance_begin(struct SinmdmModel *model,
+                                     const struct SinmdmSampling *sampling,
+                                     const struct SinmdmPoses *reference,
+                                     const struct SinmdmDance *dance,
+                                     struct SinmdmRun **out);
+
+/*
+ A dance: windows of the `reference` poses around its beats placed on the music's beats,
+ the motion between them generated (the same motion as `sinmdm dance` for the same beats,
+ seed and settings).
+
+ # Safety
+ Pointers as their types' documentation says; the arrays of `dance` readable for their
+ counts.
+ */
+enum SinmdmStatus sinmdm_dance(struct SinmdmModel *model,
+                               const struct SinmdmSampling *sampling,
+                               const struct SinmdmPoses *reference,
+                               const struct SinmdmDance *dance,
+                               struct SinmdmResult **out);
 
 /*
  The library's version, a static NUL-terminated string.

@@ -64,6 +64,7 @@
 
 #![warn(missing_docs)]
 
+mod dance;
 mod limits;
 mod model;
 mod poses;
@@ -75,6 +76,12 @@ mod stream;
 mod tasks;
 mod text;
 
+pub use dance::{
+    SINMDM_DANCE_HOLD, SINMDM_DANCE_LEVEL_AUTO, SINMDM_DANCE_LEVEL_EVERY,
+    SINMDM_DANCE_LEVEL_EVERY_OTHER, SINMDM_DANCE_LEVEL_HALF, SINMDM_DANCE_ORDER_REFERENCE,
+    SINMDM_DANCE_ORDER_SHUFFLED, SINMDM_DANCE_RAMP, SinmdmDance, sinmdm_dance, sinmdm_dance_begin,
+    sinmdm_dance_reference_beats,
+};
 pub use limits::{
     SINMDM_MAX_JOINT_INDICES, SINMDM_MAX_MODEL_BYTES, SINMDM_MAX_RAMP_FRAMES,
     SINMDM_MAX_RUN_VALUES, SINMDM_MAX_SAMPLE_FRAMES, SINMDM_MAX_SAMPLES, SINMDM_MAX_THREADS,

@@ -16,7 +16,9 @@ use crate::text::{handle, slice_arg};
 ///
 /// # Safety
 /// `sampling` is NULL or readable.
-unsafe fn sampling_arg(sampling: *const SinmdmSampling) -> Result<SinmdmSampling, Failure> {
+pub(crate) unsafe fn sampling_arg(
+    sampling: *const SinmdmSampling,
+) -> Result<SinmdmSampling, Failure> {
     Ok(*unsafe { handle(sampling.cast_mut(), "sampling") }?)
 }
 
@@ -24,7 +26,7 @@ unsafe fn sampling_arg(sampling: *const SinmdmSampling) -> Result<SinmdmSampling
 ///
 /// # Safety
 /// As [`poses_in`].
-unsafe fn reference_features(
+pub(crate) unsafe fn reference_features(
     model: &SinmdmModel,
     poses: *const SinmdmPoses,
     argument: &str,

@@ -135,28 +135,15 @@ fn motion_beats(clip: &Path, args: &BeatsArgs) -> Result<BeatsReport> {
     })
 }
 
-/// A motion's kinematic beats (every speed minimum) and those on its dance's beat (the tempo
-/// found among the minima as a song's is among onsets).
+/// A motion's kinematic beats and those on its dance's beat (see
+/// [`sinmdm_beats::pulses::motion_beats`]).
 pub(crate) fn dance_beats(
     motion: &sinmdm::motion::LocalMotion,
 ) -> Result<(
     sinmdm::motion::KinematicBeats,
     sinmdm_beats::pulses::RegularBeats,
 )> {
-    let minima = sinmdm::motion::kinematic_beats(motion);
-    if minima.frames.len() < 2 {
-        bail!(
-            "fewer than two kinematic beats (speed minima) in {} frames",
-            motion.frame_count()
-        );
-    }
-    let regular = sinmdm_beats::pulses::regular_beats(
-        &minima.frames,
-        motion.frame_count(),
-        motion.fps,
-        &sinmdm_beats::TrackerOptions::default(),
-    )?;
-    Ok((minima, regular))
+    Ok(sinmdm_beats::pulses::motion_beats(motion)?)
 }
 
 /// Beat times given by a person: a file, or a tempo and offset over `seconds`.

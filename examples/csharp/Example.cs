@@ -48,6 +48,17 @@ static class Example
                 Print("default_steps", byDefault.Poses(0));
             using (var between = model.Inbetween(first, new[] { 0, 10, 30, 40 }, 5, seed: 3, steps: 4))
                 Print("inbetween", between.Poses(0));
+            int beatStatus = 0, beatCount = 0;
+            try { beatCount = model.DanceReferenceBeats(first).Length; }
+            catch (SinmdmException e) { beatStatus = (int)e.Status; }
+            Print("dancebeats.status", new float[] { beatStatus, beatCount });
+            var dance = new DanceSettings
+            {
+                ReferenceBeats = new[] { 8, 20, 32 }, MusicBeats = new[] { 5, 17, 29, 41 }, Frames = 50,
+                Ramp = 3, Order = DanceOrder.Shuffled,
+            };
+            using (var danced = model.Dance(first, dance, seed: 3, steps: 4))
+                Print("dance", danced.Poses(0));
             using (var expanded = model.Expand(first, 5, 7, 3, seed: 2, steps: 3))
             using (var composed = model.Compose(first, new[] { 1, 2 }, true, 5, seed: 2, steps: 3))
             using (var styled = model.Harmonize(first, 2, 0.02, seed: 2, steps: 3))

@@ -157,7 +157,7 @@ def plan_harmonize(model, content, factor=HARMONIZE_FACTOR, free_share=HARMONIZE
 
 
 DANCE_TEMPO_RANGE = (0.75, 1.25)
-DANCE_HOLD = 3
+DANCE_HOLD = 5
 DANCE_RAMP = 3
 DANCE_ORDER_STREAM = 2_000_000
 

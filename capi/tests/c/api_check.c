@@ -304,6 +304,25 @@ int main(int argc, char **argv) {
   CHECK_OK(sinmdm_result_poses(between, 0, &bf));
   print_poses("inbetween", &filled);
 
+  /* The reference's dance beats (a size query first), then a dance of 50 frames on music
+     beats every 12 frames from reference beats every 12 frames, the order shuffled. */
+  size_t beat_count = 0;
+  SinmdmStatus beats_status = sinmdm_dance_reference_beats(model, &reference, NULL, 0, &beat_count);
+  float beats_summary[2] = {(float)beats_status, (float)(beats_status == SINMDM_OK ? beat_count : 0)};
+  print_floats("dancebeats.status", beats_summary, 2);
+  size_t reference_beats[3] = {8, 20, 32};
+  size_t music_beats[4] = {5, 17, 29, 41};
+  SinmdmDance dance = {reference_beats, 3, music_beats, 4, 50, 0, 3,
+                       SINMDM_DANCE_ORDER_SHUFFLED, SINMDM_DANCE_LEVEL_AUTO, 1};
+  SinmdmResult *danced = NULL;
+  CHECK_OK(sinmdm_dance(model, &once, &reference, &dance, &danced));
+  Poses dance_poses = poses_alloc(50, joints);
+  SinmdmPoseBuffers bd = buffers_of(&dance_poses);
+  CHECK_OK(sinmdm_result_poses(danced, 0, &bd));
+  print_poses("dance", &dance_poses);
+  poses_free(&dance_poses);
+  sinmdm_result_free(danced);
+
   /* A stream in chunks of 20 and 25 frames. */
   SinmdmStreamOptions stream_options = {11, 3, 30, SINMDM_FEET_PLANTED, NULL, 0, 0, SINMDM_METHOD_ANCESTRAL, 0.0};
   SinmdmStream *stream = NULL;
@@ -365,6 +384,27 @@ int main(int argc, char **argv) {
   EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_inbetween(model, &once, &reference, past_end, 1, 5, &unused));
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_inbetween(model, &once, &reference, NULL, 1, 5, &unused));
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_inbetween(model, &once, NULL, keep, 2, 5, &unused));
+  {
+    size_t ref_beats[3] = {8, 20, 32}, song[4] = {5, 17, 29, 41}, late[2] = {5, 60};
+    SinmdmDance bad = {ref_beats, 3, song, 4, 50, 0, 3, 7, SINMDM_DANCE_LEVEL_AUTO, 1};
+    EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_dance(model, &once, &reference, &bad, &unused));
+    bad.order = SINMDM_DANCE_ORDER_REFERENCE;
+    bad.level = 9;
+    EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_dance(model, &once, &reference, &bad, &unused));
+    bad.level = SINMDM_DANCE_LEVEL_AUTO;
+    bad.keep_root = 2;
+    EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_dance(model, &once, &reference, &bad, &unused));
+    bad.keep_root = 1;
+    bad.music_beats = late;
+    bad.music_beat_count = 2;
+    EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_dance(model, &once, &reference, &bad, &unused));
+    bad.music_beats = NULL;
+    EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_dance(model, &once, &reference, &bad, &unused));
+    bad.music_beats = song;
+    bad.music_beat_count = (size_t)SINMDM_MAX_SAMPLE_FRAMES + 1;
+    EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_dance(model, &once, &reference, &bad, &unused));
+    EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_dance(model, &once, &reference, NULL, &unused));
+  }
   SinmdmPoses no_rotations = {40, sample0.root, NULL, NULL};
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_expand(model, &once, &no_rotations, 5, 5, 3, &unused));
   SinmdmPoses zero_frames = {0, sample0.root, sample0.rot, NULL};

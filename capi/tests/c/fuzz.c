@@ -201,7 +201,7 @@ static void one_case(const char *model_a, const char *work) {
   SinmdmRun **run_out = pick(10) ? &run : NULL;
   SinmdmResult **result_out = pick(10) ? &result : NULL;
   size_t needed = 0;
-  switch (pick(30)) {
+  switch (pick(31)) {
     case 0: {
       SinmdmModel *opened = NULL;
       const char *paths[] = {NULL, "", "/no/such/model.onnx", model_a, work};
@@ -388,6 +388,43 @@ static void one_case(const char *model_a, const char *work) {
     case 28: {
       const char *paths[] = {NULL, "", "/no/such/libonnxruntime.so", model_a};
       CALL("load_onnxruntime", sinmdm_load_onnxruntime(paths[pick(4)]));
+      break;
+    }
+    case 29: {
+      /* Dance: beat arrays of any values and counts, any constants. */
+      static size_t reference_beats[8], music_beats[8];
+      for (size_t i = 0; i < 8; i++) {
+        reference_beats[i] = coin() ? 5 + 6 * i + pick(3) : any_size(SINMDM_MAX_SAMPLE_FRAMES);
+        music_beats[i] = coin() ? 4 + 7 * i : any_size(SINMDM_MAX_SAMPLE_FRAMES);
+      }
+      size_t counts[] = {0, 1, 2, 5, 8, SINMDM_MAX_SAMPLE_FRAMES + 1, SIZE_MAX};
+      size_t reference_count = counts[pick(7)], music_count = counts[pick(7)];
+      if (coin()) {
+        reference_count = reference_count > 8 ? 8 : reference_count;
+        music_count = music_count > 8 ? 8 : music_count;
+      }
+      SinmdmDance dance = {(reference_count <= 8 || coin()) && pick(5) ? reference_beats : NULL, reference_count,
+                           (music_count <= 8 || coin()) && pick(5) ? music_beats : NULL, music_count,
+                           coin() ? 60 : any_size(SINMDM_MAX_SAMPLE_FRAMES), any_size(8),
+                           any_size(SINMDM_MAX_RAMP_FRAMES), pick(4) ? (uint32_t)pick(2) : any_u32(),
+                           pick(4) ? (uint32_t)pick(4) : any_u32(), pick(4) ? (uint32_t)pick(2) : any_u32()};
+      if (reference_count > 8 && dance.reference_beats != NULL) dance.reference_beats = NULL;
+      if (music_count > 8 && dance.music_beats != NULL) dance.music_beats = NULL;
+      const SinmdmDance *dance_ptr = pick(10) ? &dance : NULL;
+      size_t beats[16];
+      switch (pick(3)) {
+        case 0:
+          CALL("dance", sinmdm_dance(model, sampling_ptr, poses_ptr, dance_ptr, result_out));
+          break;
+        case 1:
+          CALL("dance_begin", sinmdm_dance_begin(model, sampling_ptr, poses_ptr, dance_ptr, run_out));
+          break;
+        default:
+          CALL("dance_reference_beats",
+               sinmdm_dance_reference_beats(model, poses_ptr, coin() ? beats : NULL, pick(17),
+                                            coin() ? &needed : NULL));
+          break;
+      }
       break;
     }
     default:

@@ -139,6 +139,7 @@ pub fn expected() -> BTreeMap<String, String> {
     pose_lines("default_steps", &default_steps.poses(0).unwrap(), &mut out);
     let layout = model.metadata().layout.clone();
     let reference = features_from_poses(&layout, &crowd.poses(0).unwrap()).unwrap();
+    let between_reference = reference.clone();
     let between = sinmdm::run(
         &mut model,
         &Request {
@@ -157,6 +158,40 @@ pub fn expected() -> BTreeMap<String, String> {
     )
     .unwrap();
     pose_lines("inbetween", &between.poses(0).unwrap(), &mut out);
+    // The reference's dance beats: the status and count the C ABI gives (0 and the count, or
+    // SINMDM_INVALID_ARGUMENT, 2, and 0 when the motion has no regular beat).
+    let motion = sinmdm::motion::decode(&layout, between_reference.view()).unwrap();
+    let summary = match sinmdm_beats::pulses::motion_beats(&motion) {
+        Ok((_, regular)) => [0.0, regular.frames.len() as f32],
+        Err(_) => [2.0, 0.0],
+    };
+    out.insert("dancebeats.status".into(), hex(summary));
+    let dance = sinmdm::run(
+        &mut model,
+        &Request {
+            task: Task::Dance {
+                reference: between_reference,
+                beats: sinmdm::tasks::DanceBeats {
+                    reference_beats: vec![8, 20, 32],
+                    target_beats: vec![5, 17, 29, 41],
+                    frames: 50,
+                    hold: sinmdm::tasks::DANCE_HOLD,
+                    ramp: 3,
+                    order: sinmdm::tasks::KeyOrder::Shuffled,
+                    level: sinmdm::tasks::BeatLevel::Auto,
+                },
+                root: true,
+            },
+            count: 1,
+            seed: 3,
+            steps: Some(4),
+            feet: Feet::Planted,
+            method: Default::default(),
+        },
+        go,
+    )
+    .unwrap();
+    pose_lines("dance", &dance.poses(0).unwrap(), &mut out);
     let mut stream = Stream::new(
         model.metadata(),
         StreamOptions {

@@ -22,7 +22,7 @@ use crate::diffusion::noise;
 /// `resample_max` of configs/default.yaml).
 pub const DANCE_TEMPO_RANGE: (f64, f64) = (0.75, 1.25);
 /// Default half-width of a keyframe window, in frames.
-pub const DANCE_HOLD: usize = 3;
+pub const DANCE_HOLD: usize = 5;
 /// Default soft border of a keyframe window, in frames.
 pub const DANCE_RAMP: usize = 3;
 /// Noise stream of the shuffled keyframe order (SPEC section 7's counter-based words).
