@@ -9,4 +9,7 @@ cargo test --release --workspace
 # protobuf 3.7, the export crate pins 3.4.0), built into its own target folder.
 CARGO_TARGET_DIR=target/burn-import-check \
   cargo test --release --manifest-path tests/burn-import-check/Cargo.toml
+# MP3/OGG/FLAC input is a feature of the beat tracker's crate (symphonia), tested in its own
+# target folder so the workspace's default-feature build is not rebuilt back and forth.
+CARGO_TARGET_DIR=target/compressed cargo test --release -p sinmdm-beats --features compressed
 .venv/bin/python -m pytest -q tests/python

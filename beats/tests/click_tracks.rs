@@ -101,3 +101,35 @@ fn a_short_clip_is_refused_with_its_length() {
     let e = track_beats(&audio).unwrap_err().to_string();
     assert!(e.contains("1.00 s") && e.contains("--bpm"), "{e}");
 }
+
+/// With the `compressed` feature, FLAC reads as the same samples as the WAV it was made from
+/// (tests/data/audio/drum_heavy_kick.flac: the WAV written by soundfile as 16-bit FLAC).
+#[cfg(feature = "compressed")]
+#[test]
+fn flac_reads_as_its_wav() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/audio");
+    let wav = sinmdm_beats::read_audio(&dir.join("drum_heavy_kick.wav")).unwrap();
+    let flac = sinmdm_beats::read_audio(&dir.join("drum_heavy_kick.flac")).unwrap();
+    assert_eq!(
+        (flac.rate, flac.samples.len()),
+        (wav.rate, wav.samples.len())
+    );
+    let worst = wav
+        .samples
+        .iter()
+        .zip(&flac.samples)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
+    assert!(worst <= 1.0 / 32768.0, "{worst}");
+}
+
+/// Without it, a compressed file is refused with the way round.
+#[cfg(not(feature = "compressed"))]
+#[test]
+fn flac_needs_the_compressed_feature() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/audio");
+    let e = sinmdm_beats::read_audio(&dir.join("drum_heavy_kick.flac"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("compressed") && e.contains("WAV"), "{e}");
+}

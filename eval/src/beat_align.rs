@@ -21,7 +21,7 @@ pub const BAS_SIGMA_SECONDS: f64 = 0.05;
 /// Random-phase shifts averaged for the control scores.
 pub const CONTROL_DRAWS: usize = 16;
 /// Noise stream of the control's phase shifts.
-pub const CONTROL_STREAM: u64 = 3_000_000;
+pub const CONTROL_STREAM: u64 = 4_000_000;
 
 /// Beat alignment of one motion against one set of music beats.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -159,7 +159,7 @@ def plan_harmonize(model, content, factor=HARMONIZE_FACTOR, free_share=HARMONIZE
 DANCE_TEMPO_RANGE = (0.75, 1.25)
 DANCE_HOLD = 5
 DANCE_RAMP = 3
-DANCE_ORDER_STREAM = 2_000_000
+DANCE_ORDER_STREAM = 3_000_000
 
 
 def _median_interval(beats):

@@ -26,7 +26,8 @@ def joint_names(path):
 
 def test_the_expected_models_ship():
     names = {m.name for m in MODELS}
-    assert {"human_walk_cmu.onnx", "human_hop_cmu.onnx", "fox_survey_khronos.onnx"} <= names
+    assert {"human_walk_cmu.onnx", "human_hop_cmu.onnx", "fox_survey_khronos.onnx",
+            "human_dance_rokoko.onnx"} <= names
 
 
 @pytest.mark.parametrize("model", MODELS, ids=lambda m: m.stem)
@@ -52,7 +53,9 @@ def test_main_command_writes_bvh_files_that_parse(tmp_path):
     assert str(out) in done.stdout
     walk = CLIPS / "human_walk_cmu_131_01.bvh"
     fox = CLIPS / "fox_survey_khronos.bvh"
+    dance = CLIPS / "human_dance_rokoko_jesse.bvh"
     expected = {
+        "dance_000.bvh": dance, "dance_001.bvh": dance,
         "walk_new_000.bvh": walk, "walk_new_001.bvh": walk, "walk_new_002.bvh": walk,
         "walk_inbetween.bvh": walk, "walk_in_hop_style.bvh": walk,
         "fox_new_000.bvh": fox, "fox_new_001.bvh": fox, "fox_new_002.bvh": fox,
@@ -68,3 +71,9 @@ def test_main_command_writes_bvh_files_that_parse(tmp_path):
     walk_frames = info(ROOT / "onnx-models" / "human_walk_cmu.onnx")["training"]["clip_frames"]
     assert bvhio.readAsBvh(str(out / "walk_new_000.bvh")).FrameCount == 2 * walk_frames
     assert (out / "walk_new.gif").read_bytes()[:6] == b"GIF89a"
+    assert (out / "dance.gif").read_bytes()[:6] == b"GIF89a"
+    # The dance lasts as long as the music (6.86 s at 30 fps) and keeps keyframes on its beats.
+    used = json.loads((out / "dance_beats.json").read_text())
+    assert bvhio.readAsBvh(str(out / "dance_000.bvh")).FrameCount == used["frames"] == 206
+    assert len(used["keyframes"]) >= 6
+    assert (out / "amen_click.wav").read_bytes()[:4] == b"RIFF"

@@ -26,7 +26,7 @@ pub const DANCE_HOLD: usize = 5;
 /// Default soft border of a keyframe window, in frames.
 pub const DANCE_RAMP: usize = 3;
 /// Noise stream of the shuffled keyframe order (SPEC section 7's counter-based words).
-pub const DANCE_ORDER_STREAM: u64 = 2_000_000;
+pub const DANCE_ORDER_STREAM: u64 = 3_000_000;
 
 /// Which of the music's beats carry keyframes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
