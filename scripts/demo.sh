@@ -4,8 +4,8 @@
 #  - an in-between (the clip's first 3 s and its last part kept, the gap generated),
 #  - a style transfer: the CMU walk in the style of the model trained on the CMU hop,
 #  - three new fox motions from the fox model,
-#  - a dance to a CC0 breakbeat loop from the model of the Rokoko dance (with a GIF, the beats it
-#    used, and the loop with a click on each beat the tracker found),
+#  - two dances (seeds 1 and 2) to a CC0 breakbeat loop from the model of the Rokoko dance (with
+#    a GIF, the beats each used, and the loop with a click on each beat the tracker found),
 # as BVH files (they open in Blender with the clip's skeleton, units and frame rate),
 #  - and a crowd of eight walks as ONE glTF file (walk_crowd.glb: one animation each, metres,
 #    +Y up), which Godot, Blender, three.js and Unity's glTFast open as it is.
@@ -28,8 +28,11 @@ music=tests/data/audio/loop_amen_full.wav
 "$sinmdm" harmonize -m "$hop_model" --content "$walk" -o "$out/walk_in_hop_style.bvh"
 "$sinmdm" generate -m "$fox_model" --count 3 --seed 1 -o "$out/fox_new.bvh" --render "$out/fox_new.gif"
 "$sinmdm" beats "$music" --click "$out/amen_click.wav"
-"$sinmdm" dance -m "$dance_model" --reference "$dance" --music "$music" --count 2 --seed 1 \
-  -o "$out/dance.bvh" --render "$out/dance.gif" --beats-out "$out/dance_beats.json"
+for seed in 1 2; do
+  "$sinmdm" dance -m "$dance_model" --reference "$dance" --music "$music" --seed "$seed" \
+    -o "$out/dance_$seed.bvh" --beats-out "$out/dance_beats_$seed.json"
+done
+"$sinmdm" render "$out/dance_1.bvh" "$out/dance_2.bvh" -o "$out/dance.gif"
 # CMU's unit is unsure from the skeleton's height alone; it is 1/0.45 inch.
 "$sinmdm" generate -m "$walk_model" --count 8 --seed 2 -o "$out/walk_crowd.glb" --unit-scale 0.056444
 echo

@@ -76,7 +76,7 @@ namespace Sinmdm
     /// <summary>Poses as flat arrays: root position (3 per frame), local rotations x,y,z,w
     /// (4 per joint and frame), local translations (3 per joint and frame).</summary>
     /// <summary>The order of a dance's keyframes.</summary>
-    public enum DanceOrder : uint { Reference = 0, Shuffled = 1 }
+    public enum DanceOrder : uint { Shuffled = 0, Reference = 1 }
 
     /// <summary>Which of the music's beats carry a dance's keyframes.</summary>
     public enum BeatLevel : uint { Auto = 0, Every = 1, EveryOther = 2, Half = 3 }
@@ -93,8 +93,8 @@ namespace Sinmdm
         /// <summary>Half-width of each keyframe window in frames; 0 for the library's default.</summary>
         public int Hold;
         /// <summary>Soft border on the kept side of each window, in frames.</summary>
-        public int Ramp = 3;
-        public DanceOrder Order = DanceOrder.Reference;
+        public int Ramp = 13;
+        public DanceOrder Order = DanceOrder.Shuffled;
         public BeatLevel Level = BeatLevel.Auto;
         /// <summary>Whether the root's travel and height in each window come from the reference.</summary>
         public bool KeepRoot = true;

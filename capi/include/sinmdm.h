@@ -76,14 +76,15 @@
 #include <stdlib.h>
 
 /*
- Keyframe order: the reference's own, over and over (the default).
+ Keyframe order: each pass over the reference's beats in an order drawn from the seed (the
+ default).
  */
-#define SINMDM_DANCE_ORDER_REFERENCE 0
+#define SINMDM_DANCE_ORDER_SHUFFLED 0
 
 /*
- Keyframe order: each pass over the reference's beats in an order drawn from the seed.
+ Keyframe order: the reference's own, over and over.
  */
-#define SINMDM_DANCE_ORDER_SHUFFLED 1
+#define SINMDM_DANCE_ORDER_REFERENCE 1
 
 /*
  Beat level: the one that brings the music's tempo nearest the reference's (the default).
@@ -109,12 +110,12 @@
  Default half-width of a keyframe window, in frames (`hold` of 0 takes it too); the
  library's `DANCE_HOLD`, which a test keeps equal.
  */
-#define SINMDM_DANCE_HOLD 5
+#define SINMDM_DANCE_HOLD 12
 
 /*
  Default soft border of a keyframe window, in frames (the library's `DANCE_RAMP`).
  */
-#define SINMDM_DANCE_RAMP 3
+#define SINMDM_DANCE_RAMP 13
 
 /*
  The longest sample a task makes, and the longest stream chunk or block, in frames

@@ -16,10 +16,11 @@ use crate::status::{Failure, SinmdmStatus, guard};
 use crate::tasks::{reference_features, sampling_arg};
 use crate::text::{copy_array, handle, slice_arg};
 
-/// Keyframe order: the reference's own, over and over (the default).
-pub const SINMDM_DANCE_ORDER_REFERENCE: u32 = 0;
-/// Keyframe order: each pass over the reference's beats in an order drawn from the seed.
-pub const SINMDM_DANCE_ORDER_SHUFFLED: u32 = 1;
+/// Keyframe order: each pass over the reference's beats in an order drawn from the seed (the
+/// default).
+pub const SINMDM_DANCE_ORDER_SHUFFLED: u32 = 0;
+/// Keyframe order: the reference's own, over and over.
+pub const SINMDM_DANCE_ORDER_REFERENCE: u32 = 1;
 
 /// Beat level: the one that brings the music's tempo nearest the reference's (the default).
 pub const SINMDM_DANCE_LEVEL_AUTO: u32 = 0;
@@ -32,9 +33,9 @@ pub const SINMDM_DANCE_LEVEL_HALF: u32 = 3;
 
 /// Default half-width of a keyframe window, in frames (`hold` of 0 takes it too); the
 /// library's `DANCE_HOLD`, which a test keeps equal.
-pub const SINMDM_DANCE_HOLD: usize = 5;
+pub const SINMDM_DANCE_HOLD: usize = 12;
 /// Default soft border of a keyframe window, in frames (the library's `DANCE_RAMP`).
-pub const SINMDM_DANCE_RAMP: usize = 3;
+pub const SINMDM_DANCE_RAMP: usize = 13;
 
 /// A dance's beats and placement. Beat frames are at the model's frame rate, increasing.
 #[repr(C)]
@@ -86,11 +87,11 @@ unsafe fn beats_arg(
 /// The struct's arrays are readable for their counts.
 unsafe fn dance_arg(dance: &SinmdmDance) -> Result<DanceBeats, Failure> {
     let order = match dance.order {
-        SINMDM_DANCE_ORDER_REFERENCE => KeyOrder::Reference,
         SINMDM_DANCE_ORDER_SHUFFLED => KeyOrder::Shuffled,
+        SINMDM_DANCE_ORDER_REFERENCE => KeyOrder::Reference,
         other => {
             return Err(Failure::invalid(format!(
-                "dance.order must be SINMDM_DANCE_ORDER_REFERENCE (0) or SINMDM_DANCE_ORDER_SHUFFLED (1), got {other}"
+                "dance.order must be SINMDM_DANCE_ORDER_SHUFFLED (0) or SINMDM_DANCE_ORDER_REFERENCE (1), got {other}"
             )));
         }
     };

@@ -22,11 +22,12 @@ pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm dance -m onnx-models/human_dance_rokoko.onnx --reference tests/data/bvh/human_dance_rokoko_jesse.bvh \\
       --music tests/data/audio/loop_amen_full.wav -o out/dance.bvh
   sinmdm dance -m dance.onnx --reference dance.bvh --bpm 126 --offset 0.2 --seconds 20 -o out/d.glb
-  sinmdm dance -m dance.onnx --reference dance.bvh --beats beats.txt --count 4 --order shuffled -o out/d.bvh
+  sinmdm dance -m dance.onnx --reference dance.bvh --beats beats.txt --count 4 --order reference -o out/d.bvh
   sinmdm dance -m dance.onnx --reference dance.bvh --music song.wav --beats-out out/used.json -o out/d.bvh
 
 The reference's poses at its kinematic beats (`sinmdm beats --motion`) are placed on the music's
-beats, a window of 2 x hold + 1 frames each, and everything between them is generated. When the
+beats, a window of 2 x hold + 1 frames each (weight 1 at the beat, falling linearly over the ramp),
+and everything between them is generated. When the
 tracker's beats are off the beat, give them with --beats FILE or --bpm N --offset T.";
 
 /// Which music beats carry keyframes (`--level`).
@@ -56,10 +57,10 @@ impl From<LevelArg> for BeatLevel {
 /// The keyframes' order (`--order`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum OrderArg {
-    /// The reference's own order, over and over.
-    Reference,
     /// A new order each pass over the reference's beats, drawn from the seed.
     Shuffled,
+    /// The reference's own order, over and over.
+    Reference,
 }
 
 /// What the root does inside the keyframe windows (`--root`).
@@ -90,11 +91,12 @@ pub struct DanceOptions {
     /// Half-width of each keyframe window, in frames.
     #[arg(long, default_value_t = DANCE_HOLD)]
     pub hold: usize,
-    /// Soft border on the kept side of each window, in frames (at most hold + 1).
+    /// Soft border on the kept side of each window, in frames (at most hold + 1; the default,
+    /// hold + 1, makes each window a triangle whose weight is 1 at the beat only).
     #[arg(long, default_value_t = DANCE_RAMP)]
     pub ramp: usize,
     /// Order of the keyframes.
-    #[arg(long, value_enum, default_value_t = OrderArg::Reference)]
+    #[arg(long, value_enum, default_value_t = OrderArg::Shuffled)]
     pub order: OrderArg,
     /// Which music beats carry keyframes.
     #[arg(long, value_enum, default_value_t = LevelArg::Auto)]

@@ -72,7 +72,7 @@ def main(argv=None):
     da.add_argument("--frames", type=int, required=True)
     da.add_argument("--hold", type=int, default=tasks.DANCE_HOLD)
     da.add_argument("--ramp", type=int, default=tasks.DANCE_RAMP)
-    da.add_argument("--order", choices=["reference", "shuffled"], default="reference")
+    da.add_argument("--order", choices=["shuffled", "reference"], default="shuffled")
     da.add_argument("--level", choices=["auto", "every", "every-other", "half"], default="auto")
     da.add_argument("--root", choices=["kept", "free"], default="kept")
     st = common(sub.add_parser("stream"))

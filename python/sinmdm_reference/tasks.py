@@ -157,8 +157,8 @@ def plan_harmonize(model, content, factor=HARMONIZE_FACTOR, free_share=HARMONIZE
 
 
 DANCE_TEMPO_RANGE = (0.75, 1.25)
-DANCE_HOLD = 5
-DANCE_RAMP = 3
+DANCE_HOLD = 12
+DANCE_RAMP = 13
 DANCE_ORDER_STREAM = 3_000_000
 
 
@@ -243,7 +243,7 @@ def place_keyframes(reference_frames, reference_beats, target_beats, frames, hol
 
 
 def plan_dance(model, reference, reference_beats, target_beats, frames, hold=DANCE_HOLD,
-               ramp=DANCE_RAMP, order="reference", level="auto", root=True, seed=0):
+               ramp=DANCE_RAMP, order="shuffled", level="auto", root=True, seed=0):
     if ramp > MAX_SAMPLE_FRAMES:
         raise TaskError(f"a ramp of {ramp} frames is too wide")
     y = model.normalize(reference)

@@ -21,16 +21,16 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 SINMDM = ROOT / "target" / "release" / "sinmdm"
 
 SETTINGS = [
-    ("naive: hold 2, hard borders", ["--hold", 2, "--ramp", 1]),
-    ("hold 5, ramp 3 (default)", []),
-    ("hold 3, ramp 3", ["--hold", 3]),
-    ("hold 4, ramp 3", ["--hold", 4]),
-    ("hold 6, ramp 5", ["--hold", 6, "--ramp", 5]),
-    ("hold 8, ramp 4", ["--hold", 8, "--ramp", 4]),
-    ("hold 5, ramp 1", ["--ramp", 1]),
-    ("hold 5, ramp 2", ["--ramp", 2]),
-    ("hold 5, shuffled order", ["--order", "shuffled"]),
-    ("hold 5, root free", ["--root", "free"]),
+    ("naive: hold 2, hard borders", ["--hold", 2, "--ramp", 1, "--order", "reference"]),
+    ("hold 12, ramp 13, shuffled (default)", []),
+    ("hold 12, ramp 13, reference order", ["--order", "reference"]),
+    ("hold 12, ramp 13, root free", ["--root", "free"]),
+    ("hold 9, ramp 10", ["--hold", 9, "--ramp", 10]),
+    ("hold 7, ramp 8", ["--hold", 7, "--ramp", 8]),
+    ("hold 5, ramp 3", ["--hold", 5, "--ramp", 3]),
+    ("hold 5, ramp 3, reference order", ["--hold", 5, "--ramp", 3, "--order", "reference"]),
+    ("hold 3, ramp 3", ["--hold", 3, "--ramp", 3]),
+    ("hold 5, ramp 1", ["--hold", 5, "--ramp", 1]),
 ]
 RATIOS = [0.8, 1.0, 1.25]
 

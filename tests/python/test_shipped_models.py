@@ -55,7 +55,7 @@ def test_main_command_writes_bvh_files_that_parse(tmp_path):
     fox = CLIPS / "fox_survey_khronos.bvh"
     dance = CLIPS / "human_dance_rokoko_jesse.bvh"
     expected = {
-        "dance_000.bvh": dance, "dance_001.bvh": dance,
+        "dance_1.bvh": dance, "dance_2.bvh": dance,
         "walk_new_000.bvh": walk, "walk_new_001.bvh": walk, "walk_new_002.bvh": walk,
         "walk_inbetween.bvh": walk, "walk_in_hop_style.bvh": walk,
         "fox_new_000.bvh": fox, "fox_new_001.bvh": fox, "fox_new_002.bvh": fox,
@@ -73,7 +73,7 @@ def test_main_command_writes_bvh_files_that_parse(tmp_path):
     assert (out / "walk_new.gif").read_bytes()[:6] == b"GIF89a"
     assert (out / "dance.gif").read_bytes()[:6] == b"GIF89a"
     # The dance lasts as long as the music (6.86 s at 30 fps) and keeps keyframes on its beats.
-    used = json.loads((out / "dance_beats.json").read_text())
-    assert bvhio.readAsBvh(str(out / "dance_000.bvh")).FrameCount == used["frames"] == 206
+    used = json.loads((out / "dance_beats_1.json").read_text())
+    assert bvhio.readAsBvh(str(out / "dance_1.bvh")).FrameCount == used["frames"] == 206
     assert len(used["keyframes"]) >= 6
     assert (out / "amen_click.wav").read_bytes()[:4] == b"RIFF"

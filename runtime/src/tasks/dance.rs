@@ -22,9 +22,10 @@ use crate::diffusion::noise;
 /// `resample_max` of configs/default.yaml).
 pub const DANCE_TEMPO_RANGE: (f64, f64) = (0.75, 1.25);
 /// Default half-width of a keyframe window, in frames.
-pub const DANCE_HOLD: usize = 5;
-/// Default soft border of a keyframe window, in frames.
-pub const DANCE_RAMP: usize = 3;
+pub const DANCE_HOLD: usize = 12;
+/// Default soft border of a keyframe window, in frames: the whole half-window (`DANCE_HOLD + 1`),
+/// so each window's weight rises linearly to 1 at its beat and falls back (a triangle).
+pub const DANCE_RAMP: usize = 13;
 /// Noise stream of the shuffled keyframe order (SPEC section 7's counter-based words).
 pub const DANCE_ORDER_STREAM: u64 = 3_000_000;
 
@@ -80,12 +81,14 @@ impl fmt::Display for BeatLevel {
 }
 
 /// The order in which the reference's beat windows follow each other on the music's beats.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum KeyOrder {
+    /// Each pass over the reference's usable beats in an order drawn from the seed (the
+    /// default: a new sequence of the reference's moves for every seed).
+    #[default]
+    Shuffled,
     /// The reference's own order, starting again from its first usable beat at the end.
     Reference,
-    /// Each pass over the reference's usable beats in an order drawn from the seed.
-    Shuffled,
 }
 
 impl KeyOrder {
