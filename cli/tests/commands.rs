@@ -318,3 +318,67 @@ fn every_command_that_reads_a_clip_reads_gltf_and_fbx_and_names_what_it_refuses(
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn dance_and_beats_name_what_they_refuse_and_write_nothing() {
+    let dir = std::env::temp_dir().join(format!("sinmdm-dance-refusals-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = repo_file("onnx-models/human_dance_rokoko.onnx");
+    let clip = repo_file("tests/data/bvh/human_dance_rokoko_jesse.bvh");
+    let out = dir.join("dance.bvh");
+    let used = dir.join("used.json");
+    let base = |bpm: &str| {
+        vec![
+            "dance".to_string(),
+            "-m".into(),
+            model.to_str().unwrap().into(),
+            "--reference".into(),
+            clip.to_str().unwrap().into(),
+            "--bpm".into(),
+            bpm.into(),
+            "--seconds".into(),
+            "6".into(),
+            "--steps".into(),
+            "4".into(),
+            "-o".into(),
+            out.to_str().unwrap().into(),
+            "--quiet".into(),
+        ]
+    };
+    // At 20 BPM every beat is 3.1x the clip's beat, every other one 6.2x and half beats 1.55x:
+    // refused, naming the ratio and the trained range.
+    let args = base("20");
+    let (ok, _, err) = run_text(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        !ok && err.contains("0.75-1.25") && err.contains("--bpm"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // A beat file with a time that goes back names its line.
+    let beats = dir.join("beats.txt");
+    std::fs::write(&beats, "0.5\n1.0\n0.9\n").unwrap();
+    let mut args = base("120");
+    let at = args.iter().position(|a| a == "--bpm").unwrap();
+    args.splice(
+        at..at + 2,
+        ["--beats".to_string(), beats.to_str().unwrap().into()],
+    );
+    let (ok, _, err) = run_text(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(!ok && err.contains("beats.txt, line 3"), "{err}");
+    assert!(!out.exists());
+    // A good dance records the beats it used: keyframes on every other beat of 124 BPM.
+    let mut args = base("124");
+    args.extend(["--beats-out".into(), used.to_str().unwrap().into()]);
+    let (ok, stdout, err) = run_text(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(ok, "{err}");
+    assert!(stdout.contains("Beat Align Score"), "{stdout}");
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&used).unwrap()).unwrap();
+    assert_eq!(record["level"], "every-other");
+    assert_eq!(record["frames"], 180);
+    assert!(out.exists());
+    // A song that is not there is named; a missing --music is asked for.
+    let (ok, _, err) = run_text(&["beats", "no/such/song.wav"]);
+    assert!(!ok && err.contains("no/such/song.wav"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
