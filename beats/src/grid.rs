@@ -18,6 +18,8 @@ pub fn read_beat_file(path: &Path) -> Result<Vec<f64>, BeatsError> {
         source,
     })?;
     let mut times: Vec<f64> = Vec::new();
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let mut seen_data = false;
     for (i, line) in text.lines().enumerate() {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') {
@@ -32,9 +34,12 @@ pub fn read_beat_file(path: &Path) -> Result<Vec<f64>, BeatsError> {
             line: i + 1,
             reason,
         };
+        let first_line = !seen_data;
+        seen_data = true;
         let time: f64 = match field.parse() {
             Ok(t) => t,
-            Err(_) if times.is_empty() && i == 0 => continue,
+            // A header: the first line that is not a comment, with no digit in it.
+            Err(_) if first_line && !line.chars().any(|c| c.is_ascii_digit()) => continue,
             Err(_) => return Err(bad(format!("'{field}' is not a time in seconds"))),
         };
         if !time.is_finite() || time < 0.0 {
@@ -57,7 +62,7 @@ pub fn read_beat_file(path: &Path) -> Result<Vec<f64>, BeatsError> {
     if times.len() < 2 {
         return Err(BeatsError::BeatFile {
             path: path.to_path_buf(),
-            line: text.lines().count(),
+            line: text.lines().count().max(1),
             reason: format!("{} beat(s) in the file; at least 2 are needed", times.len()),
         });
     }
@@ -181,6 +186,12 @@ mod tests {
         std::fs::write(&bad, "0.5\nsoon\n").unwrap();
         let e = read_beat_file(&bad).unwrap_err().to_string();
         assert!(e.contains("line 2") && e.contains("soon"), "{e}");
+        // A byte-order mark is not a header; a first time with a typo is an error, not skipped.
+        std::fs::write(&bad, "\u{feff}0.5\n1.0\n1.5\n").unwrap();
+        assert_eq!(read_beat_file(&bad).unwrap(), vec![0.5, 1.0, 1.5]);
+        std::fs::write(&bad, "# tapped\n0.5s\n1.0\n").unwrap();
+        let e = read_beat_file(&bad).unwrap_err().to_string();
+        assert!(e.contains("line 2") && e.contains("0.5s"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

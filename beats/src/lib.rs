@@ -33,9 +33,10 @@ pub struct Beats {
     pub bpm: f64,
     /// Beat times in seconds from the start of the audio, increasing.
     pub times: Vec<f64>,
-    /// How strongly the onsets mark the beats, 0 to 1: `1 - m / b`, where `b` is the onset
-    /// strength's mean at the beats and `m` its mean over the whole piece (0 when the beats are
-    /// no stronger than any moment; near 1 when nearly all onset energy sits on them).
+    /// How strongly the onsets mark the beats, 0 to 1: `1 - m / b`, where `b` is the mean over
+    /// beats of the onset strength's largest value within two envelope frames of each, and `m`
+    /// its mean over the whole piece (0 when the beats are no stronger than any moment; near 1
+    /// when nearly all onset energy sits on them).
     pub confidence: f64,
 }
 

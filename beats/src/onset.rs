@@ -119,28 +119,29 @@ fn log_mel_spectrogram(samples: &[f32], rate: f64, window: usize, hop: usize) ->
     spectra
 }
 
-/// Mel scale of Slaney's auditory toolbox: linear to 1 kHz, logarithmic above.
+/// Slaney's mel scale (his auditory toolbox): linear below [`MEL_KNEE_HZ`] in steps of
+/// [`MEL_LINEAR_STEP_HZ`] per mel, logarithmic above with 27 mels per factor of 6.4.
+const MEL_KNEE_HZ: f64 = 1000.0;
+const MEL_LINEAR_STEP_HZ: f64 = 200.0 / 3.0;
+const MEL_KNEE: f64 = MEL_KNEE_HZ / MEL_LINEAR_STEP_HZ;
+
+fn mel_log_step() -> f64 {
+    6.4f64.ln() / 27.0
+}
+
 fn hz_to_mel(hz: f64) -> f64 {
-    let linear_step = 200.0 / 3.0;
-    let knee_hz = 1000.0;
-    let knee_mel = knee_hz / linear_step;
-    let log_step = 6.4f64.ln() / 27.0;
-    if hz < knee_hz {
-        hz / linear_step
+    if hz < MEL_KNEE_HZ {
+        hz / MEL_LINEAR_STEP_HZ
     } else {
-        knee_mel + (hz / knee_hz).ln() / log_step
+        MEL_KNEE + (hz / MEL_KNEE_HZ).ln() / mel_log_step()
     }
 }
 
 fn mel_to_hz(mel: f64) -> f64 {
-    let linear_step = 200.0 / 3.0;
-    let knee_hz = 1000.0;
-    let knee_mel = knee_hz / linear_step;
-    let log_step = 6.4f64.ln() / 27.0;
-    if mel < knee_mel {
-        mel * linear_step
+    if mel < MEL_KNEE {
+        mel * MEL_LINEAR_STEP_HZ
     } else {
-        knee_hz * (log_step * (mel - knee_mel)).exp()
+        MEL_KNEE_HZ * (mel_log_step() * (mel - MEL_KNEE)).exp()
     }
 }
 

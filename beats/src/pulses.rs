@@ -31,13 +31,13 @@ pub fn regular_beats(
 ) -> Result<RegularBeats, BeatsError> {
     let seconds = frames as f64 / frame_rate;
     let sigma = (PULSE_SECONDS * frame_rate).max(0.5);
-    let reach = (4.0 * sigma).ceil() as usize;
+    let reach = (4.0 * sigma).ceil().min(frames as f64) as usize;
     let mut values = vec![0.0f32; frames];
     for &e in events.iter().filter(|&&e| e < frames) {
         for (t, v) in values
             .iter_mut()
             .enumerate()
-            .take((e + reach + 1).min(frames))
+            .take(e.saturating_add(reach).saturating_add(1).min(frames))
             .skip(e.saturating_sub(reach))
         {
             let d = (t as f64 - e as f64) / sigma;

@@ -1,7 +1,7 @@
 //! The beat sequence: dynamic programming over envelope frames (Ellis 2007).
 //!
 //! Each frame's local score is the envelope (divided by its standard deviation) smoothed by a
-//! Gaussian a sixteenth of a period wide. A beat at frame `i` follows the best previous beat
+//! Gaussian of standard deviation period / 32. A beat at frame `i` follows the best previous beat
 //! `j` between half a period and two periods earlier, scored by the previous beat's cumulative
 //! score less `tightness * ln((i - j) / period)^2`. The sequence is read back from the last
 //! strong cumulative peak; weak beats at its ends (silence before the music starts or after it

@@ -73,8 +73,6 @@ namespace Sinmdm
         }
     }
 
-    /// <summary>Poses as flat arrays: root position (3 per frame), local rotations x,y,z,w
-    /// (4 per joint and frame), local translations (3 per joint and frame).</summary>
     /// <summary>The order of a dance's keyframes.</summary>
     public enum DanceOrder : uint { Shuffled = 0, Reference = 1 }
 
@@ -100,6 +98,8 @@ namespace Sinmdm
         public bool KeepRoot = true;
     }
 
+    /// <summary>Poses as flat arrays: root position (3 per frame), local rotations x,y,z,w
+    /// (4 per joint and frame), local translations (3 per joint and frame).</summary>
     public sealed class Poses
     {
         public readonly int Frames, Joints;
@@ -120,6 +120,8 @@ namespace Sinmdm
     {
         /// <summary>Respaced sampling steps used unless told otherwise (SINMDM_DEFAULT_STEPS).</summary>
         public const uint DefaultSteps = 50;
+        /// <summary>Respaced steps per block of a stream unless told otherwise (SINMDM_DEFAULT_STREAM_STEPS).</summary>
+        public const uint DefaultStreamSteps = 20;
 
         /// <summary>A `steps` value that runs all of the model's diffusion steps T (SINMDM_ALL_STEPS;
         /// slow, the reference quality). 0 gives DefaultSteps.</summary>
@@ -562,7 +564,7 @@ namespace Sinmdm
             finally { pinned.Free(); }
         }
 
-        public MotionStream(Model model, ulong seed, uint steps = Runtime.DefaultSteps, uint blockFrames = 0, Feet feet = Feet.Planted,
+        public MotionStream(Model model, ulong seed, uint steps = Runtime.DefaultStreamSteps, uint blockFrames = 0, Feet feet = Feet.Planted,
                             Method method = Method.Ancestral, double eta = 0.0)
             : this(model, new StreamSettings { Seed = seed, Steps = steps, BlockFrames = blockFrames, Feet = feet, Method = method, Eta = eta }) { }
 

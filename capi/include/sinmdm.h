@@ -180,6 +180,12 @@
 #define SINMDM_DEFAULT_STEPS 50
 
 /*
+ Respaced sampling steps per block of a stream (the library's `DEFAULT_STREAM_STEPS`); what a
+ `steps` of 0 gives in `SinmdmStreamOptions`.
+ */
+#define SINMDM_DEFAULT_STREAM_STEPS 20
+
+/*
  A `steps` value that runs all of the model's diffusion steps T (slow; the reference quality).
  */
 #define SINMDM_ALL_STEPS UINT32_MAX
@@ -481,7 +487,7 @@ typedef struct SinmdmStreamOptions {
    */
   uint64_t seed;
   /*
-   Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STEPS`, `SINMDM_ALL_STEPS` for
+   Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STREAM_STEPS`, `SINMDM_ALL_STEPS` for
    all of the model's T.
    */
   uint32_t steps;

@@ -100,8 +100,9 @@ pub use result::{
 };
 pub use run::{SinmdmRun, sinmdm_run_finish, sinmdm_run_free, sinmdm_run_step};
 pub use sampling::{
-    SINMDM_ALL_STEPS, SINMDM_DEFAULT_STEPS, SINMDM_FEET_PLANTED, SINMDM_FEET_RAW,
-    SINMDM_METHOD_ANCESTRAL, SINMDM_METHOD_DDIM, SINMDM_METHOD_DPM2M, SinmdmSampling, SinmdmSpan,
+    SINMDM_ALL_STEPS, SINMDM_DEFAULT_STEPS, SINMDM_DEFAULT_STREAM_STEPS, SINMDM_FEET_PLANTED,
+    SINMDM_FEET_RAW, SINMDM_METHOD_ANCESTRAL, SINMDM_METHOD_DDIM, SINMDM_METHOD_DPM2M,
+    SinmdmSampling, SinmdmSpan,
 };
 pub use status::{SinmdmStatus, sinmdm_last_error};
 pub use stream::{

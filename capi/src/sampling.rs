@@ -8,13 +8,22 @@ use crate::status::Failure;
 /// of 0 gives in `SinmdmSampling` and `SinmdmStreamOptions`.
 pub const SINMDM_DEFAULT_STEPS: u32 = 50;
 
+/// Respaced sampling steps per block of a stream (the library's `DEFAULT_STREAM_STEPS`); what a
+/// `steps` of 0 gives in `SinmdmStreamOptions`.
+pub const SINMDM_DEFAULT_STREAM_STEPS: u32 = 20;
+
 /// A `steps` value that runs all of the model's diffusion steps T (slow; the reference quality).
 pub const SINMDM_ALL_STEPS: u32 = u32::MAX;
 
 /// The library's step count for a C `steps` value: 0 is the default, `SINMDM_ALL_STEPS` all T.
 pub(crate) fn steps_arg(steps: u32) -> Option<usize> {
+    steps_or(steps, sinmdm::DEFAULT_STEPS)
+}
+
+/// As [`steps_arg`], with `default` for 0 (a stream's is `SINMDM_DEFAULT_STREAM_STEPS`).
+pub(crate) fn steps_or(steps: u32, default: usize) -> Option<usize> {
     match steps {
-        0 => Some(sinmdm::DEFAULT_STEPS),
+        0 => Some(default),
         SINMDM_ALL_STEPS => None,
         n => Some(n as usize),
     }
@@ -112,6 +121,14 @@ mod default_steps_tests {
         assert_eq!(SINMDM_DEFAULT_STEPS as usize, sinmdm::DEFAULT_STEPS);
         assert_eq!(steps_arg(0), Some(sinmdm::DEFAULT_STEPS));
         assert_eq!(steps_arg(SINMDM_DEFAULT_STEPS), Some(sinmdm::DEFAULT_STEPS));
+        assert_eq!(
+            SINMDM_DEFAULT_STREAM_STEPS as usize,
+            sinmdm::DEFAULT_STREAM_STEPS
+        );
+        assert_eq!(
+            steps_or(0, sinmdm::DEFAULT_STREAM_STEPS),
+            Some(sinmdm::DEFAULT_STREAM_STEPS)
+        );
         assert_eq!(steps_arg(SINMDM_ALL_STEPS), None);
         assert_eq!(steps_arg(7), Some(7));
     }

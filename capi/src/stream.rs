@@ -5,7 +5,7 @@ use sinmdm::{Stream, StreamCompose, StreamOptions};
 use crate::limits::{SINMDM_MAX_JOINT_INDICES, SINMDM_MAX_SAMPLE_FRAMES};
 use crate::model::SinmdmModel;
 use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, pose_slices, poses_in, poses_out};
-use crate::sampling::{feet_arg, method_arg, steps_arg};
+use crate::sampling::{feet_arg, method_arg, steps_or};
 use crate::status::{Failure, SinmdmStatus, guard, guard_out};
 use crate::text::{give, handle, slice_arg};
 
@@ -31,7 +31,7 @@ pub struct SinmdmStream {
 pub struct SinmdmStreamOptions {
     /// Seed of the portable noise.
     pub seed: u64,
-    /// Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STEPS`, `SINMDM_ALL_STEPS` for
+    /// Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STREAM_STEPS`, `SINMDM_ALL_STEPS` for
     /// all of the model's T.
     pub steps: u32,
     /// Frames each block makes final; 0 for the length of the model's training clip.
@@ -77,7 +77,7 @@ pub unsafe extern "C" fn sinmdm_stream_new(
             });
             let options = StreamOptions {
                 seed: o.seed,
-                steps: steps_arg(o.steps),
+                steps: steps_or(o.steps, sinmdm::DEFAULT_STREAM_STEPS),
                 block_frames: (o.block_frames > 0).then_some(o.block_frames as usize),
                 feet: feet_arg(o.feet)?,
                 compose,

@@ -12,6 +12,7 @@ use serde::Serialize;
 use crate::clip_files::ClipUpArg;
 use crate::sampling::{SamplingArgs, check_writable, reference_features, run_task};
 use sinmdm::files::write_atomically;
+use sinmdm::limits::MAX_SAMPLE_FRAMES;
 use sinmdm::motion::{LocalMotion, decode, kinematic_beats};
 use sinmdm::tasks::{
     BeatLevel, DANCE_HOLD, DANCE_RAMP, DanceBeats, KeyOrder, Placement, Task, place_keyframes,
@@ -171,10 +172,20 @@ pub fn build_dance(
     seed: u64,
 ) -> Result<Dance> {
     let fps = layout.fps;
+    if let Some(f) = frames
+        && !(1..=MAX_SAMPLE_FRAMES).contains(&f)
+    {
+        bail!("a dance of {f} frames is not possible: give 1 to {MAX_SAMPLE_FRAMES} frames");
+    }
     let fallback_seconds = frames.unwrap_or(fallback_frames) as f64 / fps;
     let (times, music_seconds) = options.music_beats(fallback_seconds)?;
     let frames = frames
         .unwrap_or_else(|| music_seconds.map_or(fallback_frames, |s| (s * fps).round() as usize));
+    if !(1..=MAX_SAMPLE_FRAMES).contains(&frames) {
+        bail!(
+            "a dance of {frames} frames is not possible: give 1 to {MAX_SAMPLE_FRAMES} frames (--seconds)"
+        );
+    }
     let mut music_beats: Vec<usize> = times
         .iter()
         .map(|t| (t * fps).round() as usize)
@@ -198,7 +209,10 @@ pub fn build_dance(
         },
         level: options.level.into(),
     };
-    let placement = place_keyframes(reference.ncols(), &beats, seed)?;
+    let placement = place_keyframes(reference.ncols(), &beats, seed).context(
+        "placing the dance's keyframes (if the tracker took the music's tempo twice or half as \
+         fast, give it with --bpm N --offset T or --beats FILE)",
+    )?;
     Ok(Dance {
         task: Task::Dance {
             reference,
@@ -236,6 +250,20 @@ impl Dance {
     /// Says what was chosen.
     pub fn describe(&self) {
         let p = &self.placement;
+        if let Task::Dance { beats, .. } = &self.task
+            && p.hold < beats.hold
+        {
+            eprintln!(
+                "dance: windows of {} frames each side instead of {}: the closest beats at this level are {} frames apart",
+                p.hold,
+                beats.hold,
+                p.keys
+                    .windows(2)
+                    .map(|w| w[1].target - w[0].target)
+                    .min()
+                    .unwrap_or(0)
+            );
+        }
         eprintln!(
             "dance: {} frames ({:.1} s), {} keyframes on {} beats (tempo {:.2}x the reference's), hold {} ramp {}",
             self.frames,

@@ -9,7 +9,8 @@ use ndarray::Axis;
 use serde::Serialize;
 
 use crate::sampling::{
-    DEFAULT_STEPS, check_writable, parse_steps, progress_bar, reference_features,
+    DEFAULT_STEPS, DEFAULT_STREAM_STEPS, check_writable, parse_steps, progress_bar,
+    reference_features,
 };
 use sinmdm::features_file::write_features;
 use sinmdm::files::write_atomically;
@@ -45,9 +46,10 @@ pub struct EvalArgs {
     /// Frames per sample (default: twice the clip).
     #[arg(long)]
     frames: Option<usize>,
-    /// Denoising steps: a number S of respaced steps, or `all`.
-    #[arg(long, default_value = DEFAULT_STEPS, value_name = "S|all")]
-    steps: String,
+    /// Denoising steps: a number S of respaced steps, or `all` (default: 50, or a stream's 20
+    /// per block with --stream).
+    #[arg(long, value_name = "S|all")]
+    steps: Option<String>,
     /// Seed of the samples.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -116,7 +118,12 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     if args.threads == Some(0) {
         bail!("--threads must be at least 1");
     }
-    let steps = parse_steps(&args.steps)?;
+    let default_steps = if args.stream {
+        DEFAULT_STREAM_STEPS
+    } else {
+        DEFAULT_STEPS
+    };
+    let steps = parse_steps(args.steps.as_deref().unwrap_or(default_steps))?;
     let method = args.method.method()?;
     let outputs: Vec<PathBuf> = args
         .json

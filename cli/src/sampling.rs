@@ -26,6 +26,10 @@ use sinmdm_formats::gltf::splice_into_character;
 /// (clap needs it as text; a test checks they agree).
 pub const DEFAULT_STEPS: &str = "50";
 
+/// Respaced steps per block of `sinmdm stream` and `sinmdm eval --stream`: the library's
+/// `sinmdm::DEFAULT_STREAM_STEPS` (a test checks they agree).
+pub const DEFAULT_STREAM_STEPS: &str = "20";
+
 /// Options shared by `generate`, `inbetween`, `expand`, `compose` and `harmonize`.
 #[derive(Debug, Args)]
 pub struct SamplingArgs {
@@ -463,6 +467,10 @@ mod default_steps_tests {
         assert_eq!(
             super::DEFAULT_STEPS.parse::<usize>(),
             Ok(sinmdm::DEFAULT_STEPS)
+        );
+        assert_eq!(
+            super::DEFAULT_STREAM_STEPS.parse::<usize>(),
+            Ok(sinmdm::DEFAULT_STREAM_STEPS)
         );
     }
 }

@@ -13,7 +13,7 @@ use sinmdm::tasks::INBETWEEN_RAMP;
 use sinmdm::{Model, ModelOptions, Stream, StreamOptions};
 
 use crate::sampling::{
-    DEFAULT_STEPS, FeetArg, check_writable, parse_position, parse_steps, progress_bar,
+    DEFAULT_STREAM_STEPS, FeetArg, check_writable, parse_position, parse_steps, progress_bar,
 };
 
 pub(crate) const EXAMPLES: &str = "Examples:
@@ -46,8 +46,9 @@ pub struct StreamArgs {
     /// Seed of the noise.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Denoising steps per block: a number of respaced steps, or `all`.
-    #[arg(long, default_value = DEFAULT_STEPS, value_name = "S|all")]
+    /// Denoising steps per block: a number of respaced steps, or `all` (default: 20, fewer than
+    /// a one-shot run's 50: a block continues the context it is conditioned on).
+    #[arg(long, default_value = DEFAULT_STREAM_STEPS, value_name = "S|all")]
     steps: String,
     #[command(flatten)]
     method: crate::sampling::MethodArgs,

@@ -37,7 +37,8 @@ def main(argv=None):
         p.add_argument("-o", "--output", required=True, help="features JSON to write")
         p.add_argument("--count", type=int, default=1)
         p.add_argument("--seed", type=int, default=0)
-        p.add_argument("--steps", default="50", help="respaced steps S, or 'all'")
+        p.add_argument("--steps", default=None,
+                       help="respaced steps S, or 'all' (default 50; a stream's 20 per block)")
         p.add_argument("--sampler", choices=["ancestral", "ddim", "dpm2m"], default="ancestral")
         p.add_argument("--eta", type=float, default=0.0)
         return p
@@ -90,6 +91,8 @@ def main(argv=None):
             feats, _ = read_features(path)
             return feats[0]
 
+        if args.steps is None:
+            args.steps = "20" if args.command == "stream" else "50"
         if args.command == "stream":
             schedule = tasks.schedule_for(model, _steps(args.steps))
             feats = stream_features(model, schedule, args.seed, args.frames, block=args.block, method=method)

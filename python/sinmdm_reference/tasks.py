@@ -244,6 +244,8 @@ def place_keyframes(reference_frames, reference_beats, target_beats, frames, hol
 
 def plan_dance(model, reference, reference_beats, target_beats, frames, hold=DANCE_HOLD,
                ramp=DANCE_RAMP, order="shuffled", level="auto", root=True, seed=0):
+    if hold < 0 or ramp < 0 or min(list(reference_beats) + list(target_beats) + [0]) < 0:
+        raise TaskError("hold, ramp and beat frames must not be negative")
     if ramp > MAX_SAMPLE_FRAMES:
         raise TaskError(f"a ramp of {ramp} frames is too wide")
     y = model.normalize(reference)

@@ -6,8 +6,9 @@
 //!   the next input), in alternating paired rounds; the median of the per-round ratios. For
 //!   reference it also times the bare loop on onnxruntime's own two-thread pool (what a Python
 //!   loop with default options gets, at the price of values that depend on the thread count).
-//! - **stream**: a stream's 1-second chunks at the default options (mean, median, worst), the
-//!   share of its time spent inside the network, and the worst chunk when the stream is
+//! - **stream**: a stream's 1-second chunks at the default options (mean, median, worst) against
+//!   the same stream at a one-shot run's step count (what streams took before), alternating, the
+//!   share of their time spent inside the network, and the worst chunk when the stream is
 //!   prepared a few steps per chunk ([`Stream::prepare`]) as a game would.
 //! - **crowd**: 20 samples at the default steps, in process.
 //!
@@ -125,15 +126,13 @@ fn loop_against_bare(path: &str, frames: usize, rounds: usize) {
     );
 }
 
-fn stream_chunks(path: &str, seconds: usize) {
-    let mut model = Model::open(path, &ModelOptions::default()).expect("model");
+/// Mean seconds per 1-second chunk of a stream with `options`, read with `next` alone, and the
+/// share of that time inside the network; prints the line.
+fn chunk_cost(model: &mut Model, options: &StreamOptions, seconds: usize, label: &str) -> f64 {
     let second = model.fps().round() as usize;
-    let mut stream = Stream::new(model.metadata(), StreamOptions::default()).expect("stream");
+    let mut stream = Stream::new(model.metadata(), options.clone()).expect("stream");
     let mut times = Vec::new();
-    let mut timed = Timed {
-        model: &mut model,
-        inside: 0.0,
-    };
+    let mut timed = Timed { model, inside: 0.0 };
     let start = Instant::now();
     for _ in 0..seconds {
         let t = Instant::now();
@@ -143,20 +142,58 @@ fn stream_chunks(path: &str, seconds: usize) {
     let total = start.elapsed().as_secs_f64();
     let worst = times.iter().copied().fold(0.0, f64::max);
     println!(
-        "stream, {seconds} 1-second chunks at the default options (blocks of {} frames):",
-        stream.sizes().block
-    );
-    println!(
-        "  mean {:.2} ms, median {:.2} ms, worst {:.1} ms per chunk; {:.1} % of the time inside the network",
+        "  {label}: mean {:.2} ms, median {:.2} ms, worst {:.1} ms per chunk; {:.1} % of the time inside the network",
         total / seconds as f64 * 1e3,
         median(&times) * 1e3,
         worst * 1e3,
         timed.inside / total * 100.0
     );
-    // The same stream prepared a few steps per chunk (as a game's frame loop would): the
+    total / seconds as f64
+}
+
+fn stream_chunks(path: &str, seconds: usize) {
+    let mut model = Model::open(path, &ModelOptions::default()).expect("model");
+    let second = model.fps().round() as usize;
+    let block = Stream::new(model.metadata(), StreamOptions::default())
+        .expect("stream")
+        .sizes()
+        .block;
+    println!(
+        "stream, {seconds} 1-second chunks (blocks of {block} frames), read with `next` alone:"
+    );
+    // The default (sinmdm::DEFAULT_STREAM_STEPS per block) against a one-shot run's step count,
+    // which streams took before, alternating so both see the same machine.
+    let before = StreamOptions {
+        steps: Some(sinmdm::DEFAULT_STEPS),
+        ..StreamOptions::default()
+    };
+    let (mut now, mut then) = (Vec::new(), Vec::new());
+    for round in 0..2 {
+        let label = |steps: usize| format!("round {}, {steps} steps per block", round + 1);
+        then.push(chunk_cost(
+            &mut model,
+            &before,
+            seconds,
+            &label(sinmdm::DEFAULT_STEPS),
+        ));
+        now.push(chunk_cost(
+            &mut model,
+            &StreamOptions::default(),
+            seconds,
+            &label(sinmdm::DEFAULT_STREAM_STEPS),
+        ));
+    }
+    println!(
+        "  default ({} steps) against {} steps per block: {:.2} ms against {:.2} ms per chunk, {:.2}x less",
+        sinmdm::DEFAULT_STREAM_STEPS,
+        sinmdm::DEFAULT_STEPS,
+        median(&now) * 1e3,
+        median(&then) * 1e3,
+        median(&then) / median(&now)
+    );
+    // The default stream prepared a few steps per chunk (as a game's frame loop would): the
     // steps per chunk that keep a block ahead, and the worst chunk then.
     let mut stream = Stream::new(model.metadata(), StreamOptions::default()).expect("stream");
-    let block = stream.sizes().block;
     // No block is under way yet, so the steps per block come from the options.
     let steps = StreamOptions::default()
         .steps

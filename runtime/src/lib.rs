@@ -74,5 +74,5 @@ pub use onnxruntime::{
     ONNXRUNTIME_VERSION, OnnxRuntime, RuntimeLibraryError, init as init_onnxruntime,
     load_onnxruntime,
 };
-pub use stream::{Stream, StreamChunk, StreamCompose, StreamOptions};
+pub use stream::{DEFAULT_STREAM_STEPS, Stream, StreamChunk, StreamCompose, StreamOptions};
 pub use tasks::{Generated, Plan, Progress, Request, Run, Span, Task, TaskError, plan, run};

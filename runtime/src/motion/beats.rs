@@ -56,7 +56,8 @@ pub fn gaussian_smooth(values: &[f64], sigma: f64) -> Vec<f64> {
     if n == 0 || sigma <= 0.0 {
         return values.to_vec();
     }
-    let reach = (4.0 * sigma).ceil() as isize;
+    // The kernel never needs to reach past the input (an absurd frame rate would ask for more).
+    let reach = (4.0 * sigma).ceil().min(n as f64) as isize;
     let kernel: Vec<f64> = (-reach..=reach)
         .map(|k| (-0.5 * (k as f64 / sigma).powi(2)).exp())
         .collect();

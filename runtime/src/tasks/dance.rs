@@ -10,7 +10,8 @@
 //! The beat level (every beat, every other one, or half beats) is chosen so that the music's
 //! beat interval over the reference's stays within [`DANCE_TEMPO_RANGE`], the stretch the default
 //! training showed the model; outside it the task is refused. Windows never overlap: the hold is
-//! shrunk to leave at least one free frame between neighbours.
+//! shrunk so the closest two beats' windows keep a free frame between them (beats a frame apart
+//! get windows of one frame each, touching), which [`Placement::hold`] reports.
 
 use std::fmt;
 
@@ -217,11 +218,15 @@ pub fn place_keyframes(
         })?;
     let (low, high) = DANCE_TEMPO_RANGE;
     if !(low..=high).contains(&ratio) {
+        let tried = if dance.level == BeatLevel::Auto {
+            "no level (every beat, every other one, half beats) comes closer"
+        } else {
+            "another level may fit"
+        };
         return Err(TaskError::Dance(format!(
-            "the music's beats ({} level, every {:.1} frames) are {ratio:.2}x the reference's \
-             (every {reference_interval:.1} frames); the model learned {low}-{high}x. Give the \
-             music's tempo at another level (--bpm twice or half as much) or another piece",
-            level,
+            "the music's beats ({level} level, every {:.1} frames) are {ratio:.2}x the reference's \
+             (every {reference_interval:.1} frames), outside the {low}-{high}x the model learned; \
+             {tried}",
             ratio * reference_interval
         )));
     }
@@ -336,6 +341,11 @@ mod tests {
         d.level = BeatLevel::Every;
         let e = place_keyframes(80, &d, 0).unwrap_err().to_string();
         assert!(e.contains("0.69x") && e.contains("0.75-1.25"), "{e}");
+        assert!(e.contains("another level may fit"), "{e}");
+        d.level = BeatLevel::Auto;
+        d.target_beats = vec![0, 21, 42, 63, 84];
+        let e = place_keyframes(80, &d, 0).unwrap_err().to_string();
+        assert!(e.contains("1.31x") && e.contains("no level"), "{e}");
     }
 
     #[test]
