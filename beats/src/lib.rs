@@ -22,6 +22,7 @@ pub mod onset;
 pub mod pulses;
 pub mod tempo;
 pub mod track;
+mod window;
 
 pub use audio::{Audio, read_audio};
 pub use error::BeatsError;

@@ -11,6 +11,7 @@
 
 use realfft::RealFftPlanner;
 
+use crate::window::hann;
 use crate::{Audio, BeatsError};
 
 /// Mel bands of the spectrogram.
@@ -69,9 +70,7 @@ impl OnsetEnvelope {
 /// Log-mel spectra, one per hop, of windows centred on `t * hop` (the signal padded with
 /// zeros at both ends).
 fn log_mel_spectrogram(samples: &[f32], rate: f64, window: usize, hop: usize) -> Vec<Vec<f64>> {
-    let hann: Vec<f64> = (0..window)
-        .map(|i| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / window as f64).cos())
-        .collect();
+    let hann = hann(window);
     let filters = mel_filters(rate, window, MEL_BANDS);
     let mut planner = RealFftPlanner::<f64>::new();
     let fft = planner.plan_fft_forward(window);

@@ -10,6 +10,7 @@
 use realfft::RealFftPlanner;
 
 use crate::onset::OnsetEnvelope;
+use crate::window::hann;
 use crate::{BeatsError, TrackerOptions};
 
 /// Length of each autocorrelation window, in seconds.
@@ -26,9 +27,7 @@ pub fn mean_autocorrelation(values: &[f32], window: usize) -> Vec<f64> {
     let mut input = forward.make_input_vec();
     let mut spectrum = forward.make_output_vec();
     let mut back = inverse.make_output_vec();
-    let hann: Vec<f64> = (0..window)
-        .map(|i| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / window as f64).cos())
-        .collect();
+    let hann = hann(window);
     let mut sum = vec![0.0f64; window];
     let mut count = 0usize;
     let half = window as isize / 2;

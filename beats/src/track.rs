@@ -7,6 +7,8 @@
 //! strong cumulative peak; weak beats at its ends (silence before the music starts or after it
 //! stops) are trimmed.
 
+use crate::window::convolve_same;
+
 /// Beat frames of an onset envelope with beat period `period` (envelope frames).
 pub fn beat_frames(onset: &[f32], period: f64, tightness: f64) -> Vec<usize> {
     let n = onset.len();
@@ -78,18 +80,8 @@ fn local_score(onset: &[f32], period: f64) -> Vec<f64> {
     let kernel: Vec<f64> = (-reach..=reach)
         .map(|k| (-0.5 * (k as f64 * 32.0 / period).powi(2)).exp())
         .collect();
-    (0..n as isize)
-        .map(|i| {
-            kernel
-                .iter()
-                .enumerate()
-                .filter_map(|(k, w)| {
-                    let at = i + k as isize - reach;
-                    (at >= 0 && (at as usize) < n).then(|| w * onset[at as usize] as f64 * scale)
-                })
-                .sum()
-        })
-        .collect()
+    let scaled: Vec<f64> = onset.iter().map(|&v| v as f64 * scale).collect();
+    convolve_same(&scaled, &kernel)
 }
 
 /// The last local peak of the cumulative score that reaches half the median peak, among frames
@@ -127,20 +119,8 @@ fn last_beat(cumulative: &[f64], local: &[f64], local_peak: f64) -> Option<usize
 /// Drops leading and trailing beats whose smoothed local score is under half the root mean
 /// square of all beats' smoothed scores.
 fn trim_weak_ends(beats: &[usize], local: &[f64]) -> Vec<usize> {
-    let weights = [0.25, 0.75, 1.0, 0.75, 0.25];
     let raw: Vec<f64> = beats.iter().map(|&b| local[b]).collect();
-    let smooth: Vec<f64> = (0..raw.len() as isize)
-        .map(|i| {
-            weights
-                .iter()
-                .enumerate()
-                .filter_map(|(k, w)| {
-                    let at = i + k as isize - 2;
-                    (at >= 0 && (at as usize) < raw.len()).then(|| w * raw[at as usize])
-                })
-                .sum()
-        })
-        .collect();
+    let smooth = convolve_same(&raw, &[0.25, 0.75, 1.0, 0.75, 0.25]);
     if smooth.is_empty() {
         return Vec::new();
     }

@@ -175,7 +175,7 @@
 
 /*
  Respaced sampling steps of the command line (the library's `DEFAULT_STEPS`); what a `steps`
- of 0 gives in `SinmdmSampling` and `SinmdmStreamOptions`.
+ of 0 gives in `SinmdmSampling` (a stream's is `SINMDM_DEFAULT_STREAM_STEPS`).
  */
 #define SINMDM_DEFAULT_STEPS 50
 

@@ -5,7 +5,7 @@ use sinmdm::{Feet, Request, Task};
 use crate::status::Failure;
 
 /// Respaced sampling steps of the command line (the library's `DEFAULT_STEPS`); what a `steps`
-/// of 0 gives in `SinmdmSampling` and `SinmdmStreamOptions`.
+/// of 0 gives in `SinmdmSampling` (a stream's is `SINMDM_DEFAULT_STREAM_STEPS`).
 pub const SINMDM_DEFAULT_STEPS: u32 = 50;
 
 /// Respaced sampling steps per block of a stream (the library's `DEFAULT_STREAM_STEPS`); what a

@@ -116,8 +116,8 @@ fn song_beats(song: &Path, click: Option<&Path>) -> Result<BeatsReport> {
 fn motion_beats(clip: &Path, args: &BeatsArgs) -> Result<BeatsReport> {
     let motion = crate::clip_files::read_motion_file(clip, args.clip_anim.as_deref())?.to_local();
     let fps = motion.fps;
-    let (minima, regular) =
-        dance_beats(&motion).with_context(|| format!("{}: no dance beat", clip.display()))?;
+    let (minima, regular) = sinmdm_beats::pulses::motion_beats(&motion)
+        .with_context(|| format!("{}: no dance beat", clip.display()))?;
     println!(
         "{} speed minima; on the dance's beat: {} (frames at {fps} fps)",
         minima.frames.len(),
@@ -133,17 +133,6 @@ fn motion_beats(clip: &Path, args: &BeatsArgs) -> Result<BeatsReport> {
         minima: Some(minima.frames),
         fps: Some(fps),
     })
-}
-
-/// A motion's kinematic beats and those on its dance's beat (see
-/// [`sinmdm_beats::pulses::motion_beats`]).
-pub(crate) fn dance_beats(
-    motion: &sinmdm::motion::LocalMotion,
-) -> Result<(
-    sinmdm::motion::KinematicBeats,
-    sinmdm_beats::pulses::RegularBeats,
-)> {
-    Ok(sinmdm_beats::pulses::motion_beats(motion)?)
 }
 
 /// Beat times given by a person: a file, or a tempo and offset over `seconds`.

@@ -10,7 +10,9 @@ use ndarray::Array2;
 use serde::Serialize;
 
 use crate::clip_files::ClipUpArg;
-use crate::sampling::{SamplingArgs, check_writable, reference_features, run_task};
+use crate::sampling::{
+    SamplingArgs, check_writable, reference_features, run_task, seconds_to_frames,
+};
 use sinmdm::files::write_atomically;
 use sinmdm::limits::MAX_SAMPLE_FRAMES;
 use sinmdm::motion::{LocalMotion, decode, kinematic_beats};
@@ -147,18 +149,17 @@ impl DanceOptions {
 
 /// A dance task ready to run, and what was chosen for it.
 pub struct Dance {
-    /// The task.
-    pub task: Task,
+    /// Raw reference features in the model's layout.
+    reference: Array2<f32>,
+    /// Both sides' beats (the reference's on its dance beat, the music's in output frames), the
+    /// output's length and the placement settings.
+    beats: DanceBeats,
+    /// Whether the root's travel in the windows comes from the reference.
+    root: bool,
     /// Where its keyframes go.
     pub placement: Placement,
     /// Frames per second of the model (and of every frame number here).
     pub fps: f64,
-    /// The reference's kinematic beats, frames.
-    pub reference_beats: Vec<usize>,
-    /// The music's beats, frames of the output.
-    pub music_beats: Vec<usize>,
-    /// Frames of the output.
-    pub frames: usize,
 }
 
 /// Builds the dance of `reference` (raw features in the model's layout) on the music of
@@ -172,20 +173,22 @@ pub fn build_dance(
     seed: u64,
 ) -> Result<Dance> {
     let fps = layout.fps;
-    if let Some(f) = frames
-        && !(1..=MAX_SAMPLE_FRAMES).contains(&f)
-    {
-        bail!("a dance of {f} frames is not possible: give 1 to {MAX_SAMPLE_FRAMES} frames");
-    }
-    let fallback_seconds = frames.unwrap_or(fallback_frames) as f64 / fps;
+    let check = |frames: usize| -> Result<usize> {
+        if !(1..=MAX_SAMPLE_FRAMES).contains(&frames) {
+            bail!(
+                "a dance of {frames} frames is not possible: give 1 to {MAX_SAMPLE_FRAMES} frames (--seconds)"
+            );
+        }
+        Ok(frames)
+    };
+    // A length given is checked before the music's beats are laid over it.
+    let given = frames.map(check).transpose()?;
+    let fallback_seconds = given.unwrap_or(fallback_frames) as f64 / fps;
     let (times, music_seconds) = options.music_beats(fallback_seconds)?;
-    let frames = frames
-        .unwrap_or_else(|| music_seconds.map_or(fallback_frames, |s| (s * fps).round() as usize));
-    if !(1..=MAX_SAMPLE_FRAMES).contains(&frames) {
-        bail!(
-            "a dance of {frames} frames is not possible: give 1 to {MAX_SAMPLE_FRAMES} frames (--seconds)"
-        );
-    }
+    let frames =
+        check(given.unwrap_or_else(|| {
+            music_seconds.map_or(fallback_frames, |s| (s * fps).round() as usize)
+        }))?;
     let mut music_beats: Vec<usize> = times
         .iter()
         .map(|t| (t * fps).round() as usize)
@@ -193,13 +196,13 @@ pub fn build_dance(
         .collect();
     music_beats.dedup();
     let motion = decode(layout, reference.view()).context("decoding the reference")?;
-    let reference_beats = crate::beats::dance_beats(&motion)
+    let reference_beats = sinmdm_beats::pulses::motion_beats(&motion)
         .context("finding the reference's beats")?
         .1
         .frames;
     let beats = DanceBeats {
-        reference_beats: reference_beats.clone(),
-        target_beats: music_beats.clone(),
+        reference_beats,
+        target_beats: music_beats,
         frames,
         hold: options.hold,
         ramp: options.ramp,
@@ -214,16 +217,11 @@ pub fn build_dance(
          fast, give it with --bpm N --offset T or --beats FILE)",
     )?;
     Ok(Dance {
-        task: Task::Dance {
-            reference,
-            beats,
-            root: options.root == RootArg::Kept,
-        },
+        reference,
+        beats,
+        root: options.root == RootArg::Kept,
         placement,
         fps,
-        reference_beats,
-        music_beats,
-        frames,
     })
 }
 
@@ -247,12 +245,20 @@ struct BeatsOut<'a> {
 }
 
 impl Dance {
+    /// The task to run (a copy: the caller's request owns it).
+    pub fn task(&self) -> Task {
+        Task::Dance {
+            reference: self.reference.clone(),
+            beats: self.beats.clone(),
+            root: self.root,
+        }
+    }
+
     /// Says what was chosen.
     pub fn describe(&self) {
         let p = &self.placement;
-        if let Task::Dance { beats, .. } = &self.task
-            && p.hold < beats.hold
-        {
+        let beats = &self.beats;
+        if p.hold < beats.hold {
             eprintln!(
                 "dance: windows of {} frames each side instead of {}: the closest beats at this level are {} frames apart",
                 p.hold,
@@ -266,8 +272,8 @@ impl Dance {
         }
         eprintln!(
             "dance: {} frames ({:.1} s), {} keyframes on {} beats (tempo {:.2}x the reference's), hold {} ramp {}",
-            self.frames,
-            self.frames as f64 / self.fps,
+            beats.frames,
+            beats.frames as f64 / self.fps,
             p.keys.len(),
             p.level,
             p.ratio,
@@ -290,13 +296,13 @@ impl Dance {
         let p = &self.placement;
         let out = BeatsOut {
             fps: self.fps,
-            frames: self.frames,
+            frames: self.beats.frames,
             level: p.level.name(),
             tempo_ratio: p.ratio,
             hold: p.hold,
             ramp: p.ramp,
-            music_beats: &self.music_beats,
-            reference_beats: &self.reference_beats,
+            music_beats: &self.beats.target_beats,
+            reference_beats: &self.beats.reference_beats,
             keyframes: p.keys.iter().map(|k| (k.target, k.reference)).collect(),
             used_beat_seconds: self.used_beat_seconds(),
         };
@@ -357,13 +363,10 @@ pub(crate) fn run(args: &DanceArgs) -> Result<()> {
     }
     let mut model = args.sampling.open_model()?;
     let layout = model.metadata().layout.clone();
-    let frames = match args.seconds {
-        Some(s) if !(s.is_finite() && s > 0.0) => {
-            bail!("--seconds must be a positive number, got {s}")
-        }
-        Some(s) => Some((s * layout.fps).round() as usize),
-        None => None,
-    };
+    let frames = args
+        .seconds
+        .map(|s| seconds_to_frames(s, layout.fps))
+        .transpose()?;
     let reference = reference_features(&model, &args.reference, &args.up)?;
     let fallback = 2 * reference.ncols();
     let dance = build_dance(
@@ -379,7 +382,7 @@ pub(crate) fn run(args: &DanceArgs) -> Result<()> {
         dance.write_beats(path)?;
         eprintln!("wrote {}", path.display());
     }
-    let generated = run_task(&args.sampling, &mut model, dance.task.clone())?;
+    let generated = run_task(&args.sampling, &mut model, dance.task())?;
     let motions = (0..generated.count())
         .map(|i| generated.motion(i))
         .collect::<Result<Vec<_>, _>>()?;

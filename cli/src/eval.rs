@@ -179,7 +179,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     let request = Request {
         task: dance
             .as_ref()
-            .map_or(Task::Generate { frames }, |d| d.task.clone()),
+            .map_or(Task::Generate { frames }, |d| d.task()),
         count: args.samples,
         seed: args.seed,
         steps,
@@ -244,6 +244,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         raw_motion_report,
         planted_report,
         feet,
+        planted,
         replay,
         sampling_seconds,
         scoring_seconds,
@@ -307,10 +308,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
 
     let beats = match &dance {
         Some(dance) => {
-            let motions = (0..generated.count())
-                .map(|i| generated.motion(i))
-                .collect::<Result<Vec<_>, _>>()?;
-            let scores = dance.scores(&motions, args.seed);
+            let scores = dance.scores(&planted, args.seed);
             println!();
             crate::dance::print_scores(&scores);
             Some(sinmdm_eval::mean_beat_scores(&scores))

@@ -315,6 +315,14 @@ pub fn progress_bar(quiet: bool, steps: usize, message: String) -> indicatif::Pr
     bar
 }
 
+/// `--seconds S` as frames at `fps` (rounded); S must be a positive number.
+pub fn seconds_to_frames(seconds: f64, fps: f64) -> Result<usize> {
+    if !(seconds.is_finite() && seconds > 0.0) {
+        bail!("--seconds must be a positive number, got {seconds}");
+    }
+    Ok((seconds * fps).round() as usize)
+}
+
 /// Checks that every output file can be written, before any work is done.
 pub fn check_writable(paths: &[PathBuf]) -> Result<()> {
     for path in paths {

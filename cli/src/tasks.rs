@@ -5,11 +5,13 @@ use std::path::{Path, PathBuf};
 use ndarray::Array2;
 use sinmdm::FeatureLayout;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Args;
 
 use crate::clip_files::ClipUpArg;
-use crate::sampling::{SamplingArgs, parse_position, parse_spans, reference_features, run_task};
+use crate::sampling::{
+    SamplingArgs, parse_position, parse_spans, reference_features, run_task, seconds_to_frames,
+};
 use sinmdm::tasks::{
     EXPAND_RAMP, HARMONIZE_FACTOR, HARMONIZE_FREE_SHARE, INBETWEEN_RAMP, Task, joints_by_name,
     subtree,
@@ -141,12 +143,7 @@ pub(crate) fn generate(args: &GenerateArgs) -> Result<()> {
     let meta = model.metadata();
     let frames = match (args.frames, args.seconds) {
         (Some(f), _) => f,
-        (None, Some(s)) => {
-            if !(s.is_finite() && s > 0.0) {
-                bail!("--seconds must be a positive number, got {s}");
-            }
-            (s * meta.layout.fps).round() as usize
-        }
+        (None, Some(s)) => seconds_to_frames(s, meta.layout.fps)?,
         (None, None) => 2 * meta.training.clip_frames,
     };
     run_task(&args.sampling, &mut model, Task::Generate { frames })?;

@@ -43,6 +43,9 @@ pub struct ModelEvaluation {
     pub planted_report: Report,
     /// Their feet and smoothness figures, raw and planted, beside the clip's.
     pub feet: FeetReport,
+    /// The samples' motion with their feet planted, as `planted_report` scored it (what
+    /// `Generated::planted_motion` gives), for further scores without planting again.
+    pub planted: Vec<LocalMotion>,
     /// How long the samples, as the network made them, copy the clip verbatim.
     pub replay: ReplayReport,
     /// Seconds spent sampling.
@@ -129,6 +132,7 @@ pub fn evaluate_generated(
         raw_motion_report,
         planted_report,
         feet,
+        planted,
         replay,
         sampling_seconds,
         scoring_seconds: started.elapsed().as_secs_f64(),

@@ -13,13 +13,10 @@ pub const BEAT_SMOOTHING_SECONDS: f64 = 1.0 / 12.0;
 /// The kinematic beats of a motion.
 #[derive(Debug, Clone, PartialEq)]
 pub struct KinematicBeats {
-    /// Frames of the smoothed speed's local minima, increasing.
+    /// Frames of the smoothed speed's local minima, increasing. (A dance rests between its beats
+    /// too, so the gaps between minima do not give its tempo: `sinmdm-beats`'
+    /// `pulses::motion_beats` finds the beat among them.)
     pub frames: Vec<usize>,
-    /// The dance tempo: 60 s over the median interval between beats, in beats per minute (NaN
-    /// with fewer than two beats).
-    pub bpm: f64,
-    /// How regular the beats are, 0 to 1: the share of intervals within 25 % of the median.
-    pub confidence: f64,
     /// The smoothed mean joint speed per frame (file units per second).
     pub speed: Vec<f64>,
 }
@@ -97,27 +94,8 @@ pub fn local_minima(values: &[f64]) -> Vec<usize> {
 /// The kinematic beats of `motion` (see the module documentation).
 pub fn kinematic_beats(motion: &LocalMotion) -> KinematicBeats {
     let speed = gaussian_smooth(&joint_speed(motion), BEAT_SMOOTHING_SECONDS * motion.fps);
-    let frames = local_minima(&speed);
-    let intervals: Vec<f64> = frames.windows(2).map(|w| (w[1] - w[0]) as f64).collect();
-    let (bpm, confidence) = if intervals.is_empty() {
-        (f64::NAN, 0.0)
-    } else {
-        let mut sorted = intervals.clone();
-        sorted.sort_by(f64::total_cmp);
-        let median = sorted[sorted.len() / 2];
-        let regular = intervals
-            .iter()
-            .filter(|&&i| (i - median).abs() <= 0.25 * median)
-            .count();
-        (
-            60.0 * motion.fps / median,
-            regular as f64 / intervals.len() as f64,
-        )
-    };
     KinematicBeats {
-        frames,
-        bpm,
-        confidence,
+        frames: local_minima(&speed),
         speed,
     }
 }
