@@ -5,7 +5,8 @@
 #    profile of one call, a GEMM of the network's shape (the roofline), and the default crowd
 #    (`sinmdm generate --count 20`) as a whole process against its arithmetic at that GEMM rate;
 # 2. cargo bench --bench roofline: the runtime's 1 000-step single-sample loop against a bare
-#    onnxruntime loop (one process, paired rounds), a stream's 1-second chunks, and the crowd in
+#    onnxruntime loop (one process: paired whole-loop rounds, and the two interleaved step by
+#    step), a stream's 1-second chunks, and the crowd in
 #    process.
 # Usage: scripts/bench_roofline.sh [MODEL.onnx] [FRAMES] [ROUNDS]
 set -euo pipefail

@@ -12,8 +12,8 @@
 //!   prepared a few steps per chunk ([`Stream::prepare`]) as a game would.
 //! - **crowd**: 20 samples at the default steps, in process.
 //!
-//! `cargo bench -p sinmdm --bench roofline -- [MODEL.onnx] [FRAMES] [ROUNDS]` (default: the
-//! shipped walk, 498 frames, 5 rounds). `scripts/bench_roofline.sh` runs it with the GEMM
+//! `cargo bench -p sinmdm --bench roofline -- [MODEL.onnx] [FRAMES] [ROUNDS] [loop|stream|crowd]`
+//! (default: the shipped walk, 498 frames, 5 rounds, all three parts). `scripts/bench_roofline.sh` runs it with the GEMM
 //! roofline and the whole-process crowd of `scripts/lab/profile_network.py`.
 
 use std::ops::ControlFlow;
@@ -32,6 +32,7 @@ struct BareLoop {
     session: Session,
     features: usize,
     frames: usize,
+    x: Vec<f32>,
 }
 
 impl BareLoop {
@@ -41,47 +42,92 @@ impl BareLoop {
             session,
             features,
             frames,
+            x: vec![0.5f32; features * frames],
         }
+    }
+
+    /// One call at diffusion step `k`, its output kept as the next input.
+    fn call(&mut self, k: usize) {
+        let shape = [1, self.features, self.frames];
+        let xs = Tensor::from_array((shape, std::mem::take(&mut self.x))).expect("input");
+        let ts = Tensor::from_array(([1usize], vec![k as i64])).expect("step");
+        let out = self
+            .session
+            .run(ort::inputs![INPUT_FEATURES => xs, INPUT_STEP => ts])
+            .expect("run");
+        let (_, v) = out[OUTPUT_FEATURES]
+            .try_extract_tensor::<f32>()
+            .expect("x0");
+        self.x = v.to_vec();
     }
 
     /// Seconds for `steps` calls.
     fn run(&mut self, steps: usize) -> f64 {
-        let shape = [1, self.features, self.frames];
-        let mut x = vec![0.5f32; self.features * self.frames];
+        self.x.fill(0.5);
         let start = Instant::now();
         for k in (0..steps).rev() {
-            let xs = Tensor::from_array((shape, std::mem::take(&mut x))).expect("input");
-            let ts = Tensor::from_array(([1usize], vec![k as i64])).expect("step");
-            let out = self
-                .session
-                .run(ort::inputs![INPUT_FEATURES => xs, INPUT_STEP => ts])
-                .expect("run");
-            let (_, v) = out[OUTPUT_FEATURES]
-                .try_extract_tensor::<f32>()
-                .expect("x0");
-            x = v.to_vec();
+            self.call(k);
         }
-        std::hint::black_box(x[0]);
+        std::hint::black_box(self.x[0]);
         start.elapsed().as_secs_f64()
     }
 }
 
-fn generate(model: &mut Model, count: usize, frames: usize, steps: Option<usize>) -> f64 {
-    let request = Request {
+fn request(count: usize, frames: usize, steps: Option<usize>) -> Request {
+    Request {
         task: Task::Generate { frames },
         count,
         seed: 7,
         steps,
         feet: Feet::Raw,
         method: Default::default(),
-    };
-    let plan = sinmdm::plan(model.metadata(), &request).expect("plan");
+    }
+}
+
+fn generate(model: &mut Model, count: usize, frames: usize, steps: Option<usize>) -> f64 {
+    generate_timed(model, count, frames, steps).0
+}
+
+/// Seconds for a run, and the seconds of it spent inside the network's calls.
+fn generate_timed(
+    model: &mut Model,
+    count: usize,
+    frames: usize,
+    steps: Option<usize>,
+) -> (f64, f64) {
+    let plan = sinmdm::plan(model.metadata(), &request(count, frames, steps)).expect("plan");
+    let mut timed = Timed { model, inside: 0.0 };
     let start = Instant::now();
     let out = plan
-        .run(model, &mut |_, _| ControlFlow::Continue(()))
+        .run(&mut timed, &mut |_, _| ControlFlow::Continue(()))
         .expect("run");
     std::hint::black_box(out.normalized[[0, 0, 0]]);
-    start.elapsed().as_secs_f64()
+    (start.elapsed().as_secs_f64(), timed.inside)
+}
+
+/// The runtime's run (planning, every step, finishing) and the bare loop's calls interleaved
+/// step by step, so both see the same moment of a shared machine: (runtime, bare) seconds.
+fn interleaved(model: &mut Model, bare: &mut BareLoop, frames: usize) -> (f64, f64) {
+    let steps = model.metadata().diffusion.steps;
+    bare.x.fill(0.5);
+    let start = Instant::now();
+    let plan = sinmdm::plan(model.metadata(), &request(1, frames, None)).expect("plan");
+    let mut run = plan.start().expect("start");
+    let mut ours = start.elapsed().as_secs_f64();
+    let mut theirs = 0.0;
+    for k in (0..steps).rev() {
+        let t = Instant::now();
+        run.step(model, 1).expect("step");
+        ours += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        bare.call(k);
+        theirs += t.elapsed().as_secs_f64();
+    }
+    let t = Instant::now();
+    let out = run.finish().expect("finish");
+    std::hint::black_box(out.normalized[[0, 0, 0]]);
+    ours += t.elapsed().as_secs_f64();
+    (ours, theirs)
 }
 
 fn loop_against_bare(path: &str, frames: usize, rounds: usize) {
@@ -94,17 +140,20 @@ fn loop_against_bare(path: &str, frames: usize, rounds: usize) {
     pool.run(5);
     generate(&mut model, 1, frames, Some(5));
     let (mut ours, mut bares, mut pools, mut ratios) = (vec![], vec![], vec![], vec![]);
+    let (mut outside, mut inside_ratios) = (vec![], vec![]);
     for round in 0..rounds {
-        let (o, b) = if round % 2 == 0 {
-            let o = generate(&mut model, 1, frames, None);
+        let ((o, inside), b) = if round % 2 == 0 {
+            let o = generate_timed(&mut model, 1, frames, None);
             (o, bare.run(steps))
         } else {
             let b = bare.run(steps);
-            (generate(&mut model, 1, frames, None), b)
+            (generate_timed(&mut model, 1, frames, None), b)
         };
         ours.push(o);
         bares.push(b);
         ratios.push(o / b);
+        outside.push((o - inside) / o);
+        inside_ratios.push(inside / b);
         pools.push(pool.run(steps));
     }
     let (lo, hi) = ratios
@@ -120,9 +169,27 @@ fn loop_against_bare(path: &str, frames: usize, rounds: usize) {
         median(&ratios)
     );
     println!(
+        "  the runtime's own work (sampler, noise hand-over, planning): {:.2} % of its run; its network calls against the bare loop's: {:.3}",
+        median(&outside) * 100.0,
+        median(&inside_ratios)
+    );
+    println!(
         "  bare loop on onnxruntime's two-thread pool {:.3} s: runtime / pool {:.3} (values depend on the thread count)",
         median(&pools),
         median(&ours) / median(&pools)
+    );
+    let step_ratios: Vec<f64> = (0..rounds)
+        .map(|_| {
+            let (o, b) = interleaved(&mut model, &mut bare, frames);
+            o / b
+        })
+        .collect();
+    let (lo, hi) = step_ratios
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
+    println!(
+        "  interleaved step by step (the runtime's run, then one bare call, {steps} times): ratio {:.3} (rounds {lo:.3} to {hi:.3})",
+        median(&step_ratios)
     );
 }
 
@@ -253,8 +320,15 @@ fn main() {
         });
     let frames: usize = args.get(1).map_or(498, |s| s.parse().expect("FRAMES"));
     let rounds: usize = args.get(2).map_or(5, |s| s.parse().expect("ROUNDS"));
+    let only = args.get(3).map(String::as_str);
     println!("model {path}");
-    loop_against_bare(&path, frames, rounds);
-    stream_chunks(&path, 180);
-    crowd(&path, frames, rounds);
+    if only.is_none_or(|o| o == "loop") {
+        loop_against_bare(&path, frames, rounds);
+    }
+    if only.is_none_or(|o| o == "stream") {
+        stream_chunks(&path, 180);
+    }
+    if only.is_none_or(|o| o == "crowd") {
+        crowd(&path, frames, rounds);
+    }
 }

@@ -289,6 +289,19 @@ impl Model {
         x_t: ArrayView3<'_, f32>,
         t: &[i64],
     ) -> Result<Array3<f32>, ModelError> {
+        let mut out = Array3::<f32>::zeros(x_t.dim());
+        self.denoise_into(x_t, t, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Model::denoise`] written into `out`, which is reshaped to `x_t`'s shape only if it
+    /// has another (a sampler reuses one buffer from step to step).
+    pub fn denoise_into(
+        &mut self,
+        x_t: ArrayView3<'_, f32>,
+        t: &[i64],
+        out: &mut Array3<f32>,
+    ) -> Result<(), ModelError> {
         let (b, f, n) = x_t.dim();
         if f != self.features() {
             return Err(ModelError::FeatureRows {
@@ -304,7 +317,9 @@ impl Model {
         }
         let workers = self.threads.min(b).max(1);
         self.sessions_for(workers)?;
-        let mut out = Array3::<f32>::zeros((b, f, n));
+        if out.dim() != (b, f, n) || !out.is_standard_layout() {
+            *out = Array3::zeros((b, f, n));
+        }
         let path = self.path.as_path();
         // Sample i goes to thread i mod W; each thread has its own session, and the first share
         // runs on the calling thread.
@@ -315,7 +330,7 @@ impl Model {
         let mut sessions = self.sessions[..workers].iter_mut();
         let mut shares = shares.into_iter();
         let (Some(own_session), Some(own_share)) = (sessions.next(), shares.next()) else {
-            return Ok(out);
+            return Ok(());
         };
         std::thread::scope(|scope| {
             // A share whose thread the system refuses runs on the calling thread: the values
@@ -347,8 +362,7 @@ impl Model {
                 result = result.and(joined);
             }
             result
-        })?;
-        Ok(out)
+        })
     }
 }
 
@@ -428,5 +442,14 @@ impl crate::diffusion::Denoiser for Model {
 
     fn denoise(&mut self, x_t: ArrayView3<'_, f32>, t: &[i64]) -> Result<Array3<f32>, ModelError> {
         Model::denoise(self, x_t, t)
+    }
+
+    fn denoise_into(
+        &mut self,
+        x_t: ArrayView3<'_, f32>,
+        t: &[i64],
+        out: &mut Array3<f32>,
+    ) -> Result<(), ModelError> {
+        Model::denoise_into(self, x_t, t, out)
     }
 }

@@ -251,3 +251,37 @@ fn threads_past_the_limit_are_refused_when_the_model_opens() {
         "{e}"
     );
 }
+
+/// The model writes each step's prediction into a reused buffer (`denoise_into`); a denoiser
+/// that only allocates (`denoise`, the trait's default for `denoise_into`) gives the same bits,
+/// and a buffer of another shape is reshaped, not misread.
+#[test]
+fn predictions_written_in_place_equal_allocated_ones() {
+    let mut model = model_with(2);
+    let task = Task::Generate { frames: 64 };
+    let asked = request(&model, task, 3);
+    let in_place = sinmdm::run(&mut model, &asked, &mut go()).unwrap();
+    let plan = sinmdm::plan(model.metadata(), &asked).unwrap();
+    let mut counting = Counting {
+        model: &mut model,
+        calls: 0,
+    };
+    let allocated = plan.run(&mut counting, &mut go()).unwrap();
+    assert_eq!(counting.calls, 9);
+    assert_eq!(in_place.normalized, allocated.normalized);
+
+    let f = model.features();
+    let x = Array3::from_shape_fn((3, f, 40), |(b, r, c)| {
+        ((b * 7 + r * 3 + c) % 11) as f32 / 5.0
+    });
+    let t = [999, 500, 3];
+    let fresh = model.denoise(x.view(), &t).unwrap();
+    let mut reused = Array3::from_elem((1, 2, 3), f32::NAN);
+    model.denoise_into(x.view(), &t, &mut reused).unwrap();
+    assert_eq!(reused, fresh);
+    // The same buffer again, now of the right shape, for other inputs.
+    let y = x.mapv(|v| -v);
+    model.denoise_into(y.view(), &t, &mut reused).unwrap();
+    assert_eq!(reused, model.denoise(y.view(), &t).unwrap());
+    assert_ne!(reused, fresh);
+}

@@ -39,6 +39,17 @@ impl Denoiser for Timed<'_> {
         self.inside += start.elapsed().as_secs_f64();
         out
     }
+    fn denoise_into(
+        &mut self,
+        x_t: ArrayView3<'_, f32>,
+        t: &[i64],
+        out: &mut Array3<f32>,
+    ) -> Result<(), ModelError> {
+        let start = Instant::now();
+        let done = self.model.denoise_into(x_t, t, out);
+        self.inside += start.elapsed().as_secs_f64();
+        done
+    }
 }
 
 /// The median of `values` (the upper one of an even count).

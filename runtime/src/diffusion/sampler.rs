@@ -37,6 +37,18 @@ pub trait Denoiser {
     /// Predicted clean features `[B, F, N]` from noisy `x_t` `[B, F, N]` at original timesteps
     /// `t` (one per batch row).
     fn denoise(&mut self, x_t: ArrayView3<'_, f32>, t: &[i64]) -> Result<Array3<f32>, Self::Error>;
+    /// [`Denoiser::denoise`] written into `out`, a buffer the caller reuses from call to call
+    /// (any shape: a denoiser gives it the shape of `x_t`). The default calls `denoise` and
+    /// replaces `out`; a denoiser that can write in place saves an allocation per step.
+    fn denoise_into(
+        &mut self,
+        x_t: ArrayView3<'_, f32>,
+        t: &[i64],
+        out: &mut Array3<f32>,
+    ) -> Result<(), Self::Error> {
+        *out = self.denoise(x_t, t)?;
+        Ok(())
+    }
 }
 
 /// A sampling run in progress: noise drawn, steps taken one at a time by [`Sampler::step`].
@@ -56,6 +68,8 @@ pub struct Sampler {
     /// The last step's guided clean prediction (read by multistep methods, and the partial
     /// result of a run finished early).
     x0_prev: Option<Array3<f32>>,
+    /// The buffer the next step's prediction is written into (the one before last, reused).
+    spare: Option<Array3<f32>>,
 }
 
 impl std::fmt::Debug for Sampler {
@@ -102,6 +116,7 @@ impl Sampler {
             noise: NoiseWorker::start(seed, shape),
             method: Method::Ancestral,
             x0_prev: None,
+            spare: None,
         })
     }
 
@@ -173,7 +188,11 @@ impl Sampler {
         if k > 0 && harmonizing {
             self.noise.request(HARMONIZE_STREAM_BASE + step as u64 + 1);
         }
-        let x0 = denoiser.denoise(self.x.view(), &t);
+        let mut x0 = self
+            .spare
+            .take()
+            .unwrap_or_else(|| Array3::zeros(self.shape));
+        let called = denoiser.denoise_into(self.x.view(), &t, &mut x0);
         let eps = if noisy_step {
             self.noise.receive()
         } else {
@@ -184,7 +203,7 @@ impl Sampler {
         } else {
             None
         };
-        let mut x0 = x0.map_err(StepError::Denoiser)?;
+        called.map_err(StepError::Denoiser)?;
         if x0.dim() != self.shape {
             return Err(StepError::Setup(SamplerError::Shape {
                 what: "denoiser's output",
@@ -222,7 +241,7 @@ impl Sampler {
                 .and(&x0)
                 .for_each(|x, &p| *x = c0 * p + ct * *x),
         }
-        self.x0_prev = Some(x0);
+        self.spare = self.x0_prev.replace(x0);
         if let Some(h) = &self.guidance.harmonization
             && harmonizing
         {
