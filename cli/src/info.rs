@@ -84,11 +84,22 @@ pub fn describe(path: &std::path::Path, m: &ModelMetadata) -> String {
     if let Some(root) = &l.root {
         let _ = writeln!(
             s,
-            "root motion  joint '{}', axes {:?}, starts at {:?}",
+            "root motion  joint '{}', axes {:?}, starts at {:?}, {} root layout",
             joint_name(root.joint),
             root.axes,
-            root.start_position
+            root.start_position,
+            root.layout()
         );
+        if let Some(h) = &root.heading {
+            let _ = writeln!(
+                s,
+                "facing       across '{}' (left) and '{}' (right), sides told by {:?}, smoothed over {} s",
+                joint_name(h.left),
+                joint_name(h.right),
+                h.sides,
+                h.smoothing
+            );
+        }
     }
     let contacts: Vec<&str> = l.contact_joints.iter().map(|&j| joint_name(j)).collect();
     let _ = writeln!(
@@ -104,7 +115,7 @@ pub fn describe(path: &std::path::Path, m: &ModelMetadata) -> String {
     let _ = writeln!(
         s,
         "features     {} root, {} rotation joints x 6, {} position channels, {} contact labels",
-        l.root.as_ref().map_or(0, |r| r.axes.len()),
+        l.root.as_ref().map_or(0, |r| r.width()),
         l.rotation_joints.len(),
         l.position_channels.len(),
         l.contact_joints.len()

@@ -42,6 +42,10 @@ pub struct InspectArgs {
     /// Contact speed threshold in skeleton heights per second.
     #[arg(long, default_value_t = ContactConfig::default().speed_threshold)]
     pub contact_speed: f64,
+    /// How the root is described: `world` (ground displacement in world axes) or `heading`
+    /// (speeds and turn in the character's facing frame).
+    #[arg(long, default_value = "world", value_name = "LAYOUT")]
+    pub root: sinmdm::motion::RootLayout,
     #[command(flatten)]
     pub up: crate::clip_files::ClipUpArg,
 }
@@ -85,6 +89,7 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
             ..ContactConfig::default()
         },
         up: args.up.up,
+        root: args.root,
     };
     let encoded = encode(&clip, &options)
         .with_context(|| format!("{}: cannot encode the clip", args.clip.display()))?;
@@ -122,18 +127,27 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     let _ = writeln!(out, "units      {}", units_guess(height));
     match &layout.root {
         Some(root) => {
-            let axes: Vec<String> = root
-                .axes
-                .iter()
-                .map(|a| {
-                    let name = file_axis_name(layout.up, a.index());
-                    if a.index() == UP {
-                        format!("height({name})")
-                    } else {
-                        format!("d{name}")
-                    }
-                })
-                .collect();
+            let axes: Vec<String> = if root.heading.is_some() {
+                let up = file_axis_name(layout.up, UP);
+                vec![
+                    "forward".into(),
+                    "leftward".into(),
+                    "turn".into(),
+                    format!("height({up})"),
+                ]
+            } else {
+                root.axes
+                    .iter()
+                    .map(|a| {
+                        let name = file_axis_name(layout.up, a.index());
+                        if a.index() == UP {
+                            format!("height({name})")
+                        } else {
+                            format!("d{name}")
+                        }
+                    })
+                    .collect()
+            };
             let s = root.start_position;
             let _ = writeln!(
                 out,
@@ -151,6 +165,23 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
                 "root       no position channels: the clip stays in place"
             );
         }
+    }
+    if let Some(h) = layout.root.as_ref().and_then(|r| r.heading.as_ref()) {
+        let _ = writeln!(
+            out,
+            "facing     across {} (left) and {} (right), sides told by {}, smoothed over {} s; starts at {:.1} degrees",
+            skeleton.joints[h.left].name,
+            skeleton.joints[h.right].name,
+            match h.sides {
+                sinmdm::motion::features::heading::SideEvidence::Names => "their names",
+                sinmdm::motion::features::heading::SideEvidence::Travel =>
+                    "the travel (forward is where the clip goes)",
+                sinmdm::motion::features::heading::SideEvidence::Unresolved =>
+                    "nothing: neither names nor travel say, so forward may be the back",
+            },
+            h.smoothing,
+            h.start.to_degrees()
+        );
     }
     let _ = writeln!(
         out,
@@ -177,7 +208,7 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
         },
         layout.contact_speed_threshold
     );
-    let root_width = layout.root.as_ref().map_or(0, |r| r.axes.len());
+    let root_width = layout.root.as_ref().map_or(0, |r| r.width());
     let _ = writeln!(
         out,
         "features   F = {} = root {} + rotations {}x6 + positions {} + contacts {}",

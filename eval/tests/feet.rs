@@ -27,7 +27,7 @@ fn clip(hip: impl Fn(usize) -> (f64, f64)) -> (sinmdm::motion::FeatureLayout, Lo
                 joints: Some(vec!["Foot".into()]),
                 ..ContactConfig::default()
             },
-            up: None,
+            ..EncodeOptions::default()
         },
     )
     .unwrap();

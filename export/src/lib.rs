@@ -12,7 +12,7 @@ pub mod weights;
 use std::path::Path;
 
 use onnx_protobuf::{Message, ModelProto, OperatorSetIdProto, StringStringEntryProto};
-use sinmdm::model_file::{METADATA_KEY, ModelMetadata, SCHEMA_KEY, SCHEMA_VERSION};
+use sinmdm::model_file::{METADATA_KEY, ModelMetadata, SCHEMA_KEY};
 
 pub use sinmdm::network::NetworkShape;
 pub use sinmdm::network::{WeightTensor, Weights};
@@ -90,7 +90,7 @@ pub fn to_onnx_bytes(
     model.doc_string = "Single-motion diffusion denoiser (QnA-UNet): x_t [B, F, N] (normalised features) and t [B] -> x0 [B, F, N]".into();
     model.graph = Some(graph).into();
     for (key, value) in [
-        (SCHEMA_KEY, SCHEMA_VERSION.to_string()),
+        (SCHEMA_KEY, metadata.schema_version().to_string()),
         (
             METADATA_KEY,
             serde_json::to_string(metadata).expect("metadata serialises"),

@@ -17,14 +17,29 @@ def read_features(path):
     return np.asarray(doc["samples"], dtype=np.float32), float(doc["fps"])
 
 
+# The heading-relative root's rows, in order (runtime/src/motion/features/layout.rs).
+HEADING_ROOT_ROWS = ("forward", "leftward", "turn", "Y")
+
+
+def root_rows(layout):
+    """How many feature rows the root has: one per axis, or four for a heading-relative root."""
+    root = layout.get("root")
+    if not root:
+        return 0
+    return len(HEADING_ROOT_ROWS) if root.get("heading") else len(root["axes"])
+
+
 def column_names(layout):
     joints = layout["skeleton"]["joints"]
     names = []
     root = layout.get("root")
     if root:
-        for axis in root["axes"]:
-            name = joints[root["joint"]]["name"]
-            names.append(f"{name}.Y" if axis == "Y" else f"{name}.d{axis}")
+        name = joints[root["joint"]]["name"]
+        if root.get("heading"):
+            names.extend(f"{name}.{row}" for row in HEADING_ROOT_ROWS)
+        else:
+            for axis in root["axes"]:
+                names.append(f"{name}.Y" if axis == "Y" else f"{name}.d{axis}")
     for j in layout["rotation_joints"]:
         names.extend(f"{joints[j]['name']}.rot6d[{c}]" for c in range(6))
     for j, axis in layout["position_channels"]:

@@ -7,7 +7,9 @@ import numpy as np
 import onnxruntime as ort
 
 SCHEMA_KEY = "sinmdm.schema"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+# Schema 2 adds the heading-relative root (layout.root.heading); a model without it is schema 1.
+SCHEMA_VERSIONS_READ = ("1", "2")
 METADATA_KEY = "sinmdm.metadata"
 
 
@@ -37,8 +39,10 @@ class Model:
         props = self.session.get_modelmeta().custom_metadata_map
         if SCHEMA_KEY not in props:
             raise ModelError(f"'{path}' has no sinmdm metadata (no '{SCHEMA_KEY}' entry)")
-        if props[SCHEMA_KEY].strip() != str(SCHEMA_VERSION):
-            raise ModelError(f"'{path}' carries schema '{props[SCHEMA_KEY]}', expected {SCHEMA_VERSION}")
+        if props[SCHEMA_KEY].strip() not in SCHEMA_VERSIONS_READ:
+            raise ModelError(
+                f"'{path}' carries schema '{props[SCHEMA_KEY]}', expected one of {', '.join(SCHEMA_VERSIONS_READ)}"
+            )
         self.metadata = json.loads(props[METADATA_KEY])
         self.path = path
         self.features = self.metadata["network"]["features"]

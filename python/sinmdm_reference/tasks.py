@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from .features import root_rows
 from .schedule import Schedule
 
 INBETWEEN_RAMP = 10
@@ -74,7 +75,7 @@ def joint_of_columns(layout):
     joints = []
     root = layout.get("root")
     if root:
-        joints += [root["joint"]] * len(root["axes"])
+        joints += [root["joint"]] * root_rows(layout)
     for j in layout["rotation_joints"]:
         joints += [j] * 6
     joints += [j for j, _ in layout["position_channels"]]
@@ -137,7 +138,7 @@ def plan_compose(model, reference, joints, root, spans, ramp=INBETWEEN_RAMP):
     chosen = set(joints)
     rows = {r for r, j in enumerate(owner) if j in chosen}
     if root and layout.get("root"):
-        rows |= set(range(len(layout["root"]["axes"])))
+        rows |= set(range(root_rows(layout)))
     if not rows:
         raise TaskError("composition needs joints or the root to take from the reference")
     weights = np.ones(n, dtype=np.float32) if not spans else soft_mask(covered(n, check_spans(spans, n)), ramp)
@@ -260,8 +261,8 @@ def plan_dance(model, reference, reference_beats, target_beats, frames, hold=DAN
             target[:, u] = y[:, r + u - t]
             keep[u] = True
     weights = soft_mask(keep, ramp)
-    root_rows = len(model.layout["root"]["axes"]) if model.layout.get("root") else 0
+    rows_of_root = root_rows(model.layout)
     mask = np.zeros(target.shape, dtype=np.float32)
-    first = 0 if root else root_rows
+    first = 0 if root else rows_of_root
     mask[first:] = weights
     return frames, (target, mask)

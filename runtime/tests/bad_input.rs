@@ -168,7 +168,7 @@ fn bad_encoder_settings_are_errors() {
             &EncodeOptions {
                 fps,
                 contacts,
-                up: None,
+                ..EncodeOptions::default()
             },
         )
     };

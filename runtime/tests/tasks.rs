@@ -455,11 +455,26 @@ fn metadata_problems_are_named() {
     };
     let e = sinmdm::model_file::parse_metadata(path, lookup(None, Some(good.clone()))).unwrap_err();
     assert!(e.to_string().contains("has no sinmdm metadata"), "{e}");
-    let e = sinmdm::model_file::parse_metadata(path, lookup(Some("2"), Some(good.clone())))
+    let e = sinmdm::model_file::parse_metadata(path, lookup(Some("3"), Some(good.clone())))
         .unwrap_err();
     assert!(
         e.to_string()
-            .contains("schema '2'; this runtime reads schema 1"),
+            .contains("schema '3'; this runtime reads schemas 1 and 2"),
+        "{e}"
+    );
+    // A world-root model reads under schema 2 as well; a heading root under schema 1 does not.
+    assert!(
+        sinmdm::model_file::parse_metadata(path, lookup(Some("2"), Some(good.clone()))).is_ok()
+    );
+    let mut heading: serde_json::Value = serde_json::from_str(&good).unwrap();
+    heading["layout"]["root"]["heading"] = serde_json::json!({
+        "left": 1, "right": 2, "sides": "names", "smoothing": 0.2, "start": 0.5
+    });
+    let e = sinmdm::model_file::parse_metadata(path, lookup(Some("1"), Some(heading.to_string())))
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("layout.root.heading needs schema 2, the file says 1"),
         "{e}"
     );
     let mut value: serde_json::Value = serde_json::from_str(&good).unwrap();

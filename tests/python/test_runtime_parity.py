@@ -149,11 +149,11 @@ def test_bad_input_is_refused_with_a_clear_error(tmp_path):
     model = onnx.load(str(MODEL))
     for p in model.metadata_props:
         if p.key == "sinmdm.schema":
-            p.value = "2"
+            p.value = "3"
     future = tmp_path / "future.onnx"
     onnx.save(model, str(future))
     err = run_fails(tmp_path, "generate", "-m", future, "-o", out)
-    assert "schema '2'; this runtime reads schema 1" in err
+    assert "schema '3'; this runtime reads schemas 1 and 2" in err
 
     truncated = tmp_path / "truncated.onnx"
     truncated.write_bytes(MODEL.read_bytes()[:5000])

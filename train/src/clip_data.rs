@@ -108,6 +108,7 @@ impl ClipData {
                 ..ContactConfig::default()
             },
             up: data.up,
+            root: data.root_layout,
         };
         let encoded = encode(&clip, &options).map_err(|source| TrainError::Motion {
             path: path.to_path_buf(),

@@ -15,8 +15,12 @@ use crate::network::NetworkShape;
 
 /// Key of the schema version.
 pub const SCHEMA_KEY: &str = "sinmdm.schema";
-/// The schema version this crate writes and reads.
-pub const SCHEMA_VERSION: u32 = 1;
+/// The newest schema version this crate writes and reads: 2 adds the heading-relative root
+/// (`layout.root.heading`). A model without it is written as schema 1, so runtimes that read
+/// only schema 1 keep reading it, and refuse a heading model instead of misreading its root.
+pub const SCHEMA_VERSION: u32 = 2;
+/// The schema versions this crate reads.
+pub const SCHEMA_VERSIONS_READ: [u32; 2] = [1, 2];
 /// Key of the JSON-encoded [`ModelMetadata`].
 pub const METADATA_KEY: &str = "sinmdm.metadata";
 
@@ -40,6 +44,17 @@ pub struct ModelMetadata {
     pub normalizer: Normalizer,
     /// How the model was trained.
     pub training: TrainingFacts,
+}
+
+impl ModelMetadata {
+    /// The oldest schema version that holds this metadata (what a model file is written as):
+    /// 2 for a heading-relative root, 1 otherwise.
+    pub fn schema_version(&self) -> u32 {
+        match self.layout.root.as_ref().and_then(|r| r.heading.as_ref()) {
+            Some(_) => 2,
+            None => 1,
+        }
+    }
 }
 
 /// The network's sizes.
@@ -141,7 +156,7 @@ pub enum MetadataError {
     },
     /// Our metadata, but a schema version this runtime does not read.
     #[error(
-        "'{path}' carries sinmdm metadata schema '{found}'; this runtime reads schema {SCHEMA_VERSION}"
+        "'{path}' carries sinmdm metadata schema '{found}'; this runtime reads schemas 1 and {SCHEMA_VERSION}"
     )]
     SchemaVersion {
         /// The model file.
@@ -178,12 +193,17 @@ pub fn parse_metadata(
     let schema = lookup(SCHEMA_KEY).ok_or_else(|| MetadataError::NoMetadata {
         path: path.to_path_buf(),
     })?;
-    if schema.trim() != SCHEMA_VERSION.to_string() {
+    let Some(version) = schema
+        .trim()
+        .parse::<u32>()
+        .ok()
+        .filter(|v| SCHEMA_VERSIONS_READ.contains(v))
+    else {
         return Err(MetadataError::SchemaVersion {
             path: path.to_path_buf(),
             found: schema,
         });
-    }
+    };
     let bad = |message: String| MetadataError::BadMetadata {
         path: path.to_path_buf(),
         message,
@@ -198,7 +218,13 @@ pub fn parse_metadata(
         };
         bad(format!("'{METADATA_KEY}'{field}: {e}"))
     })?;
-    let problems = validate::problems(&metadata);
+    let mut problems = validate::problems(&metadata);
+    if metadata.schema_version() > version {
+        problems.push(format!(
+            "layout.root.heading needs schema {}, the file says {version}",
+            metadata.schema_version()
+        ));
+    }
     if !problems.is_empty() {
         return Err(MetadataError::Invalid {
             path: path.to_path_buf(),

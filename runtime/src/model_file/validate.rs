@@ -160,6 +160,40 @@ fn layout(p: &mut Problems, m: &ModelMetadata) {
             ));
         }
         p.finite("layout.root.start_position", &root.start_position.0);
+        if let Some(h) = &root.heading {
+            for (field, j) in [("left", h.left), ("right", h.right)] {
+                if j >= n {
+                    p.add(format!(
+                        "layout.root.heading.{field} is {j}; the skeleton has {n} joints"
+                    ));
+                }
+            }
+            if h.left == h.right {
+                p.add(format!(
+                    "layout.root.heading.left and .right are both {}; they must differ",
+                    h.left
+                ));
+            }
+            if !(h.smoothing.is_finite() && (0.0..=10.0).contains(&h.smoothing)) {
+                p.add(format!(
+                    "layout.root.heading.smoothing is {}; it must be 0 to 10 seconds",
+                    h.smoothing
+                ));
+            }
+            p.finite("layout.root.heading.start", &[h.start]);
+            if root.axes.len() != 3 {
+                p.add(format!(
+                    "layout.root.axes is {:?}; a heading-relative root moves on all three",
+                    root.axes
+                ));
+            }
+            if root.joint < n && !l.rotation_joints.contains(&root.joint) {
+                p.add(format!(
+                    "layout.root.joint {} has no rotation column; a heading-relative root turns",
+                    root.joint
+                ));
+            }
+        }
         if !is_rotation(&root.frame) {
             p.add(format!(
                 "layout.root.frame is {:?}; it must be a rotation matrix",

@@ -15,6 +15,7 @@ pub mod pose;
 pub mod resample;
 pub mod rotation;
 pub mod skeleton;
+pub mod smooth;
 pub mod up;
 pub mod up_detect;
 
@@ -23,7 +24,8 @@ pub use clip::{ChannelClip, LocalMotion, fps_from_frame_time};
 pub use contacts::ContactConfig;
 pub use features::{
     ClipForModel, Column, ColumnKind, EncodeOptions, EncodedClip, FeatureLayout, FeatureMatrix,
-    MotionError, RootFeatures, decode, encode, encode_for, encode_for_model, encode_motion,
+    MotionError, RootFeatures, RootLayout, decode, encode, encode_for, encode_for_model,
+    encode_motion,
 };
 pub use feet::{Feet, PlantOptions, PlantStats, plant_feet};
 pub use fk::{GlobalPose, global_pose, global_poses, max_position_error, skeleton_height};

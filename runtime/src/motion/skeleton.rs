@@ -184,6 +184,17 @@ impl Skeleton {
             .collect()
     }
 
+    /// The joints above `joint`, its parent first and the top joint last.
+    pub fn ancestors(&self, joint: usize) -> Vec<usize> {
+        let mut out = Vec::new();
+        let mut j = joint;
+        while let Some(p) = self.joints.get(j).and_then(|j| j.parent) {
+            out.push(p);
+            j = p;
+        }
+        out
+    }
+
     /// Joints that have no child joints (the ends of chains: feet, hands, head, tail tips).
     pub fn leaves(&self) -> Vec<usize> {
         let mut has_child = vec![false; self.joints.len()];

@@ -201,7 +201,7 @@ impl Stream {
             if compose.root
                 && let Some(r) = &layout.root
             {
-                compose_rows.extend(0..r.axes.len());
+                compose_rows.extend(0..r.width());
             }
             compose_rows.sort_unstable();
             compose_rows.dedup();

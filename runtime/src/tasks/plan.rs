@@ -93,12 +93,7 @@ impl Plan {
     /// position column fully masked); `None` for tasks without a reference mask.
     pub fn kept_root(&self) -> Option<Vec<bool>> {
         let inpaint = self.guidance.inpainting.as_ref()?;
-        let axes = self
-            .metadata
-            .layout
-            .root
-            .as_ref()
-            .map_or(0, |r| r.axes.len());
+        let axes = self.metadata.layout.root.as_ref().map_or(0, |r| r.width());
         Some(
             (0..self.frames)
                 .map(|frame| axes > 0 && (0..axes).all(|c| inpaint.mask[[c, frame]] >= 1.0))
@@ -285,7 +280,7 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
                 keep[first..=last].fill(true);
             }
             let weights = soft_mask(&keep, placed.ramp);
-            let root_rows = metadata.layout.root.as_ref().map_or(0, |r| r.axes.len());
+            let root_rows = metadata.layout.root.as_ref().map_or(0, |r| r.width());
             let rows: Vec<usize> = if *root {
                 (0..f).collect()
             } else {
@@ -386,7 +381,7 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
                 .flat_map(|&j| layout.joint_columns(j))
                 .collect();
             if *root && let Some(r) = &layout.root {
-                rows.extend(0..r.axes.len());
+                rows.extend(0..r.width());
             }
             rows.sort_unstable();
             rows.dedup();

@@ -193,6 +193,15 @@ pub struct DataConfig {
     /// The animation of a glTF or FBX clip to learn, by name or index; absent reads the first.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub animation: Option<String>,
+    /// How the root is described: `world` (ground displacement in world axes and a world
+    /// rotation, as SinMDM) or `heading` (speeds and turn in the character's facing frame, what
+    /// steering needs; SPEC section 2).
+    #[serde(default, skip_serializing_if = "is_world")]
+    pub root_layout: sinmdm::motion::RootLayout,
+}
+
+fn is_world(layout: &sinmdm::motion::RootLayout) -> bool {
+    *layout == sinmdm::motion::RootLayout::World
 }
 
 impl TrainConfig {

@@ -3,6 +3,7 @@
 use ndarray::ArrayView2;
 
 use super::error::MotionError;
+use super::heading::{integrate, yaw};
 use super::layout::FeatureLayout;
 use crate::motion::clip::LocalMotion;
 use crate::motion::math::{IDENTITY, Mat3, Vec3};
@@ -46,7 +47,32 @@ pub fn decode(
         }
     }
     let mut row = 0;
-    if let Some(root) = &layout.root {
+    // The facing per frame under the heading layout, to turn the root's rotation back by.
+    let mut facing: Option<(usize, Vec<f64>)> = None;
+    if let Some(root) = &layout.root
+        && let Some(heading) = &root.heading
+    {
+        let column = |r: usize| -> Vec<f64> {
+            features
+                .row(row + r)
+                .iter()
+                .map(|&v| f64::from(v))
+                .collect()
+        };
+        let (positions, headings) = integrate(
+            &column(0),
+            &column(1),
+            &column(2),
+            &column(3),
+            root.start_position,
+            heading.start,
+        );
+        for (f, p) in positions.into_iter().enumerate() {
+            translations[f * joints + root.joint] = p;
+        }
+        facing = Some((root.joint, headings));
+        row += root.width();
+    } else if let Some(root) = &layout.root {
         for &axis in &root.axes {
             let a = axis.index();
             let mut value = root.start_position[a];
@@ -71,6 +97,26 @@ pub fn decode(
             rotations[f * joints + joint] = mat_from_6d(&six);
         }
         row += 6;
+    }
+    if let Some((joint, headings)) = &facing {
+        for (f, &h) in headings.iter().enumerate() {
+            let k = f * joints + joint;
+            rotations[k] = yaw(h) * rotations[k];
+        }
+        // The joints above the motion root were taken relative to the first facing.
+        let first = layout
+            .root
+            .as_ref()
+            .and_then(|r| r.heading.as_ref())
+            .map_or(0.0, |h| h.start);
+        for above in layout.skeleton.ancestors(*joint) {
+            if layout.rotation_joints.contains(&above) {
+                for f in 0..frames {
+                    let k = f * joints + above;
+                    rotations[k] = yaw(first) * rotations[k];
+                }
+            }
+        }
     }
     for &(joint, axis) in &layout.position_channels {
         for f in 0..frames {

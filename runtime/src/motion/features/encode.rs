@@ -4,6 +4,10 @@ use ndarray::Array2;
 
 use super::FeatureMatrix;
 use super::error::MotionError;
+use super::heading::{
+    HEADING_SMOOTHING_SECONDS, Heading, RootLayout, SideEvidence, facing_angles, facing_pair,
+    left_by_name, root_columns, yaw,
+};
 use super::layout::{FeatureLayout, RootFeatures};
 use crate::limits::MAX_ENCODED_FRAMES;
 use crate::motion::clip::{ChannelClip, LocalMotion};
@@ -26,6 +30,8 @@ pub struct EncodeOptions {
     pub contacts: ContactConfig,
     /// The clip's up axis; `None` detects it from the motion ([`crate::motion::up_detect::detect_up`]).
     pub up: Option<UpAxis>,
+    /// How the root is described ([`super::heading`]).
+    pub root: RootLayout,
 }
 
 impl Default for EncodeOptions {
@@ -34,6 +40,7 @@ impl Default for EncodeOptions {
             fps: Some(30.0),
             contacts: ContactConfig::default(),
             up: None,
+            root: RootLayout::World,
         }
     }
 }
@@ -203,6 +210,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         axes: root_axes.into_iter().map(Axis::from_index).collect(),
         start_position: (frame * local.translations[root_joint]),
         frame,
+        heading: None,
     });
     let rotation_joints: Vec<usize> = (0..joints)
         .filter(|&j| skeleton.joints[j].rotates())
@@ -252,10 +260,17 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         up,
         ground: None,
     };
-    let layout = FeatureLayout {
+    let mut layout = FeatureLayout {
         ground: Some(ground_level(&layout.contact_joints, &poses)),
         ..layout
     };
+    if options.root == RootLayout::Heading {
+        let heading = choose_heading(&layout, &local, &poses)?;
+        if let Some(root) = layout.root.as_mut() {
+            root.axes = vec![Axis::X, Axis::Y, Axis::Z];
+            root.heading = Some(heading);
+        }
+    }
 
     let filled = fill_features(&layout, &local, &poses);
     Ok(EncodedClip {
@@ -265,6 +280,87 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         up_detection,
         in_place: filled.in_place,
     })
+}
+
+/// The heading-relative root's facts for a clip (see [`super::heading`]), or why it has none.
+fn choose_heading(
+    layout: &FeatureLayout,
+    local: &LocalMotion,
+    poses: &[crate::motion::fk::GlobalPose],
+) -> Result<Heading, MotionError> {
+    let skeleton = &layout.skeleton;
+    let root = layout.root.as_ref().ok_or_else(|| {
+        MotionError::Heading("its root has no position channels, so it never travels".into())
+    })?;
+    let name = |j: usize| skeleton.joints[j].name.as_str();
+    let ground = [Axis::X, Axis::Z];
+    if !ground.iter().all(|a| root.axes.contains(a)) {
+        return Err(MotionError::Heading(format!(
+            "its root '{}' does not move on both ground axes",
+            name(root.joint)
+        )));
+    }
+    if !skeleton.joints[root.joint].rotates() {
+        return Err(MotionError::Heading(format!(
+            "its root '{}' has no rotation channels to turn with the facing",
+            name(root.joint)
+        )));
+    }
+    let (a, b) =
+        facing_pair(skeleton, root.joint, &poses[0], layout.skeleton_height).ok_or_else(|| {
+            MotionError::Heading(
+                "no left/right pair of joints (hips or shoulders) gives it a facing".into(),
+            )
+        })?;
+    let sigma = HEADING_SMOOTHING_SECONDS * layout.fps;
+    let (left, right, sides) = match left_by_name(name(a), name(b)) {
+        Some(true) => (a, b, SideEvidence::Names),
+        Some(false) => (b, a, SideEvidence::Names),
+        None => {
+            // The side that makes the clip travel forward is the left one.
+            let headings = facing_angles(poses, a, b, sigma);
+            let positions = root_positions(root, local);
+            let [forward, _, _, _] = root_columns(&positions, &headings);
+            let along: f64 = forward.iter().sum();
+            let travel: f64 = positions
+                .windows(2)
+                .map(|w| {
+                    let mut d = w[1] - w[0];
+                    d[UP] = 0.0;
+                    d.norm()
+                })
+                .sum();
+            if along.abs() < 0.1 * travel || travel < 0.05 * layout.skeleton_height {
+                (a, b, SideEvidence::Unresolved)
+            } else if along > 0.0 {
+                (a, b, SideEvidence::Travel)
+            } else {
+                (b, a, SideEvidence::Travel)
+            }
+        }
+    };
+    let start = facing_angles(poses, left, right, sigma)
+        .first()
+        .copied()
+        .unwrap_or(0.0);
+    Ok(Heading {
+        left,
+        right,
+        sides,
+        smoothing: HEADING_SMOOTHING_SECONDS,
+        start,
+    })
+}
+
+/// The root joint's position per frame in the canonical frame.
+fn root_positions(root: &RootFeatures, local: &LocalMotion) -> Vec<Vec3> {
+    let joints = local.skeleton.len();
+    (0..local.frame_count())
+        .map(|f| {
+            let t = local.translations[f * joints + root.joint];
+            if root.turned() { root.frame * t } else { t }
+        })
+        .collect()
 }
 
 /// What [`fill_features`] makes.
@@ -287,7 +383,21 @@ fn fill_features(
     let height = layout.skeleton_height;
     let mut features = Array2::<f32>::zeros((layout.width(), frames));
     let mut row = 0;
-    if let Some(root) = &layout.root {
+    // The facing per frame under the heading layout: the root's rotation is taken relative to it.
+    let mut facing: Option<Vec<f64>> = None;
+    if let Some(root) = &layout.root
+        && let Some(heading) = &root.heading
+    {
+        let headings = facing_angles(poses, heading.left, heading.right, heading.smoothing * fps);
+        let columns = root_columns(&root_positions(root, local), &headings);
+        for values in columns {
+            for (f, v) in values.into_iter().enumerate() {
+                features[[row, f]] = v as f32;
+            }
+            row += 1;
+        }
+        facing = Some(headings);
+    } else if let Some(root) = &layout.root {
         for &axis in &root.axes {
             let a = axis.index();
             let at = |f: usize| {
@@ -311,18 +421,27 @@ fn fill_features(
             row += 1;
         }
     }
-    let root_turn = layout
-        .root
-        .as_ref()
-        .filter(|r| r.turned())
-        .map(|r| (r.joint, r.frame));
+    let root_joint = layout.root.as_ref().map(|r| r.joint);
+    let root_turn = layout.root.as_ref().filter(|r| r.turned()).map(|r| r.frame);
+    // Under the heading layout, the joints above the motion root (a static container) are
+    // taken relative to the first facing, so a clip turned about up keeps its features.
+    let above_root = root_joint.map_or_else(Vec::new, |r| layout.skeleton.ancestors(r));
     for &joint in &layout.rotation_joints {
         for f in 0..frames {
-            let rotation = &local.rotations[f * joints + joint];
-            let six = match root_turn {
-                Some((j, frame)) if j == joint => mat_to_6d(&(frame * rotation)),
-                _ => mat_to_6d(rotation),
-            };
+            let mut rotation = local.rotations[f * joints + joint];
+            if root_joint == Some(joint) {
+                if let Some(frame) = root_turn {
+                    rotation = frame * rotation;
+                }
+                if let Some(headings) = &facing {
+                    rotation = yaw(headings[f]).transpose() * rotation;
+                }
+            } else if let Some(headings) = &facing
+                && above_root.contains(&joint)
+            {
+                rotation = yaw(headings[0]).transpose() * rotation;
+            }
+            let six = mat_to_6d(&rotation);
             for (c, value) in six.iter().enumerate() {
                 features[[row + c, f]] = *value as f32;
             }

@@ -10,6 +10,11 @@ pub enum MotionError {
     /// The clip has no frames.
     #[error("the clip has no frames")]
     NoFrames,
+    /// The heading-relative root was asked for a clip it cannot describe.
+    #[error(
+        "the heading-relative root cannot describe this clip: {0}; train with root_layout: world"
+    )]
+    Heading(String),
     /// A contact joint named in the configuration is not in the skeleton.
     #[error("contact joint '{name}' is not in the skeleton (joints: {available})")]
     UnknownContactJoint {

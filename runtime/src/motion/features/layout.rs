@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::heading::{Heading, RootLayout};
 use crate::motion::math::{IDENTITY, Mat3, Vec3};
 use crate::motion::skeleton::{Axis, Skeleton};
 use crate::motion::up::{UP, UpAxis};
@@ -23,6 +24,10 @@ pub struct RootFeatures {
     /// height is height whatever the container's axes. Identity (and not written) otherwise.
     #[serde(default = "identity", skip_serializing_if = "is_identity")]
     pub frame: Mat3,
+    /// The heading-relative root's facts ([`super::heading`]); absent for the world layout,
+    /// which every model file written before it existed has.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heading: Option<Heading>,
 }
 
 fn identity() -> Mat3 {
@@ -38,7 +43,50 @@ impl RootFeatures {
     pub(crate) fn turned(&self) -> bool {
         !is_identity(&self.frame)
     }
+
+    /// Which root description the features use.
+    pub fn layout(&self) -> RootLayout {
+        match self.heading {
+            Some(_) => RootLayout::Heading,
+            None => RootLayout::World,
+        }
+    }
+
+    /// The root's feature rows: one per position axis for the world layout, four (forward,
+    /// leftward, turn, height) for the heading layout.
+    pub fn width(&self) -> usize {
+        match self.heading {
+            Some(_) => HEADING_ROOT_KINDS.len(),
+            None => self.axes.len(),
+        }
+    }
+
+    /// What each of the root's rows holds, in order.
+    pub fn kinds(&self) -> Vec<ColumnKind> {
+        match self.heading {
+            Some(_) => HEADING_ROOT_KINDS.to_vec(),
+            None => self
+                .axes
+                .iter()
+                .map(|&axis| {
+                    if axis.index() == UP {
+                        ColumnKind::RootHeight
+                    } else {
+                        ColumnKind::RootDisplacement(axis)
+                    }
+                })
+                .collect(),
+        }
+    }
 }
+
+/// The heading layout's root rows, in order.
+pub const HEADING_ROOT_KINDS: [ColumnKind; 4] = [
+    ColumnKind::RootForward,
+    ColumnKind::RootLeftward,
+    ColumnKind::RootTurn,
+    ColumnKind::RootHeight,
+];
 
 /// What one feature column holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -47,6 +95,13 @@ pub enum ColumnKind {
     RootDisplacement(Axis),
     /// Root height (absolute Y).
     RootHeight,
+    /// Heading layout: the root's ground displacement per frame along its facing.
+    RootForward,
+    /// Heading layout: the root's ground displacement per frame across its facing, to its left.
+    RootLeftward,
+    /// Heading layout: the facing's turn per frame about up, radians (toward +X from +Z is
+    /// positive).
+    RootTurn,
     /// Component 0..6 of a joint's 6D rotation (`R00 R01 R02 R10 R11 R12`).
     Rotation6d(u8),
     /// A varying non-root position channel (absolute value).
@@ -100,7 +155,7 @@ pub struct FeatureLayout {
 impl FeatureLayout {
     /// Number of feature columns (F).
     pub fn width(&self) -> usize {
-        self.root.as_ref().map_or(0, |r| r.axes.len())
+        self.root.as_ref().map_or(0, RootFeatures::width)
             + 6 * self.rotation_joints.len()
             + self.position_channels.len()
             + self.contact_joints.len()
@@ -110,17 +165,10 @@ impl FeatureLayout {
     pub fn columns(&self) -> Vec<Column> {
         let mut out = Vec::with_capacity(self.width());
         if let Some(root) = &self.root {
-            for &axis in &root.axes {
-                let kind = if axis.index() == UP {
-                    ColumnKind::RootHeight
-                } else {
-                    ColumnKind::RootDisplacement(axis)
-                };
-                out.push(Column {
-                    joint: root.joint,
-                    kind,
-                });
-            }
+            out.extend(root.kinds().into_iter().map(|kind| Column {
+                joint: root.joint,
+                kind,
+            }));
         }
         for &joint in &self.rotation_joints {
             out.extend((0..6).map(|c| Column {
@@ -171,6 +219,9 @@ impl FeatureLayout {
         match column.kind {
             ColumnKind::RootDisplacement(axis) => format!("{joint}.d{axis}"),
             ColumnKind::RootHeight => format!("{joint}.Y"),
+            ColumnKind::RootForward => format!("{joint}.forward"),
+            ColumnKind::RootLeftward => format!("{joint}.leftward"),
+            ColumnKind::RootTurn => format!("{joint}.turn"),
             ColumnKind::Rotation6d(c) => format!("{joint}.rot6d[{c}]"),
             ColumnKind::Position(axis) => format!("{joint}.{axis}position"),
             ColumnKind::Contact => format!("{joint}.contact"),

@@ -24,11 +24,13 @@ pub type FeatureMatrix = ndarray::Array2<f32>;
 mod decode;
 mod encode;
 mod error;
+pub mod heading;
 mod layout;
 mod reference;
 
 pub use decode::decode;
 pub use encode::{EncodeOptions, EncodedClip, encode, encode_for, encode_motion};
 pub use error::MotionError;
-pub use layout::{Column, ColumnKind, FeatureLayout, RootFeatures};
+pub use heading::{Heading, RootLayout};
+pub use layout::{Column, ColumnKind, FeatureLayout, HEADING_ROOT_KINDS, RootFeatures};
 pub use reference::{ClipForModel, encode_for_model};
