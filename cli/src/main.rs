@@ -12,6 +12,7 @@ mod library;
 mod render;
 mod reorient;
 mod sampling;
+mod steer;
 mod stream;
 mod tasks;
 
@@ -49,6 +50,10 @@ pub enum Command {
     /// music's beats, everything between them new.
     #[command(after_help = dance::EXAMPLES)]
     Dance(dance::DanceArgs),
+    /// Motion that goes where it is told (a path, a circle, a figure eight, speeds and turn
+    /// rates), the body in the clip's style; needs a heading-relative model.
+    #[command(after_help = steer::EXAMPLES)]
+    Steer(steer::SteerArgs),
     /// Style transfer: a content clip's low frequencies in the style the model learned.
     #[command(after_help = tasks::HARMONIZE_EXAMPLES)]
     Harmonize(tasks::HarmonizeArgs),
@@ -93,6 +98,7 @@ fn main() -> std::process::ExitCode {
         Command::Compose(args) => tasks::compose(&args),
         Command::Harmonize(args) => tasks::harmonize(&args),
         Command::Dance(args) => dance::run(&args),
+        Command::Steer(args) => steer::run(&args),
         Command::Stream(args) => stream::run(&args),
         Command::Eval(args) => eval::run(&args),
         Command::Info(args) => info::info(&args),

@@ -362,6 +362,9 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         method: args.method.method()?,
     };
     let plan = sinmdm::plan(model.metadata(), &request)?;
+    for warning in plan.warnings() {
+        eprintln!("warning: {warning}");
+    }
     let mut outputs: Vec<PathBuf> = (0..plan.count())
         .map(|i| args.output_path(i, plan.count()))
         .collect();

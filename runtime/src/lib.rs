@@ -59,6 +59,8 @@ pub mod motion;
 pub mod network;
 mod onnxruntime;
 #[doc(hidden)]
+pub mod steer;
+#[doc(hidden)]
 pub mod stream;
 #[doc(hidden)]
 pub mod tasks;

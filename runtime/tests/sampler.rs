@@ -100,6 +100,7 @@ fn a_task_runs_on_any_denoiser_and_a_full_mask_returns_the_reference() {
             mask: Array2::ones((f, 25)),
         }),
         harmonization: None,
+        steering: None,
     };
     let mut sampler = Sampler::new(&schedule, &guidance, 3, f, 25, 5).unwrap();
     while !sampler.is_finished() {
@@ -147,6 +148,7 @@ fn a_sampler_refuses_guidance_of_the_wrong_shape() {
             mask: Array2::zeros((5, 9)),
         }),
         harmonization: None,
+        steering: None,
     };
     let e = sinmdm::Sampler::new(&schedule, &guidance, 1, 5, 10, 0).unwrap_err();
     assert!(e.to_string().contains("inpainting mask"), "{e}");

@@ -13,6 +13,8 @@
 #                   and not trained again, an interrupted one resumes
 #   SHARED_BVH_DIR  the shared clip folder, if you have it: adds the MANN dog walk (60 fps,
 #                   learned at 30 fps and at its own rate) and the zombie walk
+# TRAIN_ARGS (environment) adds sinmdm-train arguments to every new run, for example
+# TRAIN_ARGS="--root-layout heading" for the heading-relative root's table.
 # Pause any other training or benchmark while this runs: the times are wall-clock on this machine.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -44,7 +46,7 @@ for entry in "${clips[@]}"; do
       "$train" --resume --out "$run" --export "$model"
     else
       # shellcheck disable=SC2086
-      "$train" "$clip" --out "$run" --export "$model" $extra
+      "$train" "$clip" --out "$run" --export "$model" $extra ${TRAIN_ARGS:-}
     fi
   fi
   for seed in 0 1 2 3 4; do

@@ -39,6 +39,9 @@ pub struct Guidance {
     pub inpainting: Option<Inpainting>,
     /// Low-frequency replacement after each step.
     pub harmonization: Option<Harmonization>,
+    /// The root's slow motion pulled to steering commands ([`crate::steer`]), before the mask
+    /// blending.
+    pub steering: Option<crate::steer::Steering>,
 }
 
 /// The average of each group of `factor` frames along the last axis (the last group may be
@@ -109,6 +112,16 @@ impl Guidance {
         if let Some(inpaint) = &self.inpainting {
             shape("inpainting reference", &inpaint.reference)?;
             shape("inpainting mask", &inpaint.mask)?;
+        }
+        if let Some(steer) = &self.steering
+            && (steer.frames() != frames || features < 3)
+        {
+            return Err(SamplerError::Shape {
+                what: "steering",
+                got: (features, steer.frames()),
+                features,
+                frames,
+            });
         }
         if let Some(h) = &self.harmonization {
             shape("harmonization content", &h.content)?;

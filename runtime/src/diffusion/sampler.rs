@@ -212,6 +212,11 @@ impl Sampler {
                 frames: self.shape.2,
             }));
         }
+        if let Some(steer) = &self.guidance.steering {
+            for row in x0.outer_iter_mut() {
+                steer.apply(row);
+            }
+        }
         if let Some(inpaint) = &self.guidance.inpainting {
             for mut row in x0.outer_iter_mut() {
                 Zip::from(&mut row)

@@ -24,8 +24,8 @@ pub use clip::{ChannelClip, LocalMotion, fps_from_frame_time};
 pub use contacts::ContactConfig;
 pub use features::{
     ClipForModel, Column, ColumnKind, EncodeOptions, EncodedClip, FeatureLayout, FeatureMatrix,
-    MotionError, RootFeatures, RootLayout, decode, encode, encode_for, encode_for_model,
-    encode_motion,
+    MotionError, RootFeatures, RootLayout, RootStart, decode, decode_from, encode, encode_for,
+    encode_for_model, encode_motion, root_track,
 };
 pub use feet::{Feet, PlantOptions, PlantStats, plant_feet};
 pub use fk::{GlobalPose, global_pose, global_poses, max_position_error, skeleton_height};

@@ -24,9 +24,14 @@ use crate::diffusion::sampler::{Denoiser, Guidance, Inpainting, Sampler};
 use crate::diffusion::{Method, Schedule};
 use crate::limits::MAX_SAMPLE_FRAMES;
 use crate::model_file::ModelMetadata;
+use crate::motion::features::heading::yaw;
 use crate::motion::feet::{Anchor, Feet, Kept, PlantOptions, plant_feet};
 use crate::motion::math::{Mat3, Vec3};
-use crate::motion::{FeatureMatrix, LocalMotion, Pose, decode, poses};
+use crate::motion::up::UP;
+use crate::motion::{
+    FeatureMatrix, LocalMotion, Pose, RootStart, decode, decode_from, poses, root_track,
+};
+use crate::steer::{SteerFrame, SteerLimits, plan_steering};
 use crate::tasks::mask::soft_mask;
 use crate::tasks::{INBETWEEN_RAMP, Progress, TaskError};
 use blocks::{BlockSizes, block_seed};
@@ -142,8 +147,16 @@ pub struct Stream {
     carried: Option<Array2<f32>>,
     /// The last `C` final frames as handed out (feet as chosen).
     tail: Option<LocalMotion>,
-    /// The root joint's translation in the last final frame, before planting.
+    /// The root joint's translation in the last final frame, before planting (a world-layout
+    /// root).
     last_root: Option<Vec3>,
+    /// A heading-relative root's canonical position and facing in the last final frame.
+    last_course: Option<RootStart>,
+    /// Steering commands from stream frame `commands_first` on.
+    commands: VecDeque<SteerFrame>,
+    commands_first: usize,
+    /// Lines on what steering clamped.
+    warnings: Vec<String>,
     /// Final frames not yet handed out.
     ready: VecDeque<Frame>,
     /// The next block, when its run has been started ahead of need.
@@ -228,6 +241,10 @@ impl Stream {
             carried: None,
             tail: None,
             last_root: None,
+            last_course: None,
+            commands: VecDeque::new(),
+            commands_first: 0,
+            warnings: Vec::new(),
             ready: VecDeque::new(),
             pending: None,
             guide: Guide::default(),
@@ -253,6 +270,40 @@ impl Stream {
     /// make a composed stream independent of chunk sizes.
     pub fn lookahead(&self) -> usize {
         2 * self.sizes.block + self.sizes.ramp
+    }
+
+    /// Steering commands for the frames after the last commanded one (the first call commands
+    /// frame 0): where the root goes, frame by frame and ahead of time ([`crate::steer`]).
+    /// A block uses the commands given when it starts, so commands reach the motion within
+    /// [`Stream::lookahead`] frames. Needs a heading-relative model. Commands beyond the clip's
+    /// range are clamped when used and reported by [`Stream::warnings`].
+    pub fn steer(&mut self, commands: &[SteerFrame]) -> Result<(), TaskError> {
+        if SteerLimits::of(&self.metadata).is_none() {
+            return Err(TaskError::Steer(
+                "the model has no heading-relative root (train it with --root-layout heading)"
+                    .into(),
+            ));
+        }
+        self.commands.extend(commands.iter().copied());
+        Ok(())
+    }
+
+    /// What steering changed of the commands so far (clamped to the clip's range), one line
+    /// per kind.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The commands for stream frames `start..start + frames` (free where none was given).
+    fn commands_for(&self, start: usize, frames: usize) -> Vec<SteerFrame> {
+        (start..start + frames)
+            .map(|frame| {
+                frame
+                    .checked_sub(self.commands_first)
+                    .and_then(|i| self.commands.get(i).copied())
+                    .unwrap_or(SteerFrame::Free)
+            })
+            .collect()
     }
 
     /// Poses for the frames after the last supplied one (the first call supplies frame 0), for
@@ -412,18 +463,62 @@ impl Stream {
                 }
             }
         }
+        let steering = if self.commands.is_empty() {
+            None
+        } else {
+            let course = match (self.last_course, window.context) {
+                (Some(last), c) if c > 0 => Some((c - 1, last)),
+                _ => self
+                    .metadata
+                    .layout
+                    .root
+                    .as_ref()
+                    .and_then(|r| r.heading.as_ref().map(|h| (r, h)))
+                    .map(|(r, h)| {
+                        (
+                            0,
+                            RootStart {
+                                position: r.start_position,
+                                heading: h.start,
+                            },
+                        )
+                    }),
+            };
+            match course {
+                Some((anchor, course)) => {
+                    let commands = self.commands_for(window.start, n);
+                    let planned =
+                        plan_steering(&self.metadata, &commands, anchor, course, sizes.ramp)
+                            .map_err(TaskError::Steer)?;
+                    for line in planned.warnings {
+                        if !self.warnings.contains(&line) {
+                            self.warnings.push(line);
+                        }
+                    }
+                    planned.steering
+                }
+                None => None,
+            }
+        };
+        // Commands the next blocks cannot reach are dropped.
+        let floor = (window.start + window.frames).saturating_sub(sizes.context + sizes.ramp + 1);
+        while self.commands_first < floor && !self.commands.is_empty() {
+            self.commands.pop_front();
+            self.commands_first += 1;
+        }
         // Supplied poses the next blocks cannot reach are dropped (also when nothing is composed,
         // so supplying poses never makes memory grow).
         self.guide.forget_before(
             (window.start + window.frames).saturating_sub(sizes.context + sizes.ramp + 1),
         );
-        let guidance = if mask.iter().any(|&m| m > 0.0) {
-            Guidance {
-                inpainting: Some(Inpainting { reference, mask }),
-                harmonization: None,
-            }
-        } else {
-            Guidance::default()
+        let inpainting = mask
+            .iter()
+            .any(|&m| m > 0.0)
+            .then_some(Inpainting { reference, mask });
+        let guidance = Guidance {
+            inpainting,
+            harmonization: None,
+            steering,
         };
         let seed = block_seed(self.seed, self.blocks as u64);
         let sampler =
@@ -447,9 +542,46 @@ impl Stream {
         let done = window.finalised(&sizes);
         let layout = &self.metadata.layout;
         let joints = layout.skeleton.len();
-        let mut motion = decode(layout, raw.slice(s![.., ..done.end]))?;
+        let rows = raw.slice(s![.., ..done.end]);
         let mut last_root = self.last_root;
-        if let Some(root) = &layout.root {
+        let mut last_course = self.last_course;
+        let mut motion = match layout.root.as_ref().and_then(|r| r.heading.as_ref()) {
+            // A heading-relative root: the block's course is turned and moved so that it goes
+            // on from the last final frame's position and facing.
+            Some(heading) => {
+                let root = layout
+                    .root
+                    .as_ref()
+                    .map_or(Vec3::ZERO, |r| r.start_position);
+                let start = match (self.last_course, done.start > 0) {
+                    (Some(last), true) => {
+                        let from_layout = root_track(layout, rows, None);
+                        let (positions, headings) = from_layout.unwrap_or_default();
+                        let k = done.start - 1;
+                        let turn = last.heading - headings[k];
+                        let mut travelled = positions[k] - root;
+                        travelled[UP] = 0.0;
+                        RootStart {
+                            position: last.position - yaw(turn) * travelled,
+                            heading: heading.start + turn,
+                        }
+                    }
+                    _ => RootStart {
+                        position: root,
+                        heading: heading.start,
+                    },
+                };
+                let (positions, headings) =
+                    root_track(layout, rows, Some(start)).unwrap_or_default();
+                last_course = Some(RootStart {
+                    position: positions[done.end - 1],
+                    heading: headings[done.end - 1],
+                });
+                decode_from(layout, rows, Some(start))?
+            }
+            None => decode(layout, rows)?,
+        };
+        if let Some(root) = layout.root.as_ref().filter(|r| r.heading.is_none()) {
             let r = root.joint;
             if let (Some(last), true) = (self.last_root, done.start > 0) {
                 let offset = last - motion.translations[(done.start - 1) * joints + r];
@@ -486,6 +618,7 @@ impl Stream {
         }
         self.carried = Some(carried);
         self.last_root = last_root;
+        self.last_course = last_course;
         for frame in done.clone() {
             let range = frame * joints..(frame + 1) * joints;
             self.ready.push_back(Frame {

@@ -96,6 +96,9 @@ pub enum TaskError {
         /// The memory the batch would take.
         gib: f64,
     },
+    /// Steering that this model or these commands cannot do.
+    #[error("cannot steer: {0}")]
+    Steer(String),
     /// A span with no frames.
     #[error("span {0} is empty (its end must come after its start)")]
     EmptySpan(Span),
@@ -223,6 +226,17 @@ pub enum Task {
         /// Whether the root's travel and height in each window come from the reference (its
         /// heading stays with the top joint's rotation either way).
         root: bool,
+    },
+    /// New motion of `frames` frames whose root goes where `commands` say, frame by frame
+    /// (a path on the ground, or forward speed and turn rate; [`crate::steer`]), from the
+    /// model's start position and facing. Needs a heading-relative model.
+    Steer {
+        /// Frames per sample.
+        frames: usize,
+        /// One command per frame (shorter lists leave the later frames free).
+        commands: Vec<crate::steer::SteerFrame>,
+        /// Soft border at the ends of each span of commands, in frames.
+        ramp: usize,
     },
     /// Style transfer: the content's low frequencies in the model's style.
     Harmonize {

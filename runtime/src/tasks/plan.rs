@@ -29,9 +29,16 @@ pub struct Plan {
     feet: Feet,
     method: Method,
     placement: Option<Placement>,
+    warnings: Vec<String>,
 }
 
 impl Plan {
+    /// What the plan changed of the request, one line each (steering commands clamped to the
+    /// clip's range); empty when it runs as asked.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
     /// Where a dance's keyframes went (level, tempo ratio, hold, keyframes); `None` for other
     /// tasks.
     pub fn placement(&self) -> Option<&Placement> {
@@ -253,8 +260,41 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
         None => Schedule::cosine(metadata.diffusion.steps)?,
     };
     let mut placement = None;
+    let mut warnings = Vec::new();
     let (frames, guidance) = match &request.task {
         Task::Generate { frames } => (*frames, Guidance::default()),
+        Task::Steer {
+            frames,
+            commands,
+            ramp,
+        } => {
+            check_length(*frames)?;
+            let ramp = check_ramp(*ramp)?;
+            let mut per_frame = commands.clone();
+            per_frame.resize(*frames, crate::steer::SteerFrame::Free);
+            let start = metadata
+                .layout
+                .root
+                .as_ref()
+                .and_then(|r| r.heading.as_ref().map(|h| (r.start_position, h.start)))
+                .map(|(position, heading)| crate::motion::RootStart { position, heading })
+                .ok_or_else(|| {
+                    TaskError::Steer(
+                        "the model has no heading-relative root (train it with --root-layout heading)"
+                            .into(),
+                    )
+                })?;
+            let planned = crate::steer::plan_steering(metadata, &per_frame, 0, start, ramp)
+                .map_err(TaskError::Steer)?;
+            warnings = planned.warnings;
+            (
+                *frames,
+                Guidance {
+                    steering: planned.steering,
+                    ..Guidance::default()
+                },
+            )
+        }
         Task::Dance {
             reference,
             beats,
@@ -296,6 +336,7 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
                         mask,
                     }),
                     harmonization: None,
+                    steering: None,
                 },
             )
         }
@@ -320,6 +361,7 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
                 Guidance {
                     inpainting: Some(Inpainting { reference: y, mask }),
                     harmonization: None,
+                    steering: None,
                 },
             )
         }
@@ -356,6 +398,7 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
                         mask,
                     }),
                     harmonization: None,
+                    steering: None,
                 },
             )
         }
@@ -402,6 +445,7 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
                 Guidance {
                     inpainting: Some(Inpainting { reference: y, mask }),
                     harmonization: None,
+                    steering: None,
                 },
             )
         }
@@ -426,6 +470,7 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
                 y.ncols(),
                 Guidance {
                     inpainting: None,
+                    steering: None,
                     harmonization: Some(Harmonization {
                         content: y,
                         factor: *factor,
@@ -464,5 +509,6 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
         feet: request.feet,
         method: request.method,
         placement,
+        warnings,
     })
 }

@@ -55,6 +55,11 @@ struct Args {
     /// one when the clip's motion stays correlated far longer than the network sees.
     #[arg(long, value_name = "K")]
     window: Option<usize>,
+    /// How a new run describes the root, replacing the config's data.root_layout: `world`
+    /// (ground displacement in world axes and a world rotation) or `heading` (speeds and turn
+    /// in the character's facing frame, which steering needs).
+    #[arg(long, value_name = "world|heading")]
+    root_layout: Option<sinmdm::motion::RootLayout>,
     /// Run folder: checkpoints, loss.csv, loss.png.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -171,6 +176,9 @@ fn new_run_config(args: &Args) -> Result<TrainConfig> {
     if let Some(animation) = &args.clip_anim {
         config.data.animation = Some(animation.clone());
     }
+    if let Some(layout) = args.root_layout {
+        config.data.root_layout = layout;
+    }
     if let Some(window) = args.window {
         config.model.window = window;
         config.model.window_follows_fps = false;
@@ -245,6 +253,16 @@ fn dry_run(args: &Args) -> Result<()> {
         println!("cycle           in place: contacts measured against the treadmill");
     }
     println!("features F      {features}");
+    if let Some(root) = &data.facts.layout.root {
+        let skeleton = &data.facts.layout.skeleton;
+        match &root.heading {
+            Some(h) => println!(
+                "root            heading-relative: facing across {} and {} (sides by {:?})",
+                skeleton.joints[h.left].name, skeleton.joints[h.right].name, h.sides
+            ),
+            None => println!("root            world: ground displacement in world axes"),
+        }
+    }
     println!("channels C      {}", config.model.channels);
     println!("parameters      {}", model.num_params());
     println!(
@@ -324,6 +342,9 @@ fn main() -> Result<()> {
         }
         if args.window.is_some() {
             bail!("--window sets the QnA window of a new run; a resumed run keeps its own");
+        }
+        if args.root_layout.is_some() {
+            bail!("--root-layout sets the root layout of a new run; a resumed run keeps its own");
         }
         if args.clip_anim.is_some() {
             bail!("--clip-anim picks the animation of a new run; a resumed run keeps its own");

@@ -10,11 +10,56 @@ use crate::motion::math::{IDENTITY, Mat3, Vec3};
 use crate::motion::rotation::mat_from_6d;
 use crate::motion::up::{UP, to_file};
 
+/// Where a heading-relative root starts integrating: its canonical position (the up component
+/// is ignored: height is a feature) and facing in frame 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RootStart {
+    /// The root joint's position, canonical frame.
+    pub position: Vec3,
+    /// The facing, radians about up from +Z toward +X.
+    pub heading: f64,
+}
+
 /// Turns features `[F, N]` back into local joint transforms in the file's frame (its up axis,
 /// [`FeatureLayout::up`]). Contact labels are not needed to rebuild the pose and are ignored.
 pub fn decode(
     layout: &FeatureLayout,
     features: ArrayView2<'_, f32>,
+) -> Result<LocalMotion, MotionError> {
+    decode_from(layout, features, None)
+}
+
+/// The heading-relative root's canonical position and facing in every frame of `features`,
+/// integrated from `start` (the layout's start when `None`); `None` for another root layout.
+pub fn root_track(
+    layout: &FeatureLayout,
+    features: ArrayView2<'_, f32>,
+    start: Option<RootStart>,
+) -> Option<(Vec<Vec3>, Vec<f64>)> {
+    let root = layout.root.as_ref()?;
+    let heading = root.heading.as_ref()?;
+    let start = start.unwrap_or(RootStart {
+        position: root.start_position,
+        heading: heading.start,
+    });
+    let column = |r: usize| -> Vec<f64> { features.row(r).iter().map(|&v| f64::from(v)).collect() };
+    Some(integrate(
+        &column(0),
+        &column(1),
+        &column(2),
+        &column(3),
+        start.position,
+        start.heading,
+    ))
+}
+
+/// [`decode`], with a heading-relative root starting from `start` instead of the layout's
+/// start (a stream continues its last block's course this way). `start` is ignored for a
+/// world-layout root.
+pub fn decode_from(
+    layout: &FeatureLayout,
+    features: ArrayView2<'_, f32>,
+    start: Option<RootStart>,
 ) -> Result<LocalMotion, MotionError> {
     let (width, frames) = features.dim();
     if width != layout.width() {
@@ -50,23 +95,8 @@ pub fn decode(
     // The facing per frame under the heading layout, to turn the root's rotation back by.
     let mut facing: Option<(usize, Vec<f64>)> = None;
     if let Some(root) = &layout.root
-        && let Some(heading) = &root.heading
+        && let Some((positions, headings)) = root_track(layout, features, start)
     {
-        let column = |r: usize| -> Vec<f64> {
-            features
-                .row(row + r)
-                .iter()
-                .map(|&v| f64::from(v))
-                .collect()
-        };
-        let (positions, headings) = integrate(
-            &column(0),
-            &column(1),
-            &column(2),
-            &column(3),
-            root.start_position,
-            heading.start,
-        );
         for (f, p) in positions.into_iter().enumerate() {
             translations[f * joints + root.joint] = p;
         }

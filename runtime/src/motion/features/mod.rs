@@ -28,7 +28,7 @@ pub mod heading;
 mod layout;
 mod reference;
 
-pub use decode::decode;
+pub use decode::{RootStart, decode, decode_from, root_track};
 pub use encode::{EncodeOptions, EncodedClip, encode, encode_for, encode_motion};
 pub use error::MotionError;
 pub use heading::{Heading, RootLayout};

@@ -1,0 +1,242 @@
+//! `sinmdm steer`: motion whose root goes where it is told (a path, a circle, a figure eight, or
+//! a schedule of speeds and turn rates), the body in the clip's style (the task is
+//! `sinmdm::Task::Steer`; the model needs a heading-relative root).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+
+use crate::sampling::{SamplingArgs, run_task, seconds_to_frames};
+use sinmdm::motion::features::heading::facing_against_travel;
+use sinmdm::motion::math::Vec3;
+use sinmdm::steer::follow::{path_following, velocity_following};
+use sinmdm::steer::paths::{Shape, clip_speed, path};
+use sinmdm::steer::{SteerFrame, SteerLimits};
+use sinmdm::tasks::{INBETWEEN_RAMP, Task};
+
+pub(crate) const EXAMPLES: &str = "Examples:
+  sinmdm steer -m onnx-models/human_zombie_walk_fair.onnx --circle 3 --seconds 20 -o out/circle.bvh
+  sinmdm steer -m onnx-models/human_zombie_walk_fair.onnx --figure8 3 --count 8 -o out/eight.glb
+  sinmdm steer -m zombie.onnx --velocity schedule.csv --seconds 12 -o out/steered.bvh --report
+  sinmdm steer -m zombie.onnx --path path.csv -o out/along.bvh
+
+--circle and --figure8 take the radius in character heights and start where the model's clip
+starts, facing its way. --path reads one ground position per frame (x,y,z in the model's file
+frame and units; the up component is ignored). --velocity reads lines `seconds,speed,turn`: from
+that time on, forward speed in file units per second and turn rate in degrees per second
+(positive turns left). Commands the clip never showed are clamped to its range, with a warning.";
+
+/// Arguments of `sinmdm steer`.
+#[derive(Debug, Args)]
+pub struct SteerArgs {
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// Walk a circle of this radius, in character heights, turning left.
+    #[arg(long, value_name = "R", group = "course")]
+    circle: Option<f64>,
+    /// Walk a figure eight of two circles of this radius, in character heights.
+    #[arg(long, value_name = "R", group = "course")]
+    figure8: Option<f64>,
+    /// Follow a path: one ground position per frame, `x,y,z` per line (file frame and units).
+    #[arg(long, value_name = "PATH.csv", group = "course")]
+    path: Option<PathBuf>,
+    /// Follow a schedule of velocities: lines `seconds,speed,turn` (file units per second,
+    /// degrees per second), each holding until the next.
+    #[arg(long, value_name = "SCHEDULE.csv", group = "course")]
+    velocity: Option<PathBuf>,
+    /// Speed along --circle and --figure8, file units per second (default: the clip's mean).
+    #[arg(long)]
+    speed: Option<f64>,
+    /// Length in seconds (default 20; a --path sets it by its frames).
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// Print how closely each sample followed: distance from the path, progress round it,
+    /// facing against travel, speed and turn against the schedule.
+    #[arg(long)]
+    report: bool,
+}
+
+/// Runs `sinmdm steer`.
+pub fn run(args: &SteerArgs) -> Result<()> {
+    let mut model = args.sampling.open_model()?;
+    let metadata = model.metadata().clone();
+    let Some(limits) = SteerLimits::of(&metadata) else {
+        bail!(
+            "{} has no heading-relative root: steering needs a model trained with --root-layout heading",
+            args.sampling.model.display()
+        );
+    };
+    let fps = metadata.layout.fps;
+    let height = metadata.layout.skeleton_height;
+    let given_frames = args
+        .seconds
+        .map(|s| seconds_to_frames(s, fps))
+        .transpose()?;
+    let frames = given_frames.unwrap_or((20.0 * fps).round() as usize);
+    let speed = match args.speed {
+        Some(s) if s.is_finite() && s > 0.0 => s,
+        Some(s) => bail!("--speed must be a positive number of units per second, got {s}"),
+        None => clip_speed(&metadata)
+            .unwrap_or(0.0)
+            .max(limits.forward.1 * 0.5),
+    };
+    let radius = |r: f64, flag: &str| -> Result<f64> {
+        if r.is_finite() && r > 0.0 {
+            Ok(r * height)
+        } else {
+            bail!("{flag} takes a positive radius in character heights, got {r}")
+        }
+    };
+    let commands = if let Some(r) = args.circle {
+        path(
+            &metadata,
+            Shape::Circle(radius(r, "--circle")?),
+            speed,
+            frames,
+        )
+    } else if let Some(r) = args.figure8 {
+        path(
+            &metadata,
+            Shape::FigureEight(radius(r, "--figure8")?),
+            speed,
+            frames,
+        )
+    } else if let Some(file) = &args.path {
+        Some(read_path(file)?)
+    } else if let Some(file) = &args.velocity {
+        Some(read_velocities(file, fps, frames)?)
+    } else {
+        bail!(
+            "say where to go: --circle R, --figure8 R, --path PATH.csv or --velocity SCHEDULE.csv"
+        )
+    };
+    let commands = commands.context("the model has no heading-relative root")?;
+    let frames = if args.path.is_some() {
+        given_frames.unwrap_or(commands.len())
+    } else {
+        frames
+    };
+    let task = Task::Steer {
+        frames,
+        commands: commands.clone(),
+        ramp: INBETWEEN_RAMP,
+    };
+    let generated = run_task(&args.sampling, &mut model, task)?;
+    if args.report {
+        let layout = generated.layout();
+        for i in 0..generated.count() {
+            let raw = generated.features.index_axis(ndarray::Axis(0), i);
+            let mut line = format!("sample {i}:");
+            if let Some(p) = path_following(layout, raw, &commands) {
+                line += &format!(
+                    " path distance mean {:.3} max {:.3} heights, progress {:.2};",
+                    p.mean_distance, p.max_distance, p.progress
+                );
+            }
+            if let Some(v) = velocity_following(layout, raw, &commands, (2.0 * fps) as usize) {
+                let worst = |pairs: &[(f64, f64)], floor: f64| {
+                    pairs
+                        .iter()
+                        .map(|(a, b)| (b - a).abs() / a.abs().max(floor))
+                        .fold(0.0, f64::max)
+                };
+                line += &format!(
+                    " speed off by at most {:.0} %, turn by at most {:.0} % (2 s windows);",
+                    100.0 * worst(&v.forward, 1e-9),
+                    100.0 * worst(&v.turn, 10f64.to_radians())
+                );
+            }
+            if let Some(mut a) = facing_against_travel(layout, raw) {
+                a.sort_by(f64::total_cmp);
+                if !a.is_empty() {
+                    let over = a.iter().filter(|&&x| x > 45.0).count() as f64 / a.len() as f64;
+                    line += &format!(
+                        " facing against travel median {:.1} degrees, {:.0} % over 45",
+                        a[a.len() / 2],
+                        100.0 * over
+                    );
+                }
+            }
+            println!("{line}");
+        }
+    }
+    Ok(())
+}
+
+fn numbers(line: &str) -> Vec<&str> {
+    line.split([',', ';', ' ', '\t'])
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .collect()
+}
+
+/// One position per frame, `x,y,z` per line; a first line that is not numbers is a header.
+fn read_path(file: &Path) -> Result<Vec<SteerFrame>> {
+    let text = std::fs::read_to_string(file)
+        .with_context(|| format!("cannot read the path {}", file.display()))?;
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let fields = numbers(line);
+        if fields.is_empty() {
+            continue;
+        }
+        let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
+        match values {
+            Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => {
+                out.push(SteerFrame::Position(Vec3::new(v[0], v[1], v[2])))
+            }
+            Err(_) if out.is_empty() && i == 0 => continue,
+            _ => bail!(
+                "{} line {}: expected three numbers x,y,z, got '{line}'",
+                file.display(),
+                i + 1
+            ),
+        }
+    }
+    if out.len() < 2 {
+        bail!("{}: a path needs at least two positions", file.display());
+    }
+    Ok(out)
+}
+
+/// Lines `seconds,speed,turn` (turn in degrees per second), each holding until the next, as
+/// per-frame velocity commands over `frames` frames.
+fn read_velocities(file: &Path, fps: f64, frames: usize) -> Result<Vec<SteerFrame>> {
+    let text = std::fs::read_to_string(file)
+        .with_context(|| format!("cannot read the schedule {}", file.display()))?;
+    let mut entries: Vec<(f64, f64, f64)> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let fields = numbers(line);
+        if fields.is_empty() {
+            continue;
+        }
+        let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
+        match values {
+            Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => {
+                if entries.last().is_some_and(|e| v[0] <= e.0) {
+                    bail!("{} line {}: times must increase", file.display(), i + 1);
+                }
+                entries.push((v[0], v[1], v[2].to_radians()));
+            }
+            Err(_) if entries.is_empty() && i == 0 => continue,
+            _ => bail!(
+                "{} line {}: expected seconds,speed,turn, got '{line}'",
+                file.display(),
+                i + 1
+            ),
+        }
+    }
+    if entries.is_empty() {
+        bail!("{}: the schedule is empty", file.display());
+    }
+    Ok((0..frames)
+        .map(|f| {
+            let t = f as f64 / fps;
+            match entries.iter().rev().find(|e| e.0 <= t) {
+                Some(&(_, forward, turn)) => SteerFrame::Velocity { forward, turn },
+                None => SteerFrame::Free,
+            }
+        })
+        .collect())
+}

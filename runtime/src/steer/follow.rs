@@ -1,0 +1,153 @@
+//! How well a steered motion did what it was asked: its distance from the path, how far along
+//! the path it got, and its speed and turn rate against velocity commands.
+
+use ndarray::ArrayView2;
+
+use crate::motion::FeatureLayout;
+use crate::motion::math::Vec3;
+use crate::motion::root_track;
+use crate::motion::up::UP;
+
+use super::SteerFrame;
+
+/// A motion's root against a path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathFollowing {
+    /// Mean distance on the ground from the root to the path (to the nearest point of the
+    /// path's polyline), in skeleton heights.
+    pub mean_distance: f64,
+    /// The largest such distance, in skeleton heights.
+    pub max_distance: f64,
+    /// How far along the path the root's nearest point got by the last frame, as a share of
+    /// the path's length: about 1 when it went round.
+    pub progress: f64,
+}
+
+/// The root's canonical ground positions of heading-layout `features` (raw, `[F, N]`) from
+/// the layout's start; `None` for another layout.
+pub fn root_positions(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> Option<Vec<Vec3>> {
+    let (positions, _) = root_track(layout, features, None)?;
+    Some(
+        positions
+            .into_iter()
+            .map(|mut p| {
+                p[UP] = 0.0;
+                p
+            })
+            .collect(),
+    )
+}
+
+/// The root of `features` against the path of `commands` (their [`SteerFrame::Position`]s,
+/// file frame); `None` for a layout without a heading-relative root or fewer than two points.
+pub fn path_following(
+    layout: &FeatureLayout,
+    features: ArrayView2<'_, f32>,
+    commands: &[SteerFrame],
+) -> Option<PathFollowing> {
+    let to_canonical = layout.up.canonical_from_file();
+    let path: Vec<Vec3> = commands
+        .iter()
+        .filter_map(|c| match c {
+            SteerFrame::Position(p) => {
+                let mut q = to_canonical * *p;
+                q[UP] = 0.0;
+                Some(q)
+            }
+            _ => None,
+        })
+        .collect();
+    if path.len() < 2 {
+        return None;
+    }
+    let positions = root_positions(layout, features)?;
+    let mut along = vec![0.0; path.len()];
+    for i in 1..path.len() {
+        along[i] = along[i - 1] + (path[i] - path[i - 1]).norm();
+    }
+    let length = along[path.len() - 1].max(1e-12);
+    // Nearest point of the polyline: (distance, arc length there).
+    let nearest = |p: Vec3| -> (f64, f64) {
+        let mut best = (f64::INFINITY, 0.0);
+        for i in 1..path.len() {
+            let (a, b) = (path[i - 1], path[i]);
+            let ab = b - a;
+            let len2 = ab.dot(ab);
+            let t = if len2 > 0.0 {
+                ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let d = (p - (a + ab * t)).norm();
+            if d < best.0 {
+                best = (d, along[i - 1] + t * len2.sqrt());
+            }
+        }
+        best
+    };
+    let height = layout.skeleton_height;
+    let n = positions.len().min(path.len());
+    let distances: Vec<(f64, f64)> = positions[..n].iter().map(|&p| nearest(p)).collect();
+    Some(PathFollowing {
+        mean_distance: distances.iter().map(|d| d.0).sum::<f64>() / n as f64 / height,
+        max_distance: distances.iter().map(|d| d.0).fold(0.0, f64::max) / height,
+        progress: distances.last().map_or(0.0, |d| d.1) / length,
+    })
+}
+
+/// A motion's forward speed and turn rate against velocity commands, averaged over windows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VelocityFollowing {
+    /// Per window: (commanded, achieved) mean forward speed, file units per second.
+    pub forward: Vec<(f64, f64)>,
+    /// Per window: (commanded, achieved) mean turn rate, radians per second.
+    pub turn: Vec<(f64, f64)>,
+}
+
+/// Means over consecutive windows of `window` frames of the commanded and achieved forward
+/// speed and turn rate (raw heading-layout `features`); windows without a velocity command
+/// throughout are left out. `None` for another layout.
+pub fn velocity_following(
+    layout: &FeatureLayout,
+    features: ArrayView2<'_, f32>,
+    commands: &[SteerFrame],
+    window: usize,
+) -> Option<VelocityFollowing> {
+    layout.root.as_ref()?.heading.as_ref()?;
+    let fps = layout.fps;
+    let frames = features.ncols().min(commands.len());
+    let mut out = VelocityFollowing {
+        forward: Vec::new(),
+        turn: Vec::new(),
+    };
+    let window = window.max(1);
+    for start in (1..frames).step_by(window) {
+        let end = (start + window).min(frames);
+        let asked: Option<Vec<(f64, f64)>> = (start..end)
+            .map(|f| match commands[f] {
+                SteerFrame::Velocity { forward, turn } => Some((forward, turn)),
+                _ => None,
+            })
+            .collect();
+        let Some(asked) = asked else { continue };
+        let count = (end - start) as f64;
+        let mean = |values: Vec<f64>| values.iter().sum::<f64>() / count;
+        out.forward.push((
+            mean(asked.iter().map(|a| a.0).collect()),
+            mean(
+                (start..end)
+                    .map(|f| f64::from(features[[0, f]]) * fps)
+                    .collect(),
+            ),
+        ));
+        out.turn.push((
+            mean(asked.iter().map(|a| a.1).collect()),
+            mean(
+                (start..end)
+                    .map(|f| f64::from(features[[2, f]]) * fps)
+                    .collect(),
+            ),
+        ));
+    }
+    Some(out)
+}

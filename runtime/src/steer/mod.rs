@@ -1,0 +1,315 @@
+//! Steering a heading-relative model (SPEC section 5, "Steering"): where the character goes is
+//! asked for frame by frame (a path on the ground, or forward speed and turn rate), and the
+//! sampler pulls the root's slow motion to it while the network makes the body to match.
+//!
+//! A command is an average over a stride, not a value per frame: a walk's hips speed up and
+//! slow down within each step, and its facing sways. So steering sets only the **slow part** of
+//! the root's rows. At every denoising step, for each steered row `r` of the prediction `x0`
+//! (normalised): `x0[r] += lowpass(w (y[r] - x0[r]))`, where `y` is the target, `w` the
+//! command's weight per frame (soft at the ends of a span of commands, 0 where nothing is
+//! asked) and the low-pass a triangular kernel of [`STEER_REACH_SECONDS`]. The stride's rhythm
+//! stays the model's.
+//!
+//! - **Velocity** commands target the forward row (speed / fps) and the turn row (turn rate /
+//!   fps).
+//! - **Path** commands give the ground position of each frame. Their displacement from frame to
+//!   frame, turned into the facing the prediction has at that frame (re-integrated from its own
+//!   turn rows at every step), targets the forward and leftward rows; the path's own turn, plus
+//!   the facing's error against the path's direction corrected over [`FACING_CATCH_UP_SECONDS`],
+//!   targets the turn row. A start off the path is caught up over the same time.
+//!
+//! Commands beyond what the clip showed are clamped ([`SteerLimits`]) and reported.
+
+pub mod follow;
+pub mod lowpass;
+pub mod paths;
+
+use ndarray::ArrayViewMut2;
+
+use crate::model_file::ModelMetadata;
+use crate::motion::RootStart;
+use crate::motion::features::heading::{wrap, yaw};
+use crate::motion::math::Vec3;
+use crate::motion::up::UP;
+use crate::tasks::mask::soft_mask;
+
+/// The half-width of the steering low-pass, seconds: about a stride, so the commanded average
+/// is over a whole step.
+pub const STEER_REACH_SECONDS: f64 = 0.5;
+
+/// How fast a path's facing and position errors are caught up, seconds.
+pub const FACING_CATCH_UP_SECONDS: f64 = 1.0;
+
+/// The smallest turn rate steering allows, radians per second, whatever the clip: a clip that
+/// walks straight still turns a quarter turn a second when asked (the heading-relative root
+/// makes a turn the same data as a straight walk, turned).
+pub const MIN_TURN_LIMIT: f64 = std::f64::consts::FRAC_PI_2;
+
+/// The rows of a heading-relative root, in the features' order.
+const FORWARD: usize = 0;
+const LEFTWARD: usize = 1;
+const TURN: usize = 2;
+
+/// What one frame of a steered run asks for (file frame: the model's up axis and units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SteerFrame {
+    /// Nothing: the model goes where it likes.
+    Free,
+    /// Forward speed (file units per second, along the facing) and turn rate (radians per
+    /// second about up; positive turns left, counter-clockwise seen from above).
+    Velocity {
+        /// File units per second.
+        forward: f64,
+        /// Radians per second.
+        turn: f64,
+    },
+    /// The root's position on the ground at this frame (file frame; the up component is
+    /// ignored).
+    Position(Vec3),
+}
+
+/// The range of commands a model's clip supports: its forward speed and turn rate, each as the
+/// clip's mean plus or minus two standard deviations per frame (read from the model's
+/// normaliser), the turn widened to at least [`MIN_TURN_LIMIT`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SteerLimits {
+    /// Slowest and fastest forward speed, file units per second.
+    pub forward: (f64, f64),
+    /// Largest turn rate either way, radians per second.
+    pub turn: f64,
+}
+
+impl SteerLimits {
+    /// The limits of a heading-relative model; `None` for another root layout.
+    pub fn of(metadata: &ModelMetadata) -> Option<SteerLimits> {
+        metadata.layout.root.as_ref()?.heading.as_ref()?;
+        let fps = metadata.layout.fps;
+        let n = &metadata.normalizer;
+        let row = |r: usize| (f64::from(n.mean[r]) * fps, f64::from(n.std[r]) * fps);
+        let (fm, fs) = row(FORWARD);
+        let (tm, ts) = row(TURN);
+        Some(SteerLimits {
+            forward: (fm - 2.0 * fs, fm + 2.0 * fs),
+            turn: (tm.abs() + 2.0 * ts).max(MIN_TURN_LIMIT),
+        })
+    }
+}
+
+/// One frame's goal, canonical frame, per frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Goal {
+    Free,
+    /// Forward displacement and turn per frame.
+    Velocity {
+        forward: f64,
+        turn: f64,
+    },
+    /// The root's ground position (up component 0).
+    Position(Vec3),
+}
+
+/// The steering of one sampling run: a goal per frame of its window, from a known course.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Steering {
+    goals: Vec<Goal>,
+    /// Per frame, how strongly its goal pulls (soft at the ends of a span of commands).
+    weights: Vec<f64>,
+    /// The frame whose course is known; goals are read after it.
+    anchor: usize,
+    /// The root's canonical position and facing at the anchor frame.
+    course: RootStart,
+    /// Mean and standard deviation of the forward, leftward and turn rows.
+    mean: [f64; 3],
+    std: [f64; 3],
+    /// Low-pass half-width and catch-up time, frames.
+    reach: usize,
+    catch_up: f64,
+    /// The fastest the root may go, per frame.
+    max_step: f64,
+}
+
+/// A steering built from commands, and what was clamped on the way.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SteeringPlan {
+    /// The guidance (`None` when no frame asks for anything).
+    pub steering: Option<Steering>,
+    /// One line per kind of command the clip never showed, clamped to its range.
+    pub warnings: Vec<String>,
+}
+
+/// Builds the steering of a window of `commands.len()` frames whose course at frame `anchor`
+/// is `course` (canonical), soft over `ramp` frames at the ends of each span of commands.
+/// Fails for a model without a heading-relative root.
+pub fn plan_steering(
+    metadata: &ModelMetadata,
+    commands: &[SteerFrame],
+    anchor: usize,
+    course: RootStart,
+    ramp: usize,
+) -> Result<SteeringPlan, String> {
+    let limits = SteerLimits::of(metadata).ok_or_else(|| {
+        "steering needs a model with a heading-relative root (train it with --root-layout heading)"
+            .to_string()
+    })?;
+    let layout = &metadata.layout;
+    let fps = layout.fps;
+    let to_canonical = layout.up.canonical_from_file();
+    let mut warnings = Vec::new();
+    let mut warn = |line: String| {
+        if !warnings.contains(&line) {
+            warnings.push(line);
+        }
+    };
+    let goals: Vec<Goal> = commands
+        .iter()
+        .map(|c| match *c {
+            SteerFrame::Free => Goal::Free,
+            SteerFrame::Velocity { forward, turn } => {
+                let (lo, hi) = limits.forward;
+                let f = forward.clamp(lo, hi);
+                if f != forward {
+                    warn(format!(
+                        "forward speeds beyond the clip's {lo:.3} to {hi:.3} units/s were clamped"
+                    ));
+                }
+                let t = turn.clamp(-limits.turn, limits.turn);
+                if t != turn {
+                    warn(format!(
+                        "turn rates beyond the clip's {:.0} degrees/s were clamped",
+                        limits.turn.to_degrees()
+                    ));
+                }
+                Goal::Velocity {
+                    forward: f / fps,
+                    turn: t / fps,
+                }
+            }
+            SteerFrame::Position(p) => {
+                let mut q = to_canonical * p;
+                q[UP] = 0.0;
+                Goal::Position(q)
+            }
+        })
+        .collect();
+    // A path faster than the clip ever went is followed at the clip's top speed.
+    let top = limits.forward.1.max(0.0);
+    for pair in goals.windows(2) {
+        if let [Goal::Position(a), Goal::Position(b)] = pair
+            && (*b - *a).norm() * fps > top * 1.0001
+        {
+            warn(format!(
+                "the path goes faster than the clip's {top:.3} units/s; it is followed at that speed"
+            ));
+            break;
+        }
+    }
+    let asked: Vec<bool> = goals
+        .iter()
+        .enumerate()
+        .map(|(i, g)| i > anchor && *g != Goal::Free)
+        .collect();
+    if !asked.contains(&true) {
+        return Ok(SteeringPlan {
+            steering: None,
+            warnings,
+        });
+    }
+    let weights = soft_mask(&asked, ramp).into_iter().map(f64::from).collect();
+    let n = &metadata.normalizer;
+    let rows = [FORWARD, LEFTWARD, TURN];
+    Ok(SteeringPlan {
+        steering: Some(Steering {
+            goals,
+            weights,
+            anchor,
+            course: RootStart {
+                position: Vec3::new(course.position[0], 0.0, course.position[2]),
+                heading: course.heading,
+            },
+            mean: rows.map(|r| f64::from(n.mean[r])),
+            std: rows.map(|r| f64::from(n.std[r])),
+            reach: (STEER_REACH_SECONDS * fps).round() as usize,
+            catch_up: (FACING_CATCH_UP_SECONDS * fps).max(1.0),
+            max_step: top / fps,
+        }),
+        warnings,
+    })
+}
+
+impl Steering {
+    /// Frames of the window it steers.
+    pub fn frames(&self) -> usize {
+        self.goals.len()
+    }
+
+    /// Pulls the slow part of the root rows of one normalised prediction `[F, N]` to the goals.
+    pub fn apply(&self, mut x0: ArrayViewMut2<'_, f32>) {
+        let n = self.goals.len();
+        let raw = |r: usize| -> Vec<f64> {
+            x0.row(r)
+                .iter()
+                .map(|&v| f64::from(v) * self.std[r] + self.mean[r])
+                .collect()
+        };
+        let (forward, leftward, turn) = (raw(FORWARD), raw(LEFTWARD), raw(TURN));
+        // The prediction's own course from the anchor on.
+        let mut heading = vec![self.course.heading; n];
+        let mut position = vec![self.course.position; n];
+        for i in self.anchor + 1..n {
+            heading[i] = heading[i - 1] + turn[i];
+            let mut step = yaw(heading[i]) * Vec3::new(leftward[i], 0.0, forward[i]);
+            step[UP] = 0.0;
+            position[i] = position[i - 1] + step;
+        }
+        let mut targets: [Vec<Option<f64>>; 3] = [vec![None; n], vec![None; n], vec![None; n]];
+        let mut last_direction: Option<f64> = None;
+        for i in self.anchor + 1..n {
+            match self.goals[i] {
+                Goal::Free => last_direction = None,
+                Goal::Velocity { forward, turn } => {
+                    targets[FORWARD][i] = Some(forward);
+                    targets[TURN][i] = Some(turn);
+                    last_direction = None;
+                }
+                Goal::Position(p) => {
+                    let before = match self.goals[i - 1] {
+                        Goal::Position(q) => q,
+                        _ => position[i - 1],
+                    };
+                    // The path's step, plus the error of where the prediction stands, caught
+                    // up over the catch-up time; no faster than the clip goes.
+                    let mut want =
+                        (p - before) + (before - position[i - 1]) * (1.0 / self.catch_up);
+                    want[UP] = 0.0;
+                    let speed = want.norm();
+                    if speed > self.max_step && speed > 0.0 {
+                        want = want * (self.max_step / speed);
+                    }
+                    let local = yaw(heading[i]).transpose() * want;
+                    targets[FORWARD][i] = Some(local[2]);
+                    targets[LEFTWARD][i] = Some(local[0]);
+                    if speed > 1e-9 {
+                        let direction = want[0].atan2(want[2]);
+                        let path_turn = last_direction.map_or(0.0, |d| wrap(direction - d));
+                        let error = wrap(direction - heading[i]);
+                        targets[TURN][i] = Some(path_turn + error / self.catch_up);
+                        last_direction = Some(direction);
+                    }
+                }
+            }
+        }
+        for (k, row) in [FORWARD, LEFTWARD, TURN].into_iter().enumerate() {
+            if targets[k].iter().all(Option::is_none) {
+                continue;
+            }
+            let current = [&forward, &leftward, &turn][k];
+            let pull: Vec<f64> = (0..n)
+                .map(|i| targets[k][i].map_or(0.0, |t| self.weights[i] * (t - current[i])))
+                .collect();
+            let slow = lowpass::triangular(&pull, self.reach);
+            for (v, d) in x0.row_mut(row).iter_mut().zip(slow) {
+                *v = (f64::from(*v) + d / self.std[k]) as f32;
+            }
+        }
+    }
+}
