@@ -80,6 +80,10 @@ pub struct EvalArgs {
     /// Score, each beside its random-phase control.
     #[command(flatten)]
     dance: crate::dance::DanceOptions,
+    /// Steer every sample along a course instead of free generation (a heading-relative model;
+    /// see `sinmdm steer`), and say how closely each followed it.
+    #[command(flatten)]
+    course: crate::steer::CourseArgs,
 }
 
 /// The JSON file `--json` writes.
@@ -176,10 +180,25 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     } else {
         None
     };
+    if args.course.given() && dance.is_some() {
+        bail!("a steering course does not go with a dance's music");
+    }
+    let commands = if args.course.given() {
+        Some(args.course.commands(model.metadata(), frames)?)
+    } else {
+        None
+    };
+    let task = match (&dance, &commands) {
+        (Some(d), _) => d.task(),
+        (None, Some(c)) => Task::Steer {
+            frames,
+            commands: c.clone(),
+            ramp: sinmdm::tasks::INBETWEEN_RAMP,
+        },
+        (None, None) => Task::Generate { frames },
+    };
     let request = Request {
-        task: dance
-            .as_ref()
-            .map_or(Task::Generate { frames }, |d| d.task()),
+        task,
         count: args.samples,
         seed: args.seed,
         steps,
@@ -209,7 +228,14 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
                 method,
                 ..StreamOptions::default()
             };
-            let chunk = Stream::new(&metadata, options)?.next(&mut model, frames)?;
+            let mut stream = Stream::new(&metadata, options)?;
+            if let Some(commands) = &commands {
+                stream.steer(commands)?;
+            }
+            let chunk = stream.next(&mut model, frames)?;
+            for warning in stream.warnings() {
+                eprintln!("warning: {warning}");
+            }
             normalized
                 .index_axis_mut(Axis(0), i)
                 .assign(&metadata.normalizer.normalize(chunk.features.view()));
@@ -261,6 +287,9 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         )
     };
 
+    if let Some(commands) = &commands {
+        crate::steer::print_following(&generated, commands);
+    }
     let steps_text = steps.map_or("all".to_string(), |s| s.to_string());
     println!(
         "model {} ({} training steps), clip {} ({} frames at {} fps)",

@@ -8,6 +8,8 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 
 use crate::sampling::{SamplingArgs, run_task, seconds_to_frames};
+use sinmdm::Generated;
+use sinmdm::model_file::ModelMetadata;
 use sinmdm::motion::features::heading::facing_against_travel;
 use sinmdm::motion::math::Vec3;
 use sinmdm::steer::follow::{path_following, velocity_following};
@@ -27,27 +29,94 @@ frame and units; the up component is ignored). --velocity reads lines `seconds,s
 that time on, forward speed in file units per second and turn rate in degrees per second
 (positive turns left). Commands the clip never showed are clamped to its range, with a warning.";
 
+/// Where a steered run goes: shared by `sinmdm steer` and `sinmdm eval`.
+#[derive(Debug, Clone, Args)]
+pub struct CourseArgs {
+    /// Walk a circle of this radius, in character heights, turning left.
+    #[arg(long, value_name = "R", group = "course")]
+    pub circle: Option<f64>,
+    /// Walk a figure eight of two circles of this radius, in character heights.
+    #[arg(long, value_name = "R", group = "course")]
+    pub figure8: Option<f64>,
+    /// Follow a path: one ground position per frame, `x,y,z` per line (file frame and units).
+    #[arg(long, value_name = "PATH.csv", group = "course")]
+    pub path: Option<PathBuf>,
+    /// Follow a schedule of velocities: lines `seconds,speed,turn` (file units per second,
+    /// degrees per second), each holding until the next.
+    #[arg(long, value_name = "SCHEDULE.csv", group = "course")]
+    pub velocity: Option<PathBuf>,
+    /// Speed along --circle and --figure8, file units per second (default: the clip's mean).
+    #[arg(long)]
+    pub speed: Option<f64>,
+}
+
+impl CourseArgs {
+    /// Whether a course was given.
+    pub fn given(&self) -> bool {
+        self.circle.is_some()
+            || self.figure8.is_some()
+            || self.path.is_some()
+            || self.velocity.is_some()
+    }
+
+    /// The commands of `frames` frames (a --path brings its own length), checked against the
+    /// model (it must have a heading-relative root).
+    pub fn commands(&self, metadata: &ModelMetadata, frames: usize) -> Result<Vec<SteerFrame>> {
+        let Some(limits) = SteerLimits::of(metadata) else {
+            bail!(
+                "the model has no heading-relative root: steering needs a model trained with --root-layout heading"
+            );
+        };
+        let fps = metadata.layout.fps;
+        let height = metadata.layout.skeleton_height;
+        let speed = match self.speed {
+            Some(s) if s.is_finite() && s > 0.0 => s,
+            Some(s) => bail!("--speed must be a positive number of units per second, got {s}"),
+            None => clip_speed(metadata)
+                .unwrap_or(0.0)
+                .max(limits.forward.1 * 0.5),
+        };
+        let radius = |r: f64, flag: &str| -> Result<f64> {
+            if r.is_finite() && r > 0.0 {
+                Ok(r * height)
+            } else {
+                bail!("{flag} takes a positive radius in character heights, got {r}")
+            }
+        };
+        let commands = if let Some(r) = self.circle {
+            path(
+                metadata,
+                Shape::Circle(radius(r, "--circle")?),
+                speed,
+                frames,
+            )
+        } else if let Some(r) = self.figure8 {
+            path(
+                metadata,
+                Shape::FigureEight(radius(r, "--figure8")?),
+                speed,
+                frames,
+            )
+        } else if let Some(file) = &self.path {
+            Some(read_path(file)?)
+        } else if let Some(file) = &self.velocity {
+            Some(read_velocities(file, fps, frames)?)
+        } else {
+            bail!(
+                "say where to go: --circle R, --figure8 R, --path PATH.csv or --velocity SCHEDULE.csv"
+            )
+        };
+        commands.context("the model has no heading-relative root")
+    }
+}
+
 /// Arguments of `sinmdm steer`.
 #[derive(Debug, Args)]
 pub struct SteerArgs {
     #[command(flatten)]
     sampling: SamplingArgs,
-    /// Walk a circle of this radius, in character heights, turning left.
-    #[arg(long, value_name = "R", group = "course")]
-    circle: Option<f64>,
-    /// Walk a figure eight of two circles of this radius, in character heights.
-    #[arg(long, value_name = "R", group = "course")]
-    figure8: Option<f64>,
-    /// Follow a path: one ground position per frame, `x,y,z` per line (file frame and units).
-    #[arg(long, value_name = "PATH.csv", group = "course")]
-    path: Option<PathBuf>,
-    /// Follow a schedule of velocities: lines `seconds,speed,turn` (file units per second,
-    /// degrees per second), each holding until the next.
-    #[arg(long, value_name = "SCHEDULE.csv", group = "course")]
-    velocity: Option<PathBuf>,
-    /// Speed along --circle and --figure8, file units per second (default: the clip's mean).
-    #[arg(long)]
-    speed: Option<f64>,
+    #[command(flatten)]
+    course: CourseArgs,
     /// Length in seconds (default 20; a --path sets it by its frames).
     #[arg(long)]
     seconds: Option<f64>,
@@ -61,58 +130,14 @@ pub struct SteerArgs {
 pub fn run(args: &SteerArgs) -> Result<()> {
     let mut model = args.sampling.open_model()?;
     let metadata = model.metadata().clone();
-    let Some(limits) = SteerLimits::of(&metadata) else {
-        bail!(
-            "{} has no heading-relative root: steering needs a model trained with --root-layout heading",
-            args.sampling.model.display()
-        );
-    };
     let fps = metadata.layout.fps;
-    let height = metadata.layout.skeleton_height;
     let given_frames = args
         .seconds
         .map(|s| seconds_to_frames(s, fps))
         .transpose()?;
     let frames = given_frames.unwrap_or((20.0 * fps).round() as usize);
-    let speed = match args.speed {
-        Some(s) if s.is_finite() && s > 0.0 => s,
-        Some(s) => bail!("--speed must be a positive number of units per second, got {s}"),
-        None => clip_speed(&metadata)
-            .unwrap_or(0.0)
-            .max(limits.forward.1 * 0.5),
-    };
-    let radius = |r: f64, flag: &str| -> Result<f64> {
-        if r.is_finite() && r > 0.0 {
-            Ok(r * height)
-        } else {
-            bail!("{flag} takes a positive radius in character heights, got {r}")
-        }
-    };
-    let commands = if let Some(r) = args.circle {
-        path(
-            &metadata,
-            Shape::Circle(radius(r, "--circle")?),
-            speed,
-            frames,
-        )
-    } else if let Some(r) = args.figure8 {
-        path(
-            &metadata,
-            Shape::FigureEight(radius(r, "--figure8")?),
-            speed,
-            frames,
-        )
-    } else if let Some(file) = &args.path {
-        Some(read_path(file)?)
-    } else if let Some(file) = &args.velocity {
-        Some(read_velocities(file, fps, frames)?)
-    } else {
-        bail!(
-            "say where to go: --circle R, --figure8 R, --path PATH.csv or --velocity SCHEDULE.csv"
-        )
-    };
-    let commands = commands.context("the model has no heading-relative root")?;
-    let frames = if args.path.is_some() {
+    let commands = args.course.commands(&metadata, frames)?;
+    let frames = if args.course.path.is_some() {
         given_frames.unwrap_or(commands.len())
     } else {
         frames
@@ -124,44 +149,52 @@ pub fn run(args: &SteerArgs) -> Result<()> {
     };
     let generated = run_task(&args.sampling, &mut model, task)?;
     if args.report {
-        let layout = generated.layout();
-        for i in 0..generated.count() {
-            let raw = generated.features.index_axis(ndarray::Axis(0), i);
-            let mut line = format!("sample {i}:");
-            if let Some(p) = path_following(layout, raw, &commands) {
-                line += &format!(
-                    " path distance mean {:.3} max {:.3} heights, progress {:.2};",
-                    p.mean_distance, p.max_distance, p.progress
-                );
-            }
-            if let Some(v) = velocity_following(layout, raw, &commands, (2.0 * fps) as usize) {
-                let worst = |pairs: &[(f64, f64)], floor: f64| {
-                    pairs
-                        .iter()
-                        .map(|(a, b)| (b - a).abs() / a.abs().max(floor))
-                        .fold(0.0, f64::max)
-                };
-                line += &format!(
-                    " speed off by at most {:.0} %, turn by at most {:.0} % (2 s windows);",
-                    100.0 * worst(&v.forward, 1e-9),
-                    100.0 * worst(&v.turn, 10f64.to_radians())
-                );
-            }
-            if let Some(mut a) = facing_against_travel(layout, raw) {
-                a.sort_by(f64::total_cmp);
-                if !a.is_empty() {
-                    let over = a.iter().filter(|&&x| x > 45.0).count() as f64 / a.len() as f64;
-                    line += &format!(
-                        " facing against travel median {:.1} degrees, {:.0} % over 45",
-                        a[a.len() / 2],
-                        100.0 * over
-                    );
-                }
-            }
-            println!("{line}");
-        }
+        print_following(&generated, &commands);
     }
     Ok(())
+}
+
+/// One line per sample: how closely it did what `commands` asked.
+pub fn print_following(generated: &Generated, commands: &[SteerFrame]) {
+    let layout = generated.layout();
+    let fps = layout.fps;
+    for i in 0..generated.count() {
+        let raw = generated.features.index_axis(ndarray::Axis(0), i);
+        let mut line = format!("sample {i}:");
+        if let Some(p) = path_following(layout, raw, commands) {
+            line += &format!(
+                " path distance mean {:.3} max {:.3} heights, progress {:.2};",
+                p.mean_distance, p.max_distance, p.progress
+            );
+        }
+        if let Some(v) = velocity_following(layout, raw, commands, (2.0 * fps) as usize)
+            && !v.forward.is_empty()
+        {
+            let worst = |pairs: &[(f64, f64)], floor: f64| {
+                pairs
+                    .iter()
+                    .map(|(a, b)| (b - a).abs() / a.abs().max(floor))
+                    .fold(0.0, f64::max)
+            };
+            line += &format!(
+                " speed off by at most {:.0} %, turn by at most {:.0} % (2 s windows; turn against at least 10 degrees/s);",
+                100.0 * worst(&v.forward, 1e-9),
+                100.0 * worst(&v.turn, 10f64.to_radians())
+            );
+        }
+        if let Some(mut a) = facing_against_travel(layout, raw) {
+            a.sort_by(f64::total_cmp);
+            if !a.is_empty() {
+                let over = a.iter().filter(|&&x| x > 45.0).count() as f64 / a.len() as f64;
+                line += &format!(
+                    " facing against travel median {:.1} degrees, {:.0} % over 45",
+                    a[a.len() / 2],
+                    100.0 * over
+                );
+            }
+        }
+        println!("{line}");
+    }
 }
 
 fn numbers(line: &str) -> Vec<&str> {

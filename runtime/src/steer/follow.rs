@@ -10,16 +10,21 @@ use crate::motion::up::UP;
 
 use super::SteerFrame;
 
+/// How far from a frame's own path point its nearest point is sought, seconds.
+pub const PROGRESS_WINDOW_SECONDS: f64 = 2.0;
+
 /// A motion's root against a path.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PathFollowing {
     /// Mean distance on the ground from the root to the path (to the nearest point of the
-    /// path's polyline), in skeleton heights.
+    /// path's polyline near the frame's own point), in skeleton heights.
     pub mean_distance: f64,
     /// The largest such distance, in skeleton heights.
     pub max_distance: f64,
     /// How far along the path the root's nearest point got by the last frame, as a share of
-    /// the path's length: about 1 when it went round.
+    /// the path's length: about 1 when it kept up. The nearest point of each frame is sought
+    /// within [`PROGRESS_WINDOW_SECONDS`] of the path's point for that frame, so a path that
+    /// comes back over itself (a figure eight) is not read short.
     pub progress: f64,
 }
 
@@ -66,10 +71,13 @@ pub fn path_following(
         along[i] = along[i - 1] + (path[i] - path[i - 1]).norm();
     }
     let length = along[path.len() - 1].max(1e-12);
-    // Nearest point of the polyline: (distance, arc length there).
-    let nearest = |p: Vec3| -> (f64, f64) {
+    // Nearest point of the polyline near frame `frame`'s point: (distance, arc length there).
+    let reach = (PROGRESS_WINDOW_SECONDS * layout.fps).ceil() as usize;
+    let nearest = |frame: usize, p: Vec3| -> (f64, f64) {
         let mut best = (f64::INFINITY, 0.0);
-        for i in 1..path.len() {
+        let from = frame.saturating_sub(reach).max(1);
+        let to = (frame + reach + 1).min(path.len());
+        for i in from..to {
             let (a, b) = (path[i - 1], path[i]);
             let ab = b - a;
             let len2 = ab.dot(ab);
@@ -87,7 +95,11 @@ pub fn path_following(
     };
     let height = layout.skeleton_height;
     let n = positions.len().min(path.len());
-    let distances: Vec<(f64, f64)> = positions[..n].iter().map(|&p| nearest(p)).collect();
+    let distances: Vec<(f64, f64)> = positions[..n]
+        .iter()
+        .enumerate()
+        .map(|(f, &p)| nearest(f, p))
+        .collect();
     Some(PathFollowing {
         mean_distance: distances.iter().map(|d| d.0).sum::<f64>() / n as f64 / height,
         max_distance: distances.iter().map(|d| d.0).fold(0.0, f64::max) / height,

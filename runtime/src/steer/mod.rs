@@ -37,6 +37,9 @@ use crate::tasks::mask::soft_mask;
 /// is over a whole step.
 pub const STEER_REACH_SECONDS: f64 = 0.5;
 
+/// Passes of the pull per denoising step (see [`Steering::apply`]).
+pub const STEER_PASSES: usize = 4;
+
 /// How fast a path's facing and position errors are caught up, seconds.
 pub const FACING_CATCH_UP_SECONDS: f64 = 1.0;
 
@@ -242,8 +245,16 @@ impl Steering {
         self.goals.len()
     }
 
-    /// Pulls the slow part of the root rows of one normalised prediction `[F, N]` to the goals.
+    /// Pulls the slow part of the root rows of one normalised prediction `[F, N]` to the goals,
+    /// [`STEER_PASSES`] times: a path's targets follow the prediction's course, which each pass
+    /// changes.
     pub fn apply(&self, mut x0: ArrayViewMut2<'_, f32>) {
+        for _ in 0..STEER_PASSES {
+            self.pass(x0.view_mut());
+        }
+    }
+
+    fn pass(&self, mut x0: ArrayViewMut2<'_, f32>) {
         let n = self.goals.len();
         let raw = |r: usize| -> Vec<f64> {
             x0.row(r)
@@ -262,25 +273,51 @@ impl Steering {
             position[i] = position[i - 1] + step;
         }
         let mut targets: [Vec<Option<f64>>; 3] = [vec![None; n], vec![None; n], vec![None; n]];
-        let mut last_direction: Option<f64> = None;
+        // A span of path goals starts from where the prediction stands before it (the anchor's
+        // known course for a span that starts right after it): its offset from the path, in
+        // position and in facing, fades out linearly over the catch-up time, so the targets
+        // are a course that joins the path (each frame's target is a step of that course, not
+        // a correction of the prediction's error, which would pile up along the span).
+        let mut span: Option<(usize, Vec3, f64)> = None;
+        let mut last_direction = 0.0;
         for i in self.anchor + 1..n {
             match self.goals[i] {
-                Goal::Free => last_direction = None,
+                Goal::Free => span = None,
                 Goal::Velocity { forward, turn } => {
                     targets[FORWARD][i] = Some(forward);
                     targets[TURN][i] = Some(turn);
-                    last_direction = None;
+                    span = None;
                 }
                 Goal::Position(p) => {
                     let before = match self.goals[i - 1] {
                         Goal::Position(q) => q,
-                        _ => position[i - 1],
+                        _ => p,
                     };
-                    // The path's step, plus the error of where the prediction stands, caught
-                    // up over the catch-up time; no faster than the clip goes.
-                    let mut want =
-                        (p - before) + (before - position[i - 1]) * (1.0 / self.catch_up);
-                    want[UP] = 0.0;
+                    let mut path_step = p - before;
+                    path_step[UP] = 0.0;
+                    let (start, offset, facing_offset) = match span {
+                        Some(s) => s,
+                        None => {
+                            // The direction the path leaves in (or the facing, standing still).
+                            let direction = if path_step.norm() > 1e-12 {
+                                path_step[0].atan2(path_step[2])
+                            } else {
+                                heading[i - 1]
+                            };
+                            last_direction = heading[i - 1] + wrap(direction - heading[i - 1]);
+                            let mut offset = before - position[i - 1];
+                            offset[UP] = 0.0;
+                            let s = (i, offset, heading[i - 1] - last_direction);
+                            span = Some(s);
+                            s
+                        }
+                    };
+                    let fade =
+                        |frame: usize| (1.0 - (frame + 1 - start) as f64 / self.catch_up).max(0.0);
+                    let (now, then) = (fade(i), if i > start { fade(i - 1) } else { 1.0 });
+                    // The wanted step: the path's, less the part of the offset this frame
+                    // takes away; no faster than the clip goes.
+                    let mut want = path_step + offset * (then - now);
                     let speed = want.norm();
                     if speed > self.max_step && speed > 0.0 {
                         want = want * (self.max_step / speed);
@@ -288,13 +325,16 @@ impl Steering {
                     let local = yaw(heading[i]).transpose() * want;
                     targets[FORWARD][i] = Some(local[2]);
                     targets[LEFTWARD][i] = Some(local[0]);
-                    if speed > 1e-9 {
-                        let direction = want[0].atan2(want[2]);
-                        let path_turn = last_direction.map_or(0.0, |d| wrap(direction - d));
-                        let error = wrap(direction - heading[i]);
-                        targets[TURN][i] = Some(path_turn + error / self.catch_up);
-                        last_direction = Some(direction);
-                    }
+                    // The wanted facing: the path's direction (unwrapped along the span), plus
+                    // what is left of the start's facing offset.
+                    let direction = if path_step.norm() > 1e-12 {
+                        last_direction + wrap(path_step[0].atan2(path_step[2]) - last_direction)
+                    } else {
+                        last_direction
+                    };
+                    let wanted = |d: f64, f: f64| d + facing_offset * f;
+                    targets[TURN][i] = Some(wanted(direction, now) - wanted(last_direction, then));
+                    last_direction = direction;
                 }
             }
         }
