@@ -109,8 +109,12 @@ def main() -> None:
         f"from {t['learning_rate']:g} after {t['warmup_steps']} warm-up steps, weight average "
         f"{t.get('ema_decay')}, {frames_seen(t, state)}, {fps}, seed {t['seed']})"
     )
+    if d.get("root_layout", "world") != "world":
+        config_row += f", with the {d['root_layout']} root layout"
     size_mb = model.stat().st_size / 1e6
     extra_args = " --fps clip" if d["fps"] is None else ""
+    if d.get("root_layout", "world") != "world":
+        extra_args += f" --root-layout {d['root_layout']}"
     rows = [
         ("clip", clip_row.split("|")[2].strip() if clip_row else f"`{clip}`"),
         ("config", config_row),
