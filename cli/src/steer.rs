@@ -273,3 +273,37 @@ fn read_velocities(file: &Path, fps: f64, frames: usize) -> Result<Vec<SteerFram
         })
         .collect())
 }
+
+/// The median and the share over 45 degrees of a list of facing-against-travel angles.
+fn facing_summary(mut angles: Vec<f64>) -> Option<(f64, f64)> {
+    if angles.is_empty() {
+        return None;
+    }
+    angles.sort_by(f64::total_cmp);
+    let over = angles.iter().filter(|&&a| a > 45.0).count() as f64 / angles.len() as f64;
+    Some((angles[angles.len() / 2], over))
+}
+
+/// For a heading-relative model: the facing against travel of the clip and of all samples
+/// pooled (the clip's own style of walking, such as backward glides, against the samples').
+pub fn print_facing(generated: &Generated, clip: ndarray::ArrayView2<'_, f32>) {
+    let layout = generated.layout();
+    let Some(of_clip) = facing_against_travel(layout, clip).and_then(facing_summary) else {
+        return;
+    };
+    let pooled: Vec<f64> = (0..generated.count())
+        .filter_map(|i| {
+            facing_against_travel(layout, generated.features.index_axis(ndarray::Axis(0), i))
+        })
+        .flatten()
+        .collect();
+    if let Some((median, over)) = facing_summary(pooled) {
+        println!(
+            "facing against travel while moving: clip median {:.1} degrees ({:.0} % over 45), samples {:.1} degrees ({:.0} % over 45)",
+            of_clip.0,
+            100.0 * of_clip.1,
+            median,
+            100.0 * over
+        );
+    }
+}

@@ -18,7 +18,8 @@ use crate::sampling::{
 
 pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm stream -m onnx-models/human_walk_cmu.onnx --seconds 600 -o out/ten_minutes.bvh
-  sinmdm stream -m onnx-models/human_walk_cmu.onnx --seconds 60 --chunk 0.5s --seed 3 -o out/minute.bvh";
+  sinmdm stream -m onnx-models/human_walk_cmu.onnx --seconds 60 --chunk 0.5s --seed 3 -o out/minute.bvh
+  sinmdm stream -m onnx-models/human_zombie_walk_fair.onnx --seconds 60 --circle 3 -o out/round.bvh";
 
 /// Arguments of `sinmdm stream`.
 #[derive(Debug, Args)]
@@ -58,6 +59,10 @@ pub struct StreamArgs {
     /// Threads for the network (default: every core).
     #[arg(long)]
     threads: Option<usize>,
+    /// Steer the stream along a course (a heading-relative model; see `sinmdm steer`): its
+    /// commands are given to the stream ahead of time, all at once.
+    #[command(flatten)]
+    course: crate::steer::CourseArgs,
     /// Also write the raw features of the whole stream as JSON here (for the Python reference).
     #[arg(long, value_name = "OUT.json")]
     features_json: Option<PathBuf>,
@@ -106,6 +111,10 @@ pub fn run(args: &StreamArgs) -> Result<()> {
         method: args.method.method()?,
     };
     let mut stream = Stream::new(model.metadata(), options)?;
+    if args.course.given() {
+        let commands = args.course.commands(model.metadata(), total)?;
+        stream.steer(&commands)?;
+    }
     let mut outputs = vec![args.output.clone()];
     outputs.extend(args.features_json.iter().cloned());
     check_writable(&outputs)?;
@@ -135,6 +144,9 @@ pub fn run(args: &StreamArgs) -> Result<()> {
         bar.set_position(made as u64);
     }
     bar.finish_and_clear();
+    for warning in stream.warnings() {
+        eprintln!("warning: {warning}");
+    }
     writer.finish()?;
     let seconds = started.elapsed().as_secs_f64();
     eprintln!(

@@ -20,6 +20,7 @@ from . import tasks
 from .features import read_features, write_features
 from .model import Model, ModelError
 from .sampler import sample
+from . import steer
 from .stream import stream_features
 
 
@@ -79,6 +80,8 @@ def main(argv=None):
     st = common(sub.add_parser("stream"))
     st.add_argument("--frames", type=int, required=True)
     st.add_argument("--block", type=int, default=None)
+    st.add_argument("--velocity", default=None, help="a schedule of seconds,speed,turn (degrees/s) lines")
+    st.add_argument("--path", default=None, help="one x,y,z ground position per frame (file frame)")
     args = parser.parse_args(argv)
 
     method = (args.sampler, args.eta) if args.sampler == "ddim" else (args.sampler,)
@@ -95,7 +98,13 @@ def main(argv=None):
             args.steps = "20" if args.command == "stream" else "50"
         if args.command == "stream":
             schedule = tasks.schedule_for(model, _steps(args.steps))
-            feats = stream_features(model, schedule, args.seed, args.frames, block=args.block, method=method)
+            commands = None
+            if args.velocity:
+                commands = steer.read_velocities(args.velocity, fps, args.frames)
+            elif args.path:
+                commands = steer.read_path(args.path)
+            feats = stream_features(model, schedule, args.seed, args.frames, block=args.block, method=method,
+                                    commands=commands)
             write_features(args.output, model.layout, feats[None])
             print(f"wrote {args.output}", file=sys.stderr)
             return 0

@@ -77,11 +77,12 @@ def coefficients(method, schedule, k):
 
 
 def sample(model, schedule, batch, frames, seed, inpainting=None, harmonization=None, progress=None,
-           method=("ancestral",)):
+           method=("ancestral",), steering=None):
     """Normalised features [B, F, N].
 
     inpainting: (reference [F, N], mask [F, N]) normalised; harmonization: (content [F, N],
-    factor, free_share); method as in `coefficients`."""
+    factor, free_share); method as in `coefficients`; steering: a `steer.Steering`, applied to
+    each sample's prediction before the mask blending."""
     shape = (batch, model.features, frames)
     steps = len(schedule.timesteps)
     free = int(np.floor(harmonization[2] * steps + 0.5)) if harmonization else 0
@@ -92,6 +93,10 @@ def sample(model, schedule, batch, frames, seed, inpainting=None, harmonization=
         k = steps - 1 - step
         t = np.full(batch, schedule.timesteps[k], dtype=np.int64)
         x0 = model.denoise(x, t)
+        if steering is not None:
+            x0 = np.array(x0, dtype=np.float32)
+            for b in range(batch):
+                steering.apply(x0[b])
         if inpainting is not None:
             y, m = inpainting
             x0 = x0 * (one - m) + y * m

@@ -37,6 +37,11 @@ use crate::tasks::mask::soft_mask;
 /// is over a whole step.
 pub const STEER_REACH_SECONDS: f64 = 0.5;
 
+/// The half-width of the low-pass on a path's facing, seconds: longer than a stride, so the
+/// facing follows the path's direction on average and a clip's own turns away from its travel
+/// (a stylised walk's backward glides) stay.
+pub const FACING_REACH_SECONDS: f64 = 1.5;
+
 /// Passes of the pull per denoising step (see [`Steering::apply`]).
 pub const STEER_PASSES: usize = 4;
 
@@ -124,8 +129,9 @@ pub struct Steering {
     /// Mean and standard deviation of the forward, leftward and turn rows.
     mean: [f64; 3],
     std: [f64; 3],
-    /// Low-pass half-width and catch-up time, frames.
+    /// Low-pass half-width (the facing's, for a path), and catch-up time, frames.
     reach: usize,
+    facing_reach: usize,
     catch_up: f64,
     /// The fastest the root may go, per frame.
     max_step: f64,
@@ -232,6 +238,7 @@ pub fn plan_steering(
             mean: rows.map(|r| f64::from(n.mean[r])),
             std: rows.map(|r| f64::from(n.std[r])),
             reach: (STEER_REACH_SECONDS * fps).round() as usize,
+            facing_reach: (FACING_REACH_SECONDS * fps).round() as usize,
             catch_up: (FACING_CATCH_UP_SECONDS * fps).max(1.0),
             max_step: top / fps,
         }),
@@ -346,7 +353,14 @@ impl Steering {
             let pull: Vec<f64> = (0..n)
                 .map(|i| targets[k][i].map_or(0.0, |t| self.weights[i] * (t - current[i])))
                 .collect();
-            let slow = lowpass::triangular(&pull, self.reach);
+            // A path's facing is pulled over a longer reach than its travel: the course is
+            // followed on average, and a clip's own turns away from its travel (a glide) stay.
+            let reach = if k == TURN && self.goals.iter().any(|g| matches!(g, Goal::Position(_))) {
+                self.facing_reach
+            } else {
+                self.reach
+            };
+            let slow = lowpass::triangular(&pull, reach);
             for (v, d) in x0.row_mut(row).iter_mut().zip(slow) {
                 *v = (f64::from(*v) + d / self.std[k]) as f32;
             }
