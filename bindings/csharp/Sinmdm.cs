@@ -73,6 +73,35 @@ namespace Sinmdm
         }
     }
 
+    /// <summary>What a steering frame asks for.</summary>
+    public enum SteerKind : uint { Free = 0, Velocity = 1, Position = 2 }
+
+    /// <summary>One frame's steering command for a heading-relative model (file frame: the
+    /// model's up axis and units); the layout of the C ABI's SinmdmSteerFrame.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct SteerFrame
+    {
+        public SteerKind Kind;
+        /// <summary>Velocity: forward speed, file units per second.</summary>
+        public double Forward;
+        /// <summary>Velocity: turn rate, radians per second; positive turns left.</summary>
+        public double Turn;
+        /// <summary>Position: the root's ground position (the up component is ignored).</summary>
+        public double X, Y, Z;
+
+        public static SteerFrame Velocity(double forward, double turn) =>
+            new SteerFrame { Kind = SteerKind.Velocity, Forward = forward, Turn = turn };
+
+        public static SteerFrame Position(double x, double y, double z) =>
+            new SteerFrame { Kind = SteerKind.Position, X = x, Y = y, Z = z };
+    }
+
+    /// <summary>The range of steering commands a model's clip supports.</summary>
+    public struct SteerLimits
+    {
+        public double ForwardMin, ForwardMax, TurnMax;
+    }
+
     /// <summary>The order of a dance's keyframes.</summary>
     public enum DanceOrder : uint { Shuffled = 0, Reference = 1 }
 
@@ -320,6 +349,38 @@ namespace Sinmdm
             RunHandle run = null;
             int status = Native.WithInput(reference, Joints, input =>
                 Native.sinmdm_inbetween_begin(Handle, ref native, ref input, spans, (UIntPtr)spans.Length, r, out run));
+            return Begun(status, run);
+        }
+
+        /// <summary>The range of steering commands the model's clip supports; a model without a
+        /// heading-relative root cannot be steered (SinmdmException, InvalidArgument).</summary>
+        public SteerLimits SteerLimits()
+        {
+            Native.Check(Native.sinmdm_steer_limits(Handle, out Native.SteerLimits l));
+            return new SteerLimits { ForwardMin = l.ForwardMin, ForwardMax = l.ForwardMax, TurnMax = l.TurnMax };
+        }
+
+        /// <summary>New motion of `frames` frames whose root goes where `commands` say (one per
+        /// frame from frame 0), soft over `ramp` frames where they start and stop.</summary>
+        public Result Steer(int frames, SteerFrame[] commands, int ramp, Sampling sampling)
+        {
+            if (commands == null) throw new ArgumentNullException(nameof(commands));
+            var native = sampling.ToNative();
+            int status = Native.sinmdm_steer(Handle, ref native, Native.Size(frames, nameof(frames)), commands,
+                                             (UIntPtr)commands.Length, Native.Size(ramp, nameof(ramp)), out ResultHandle result);
+            return Blocking(status, result);
+        }
+
+        public Result Steer(int frames, SteerFrame[] commands, int ramp, ulong seed, uint steps = Runtime.DefaultSteps, Feet feet = Feet.Planted) =>
+            Steer(frames, commands, ramp, new Sampling { Seed = seed, Count = 1, Steps = steps, Feet = feet });
+
+        /// <summary>Begins a steered run, to step with Run.Step.</summary>
+        public Run BeginSteer(int frames, SteerFrame[] commands, int ramp, Sampling sampling)
+        {
+            if (commands == null) throw new ArgumentNullException(nameof(commands));
+            var native = sampling.ToNative();
+            int status = Native.sinmdm_steer_begin(Handle, ref native, Native.Size(frames, nameof(frames)), commands,
+                                                   (UIntPtr)commands.Length, Native.Size(ramp, nameof(ramp)), out RunHandle run);
             return Begun(status, run);
         }
 
@@ -571,6 +632,14 @@ namespace Sinmdm
         /// <summary>Poses for the frames after the last supplied ones, for a composed stream.</summary>
         public void Supply(Poses poses) =>
             Native.Check(Native.WithInput(poses, model.Joints, input => Native.sinmdm_stream_supply(handle, model.Handle, ref input)));
+
+        /// <summary>Steering commands for the frames after the last commanded ones (a
+        /// heading-relative model); commands given 2 x block + 10 frames ahead reach the motion.</summary>
+        public void Steer(SteerFrame[] commands)
+        {
+            if (commands == null) throw new ArgumentNullException(nameof(commands));
+            Native.Check(Native.sinmdm_stream_steer(handle, commands, (UIntPtr)commands.Length));
+        }
 
         /// <summary>Prepares frames ahead with at most `maxSteps` denoising steps (call it each
         /// frame); returns the frames ready, so Next for that many runs no network.</summary>

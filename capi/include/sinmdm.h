@@ -216,6 +216,21 @@
 #define SINMDM_METHOD_DPM2M 2
 
 /*
+ A frame that asks for nothing: the model goes where it likes.
+ */
+#define SINMDM_STEER_FREE 0
+
+/*
+ A frame that asks for a forward speed and a turn rate.
+ */
+#define SINMDM_STEER_VELOCITY 1
+
+/*
+ A frame that asks for the root's position on the ground.
+ */
+#define SINMDM_STEER_POSITION 2
+
+/*
  What a call did. Every function returns one; on anything but `SINMDM_OK`,
  `sinmdm_last_error` says why, in words that name the argument, field or file. One kind of
  mistake always gets the same status, whichever function it is made at.
@@ -477,6 +492,47 @@ typedef struct SinmdmPoseBuffers {
    */
   size_t translations_capacity;
 } SinmdmPoseBuffers;
+
+/*
+ The range of commands a model's clip supports (what is beyond it is clamped).
+ */
+typedef struct SinmdmSteerLimits {
+  /*
+   Slowest forward speed, file units per second.
+   */
+  double forward_min;
+  /*
+   Fastest forward speed, file units per second.
+   */
+  double forward_max;
+  /*
+   Largest turn rate either way, radians per second.
+   */
+  double turn_max;
+} SinmdmSteerLimits;
+
+/*
+ One frame's steering command (file frame: the model's up axis and units).
+ */
+typedef struct SinmdmSteerFrame {
+  /*
+   `SINMDM_STEER_FREE`, `SINMDM_STEER_VELOCITY` or `SINMDM_STEER_POSITION`.
+   */
+  uint32_t kind;
+  /*
+   `SINMDM_STEER_VELOCITY`: forward speed, file units per second.
+   */
+  double forward;
+  /*
+   `SINMDM_STEER_VELOCITY`: turn rate, radians per second; positive turns left
+   (counter-clockwise seen from above).
+   */
+  double turn;
+  /*
+   `SINMDM_STEER_POSITION`: the root's position, file frame (the up component is ignored).
+   */
+  double position[3];
+} SinmdmSteerFrame;
 
 /*
  How a stream makes its motion; zeros give the defaults.
@@ -803,6 +859,61 @@ void sinmdm_run_free(struct SinmdmRun *run);
  keep it. Never NULL.
  */
 const char *sinmdm_last_error(void);
+
+/*
+ Writes the range of commands `model`'s clip supports to `out`; `SINMDM_INVALID_ARGUMENT`
+ for a model without a heading-relative root (it cannot be steered).
+
+ # Safety
+ `model` is a live handle; `out` writable.
+ */
+enum SinmdmStatus sinmdm_steer_limits(const struct SinmdmModel *model,
+                                      struct SinmdmSteerLimits *out);
+
+/*
+ Begins a steered run (see `sinmdm_steer` and `sinmdm_run_step`).
+
+ # Safety
+ As `sinmdm_steer`.
+ */
+enum SinmdmStatus sinmdm_steer_begin(struct SinmdmModel *model,
+                                     const struct SinmdmSampling *sampling,
+                                     size_t frames,
+                                     const struct SinmdmSteerFrame *commands,
+                                     size_t command_count,
+                                     size_t ramp,
+                                     struct SinmdmRun **out);
+
+/*
+ New motion of `frames` frames whose root goes where `commands` say (one per frame from
+ frame 0; frames past them are free), from the model's start position and facing, soft over
+ `ramp` frames where commands start and stop (the same motion as `sinmdm steer` for the same
+ commands, seed and settings). Needs a heading-relative model.
+
+ # Safety
+ Pointers as their types' documentation says; `commands` readable for `command_count`
+ values.
+ */
+enum SinmdmStatus sinmdm_steer(struct SinmdmModel *model,
+                               const struct SinmdmSampling *sampling,
+                               size_t frames,
+                               const struct SinmdmSteerFrame *commands,
+                               size_t command_count,
+                               size_t ramp,
+                               struct SinmdmResult **out);
+
+/*
+ Steering commands for the frames after the last commanded one (the first call commands
+ frame 0 on): a block uses the commands given when it starts, so commands given
+ `2 x block_frames + 10` frames ahead of what has been handed out reach the motion.
+ `SINMDM_INVALID_ARGUMENT` for a model without a heading-relative root.
+
+ # Safety
+ `stream` is a live handle; `commands` readable for `count` values.
+ */
+enum SinmdmStatus sinmdm_stream_steer(struct SinmdmStream *stream,
+                                      const struct SinmdmSteerFrame *commands,
+                                      size_t count);
 
 /*
  Makes a stream of `model`'s motion with `options` and writes its handle to `out`.

@@ -72,6 +72,7 @@ mod result;
 mod run;
 mod sampling;
 mod status;
+mod steer;
 mod stream;
 mod tasks;
 mod text;
@@ -105,6 +106,10 @@ pub use sampling::{
     SinmdmSampling, SinmdmSpan,
 };
 pub use status::{SinmdmStatus, sinmdm_last_error};
+pub use steer::{
+    SINMDM_STEER_FREE, SINMDM_STEER_POSITION, SINMDM_STEER_VELOCITY, SinmdmSteerFrame,
+    SinmdmSteerLimits, sinmdm_steer, sinmdm_steer_begin, sinmdm_steer_limits, sinmdm_stream_steer,
+};
 pub use stream::{
     SinmdmStream, SinmdmStreamOptions, sinmdm_stream_free, sinmdm_stream_new, sinmdm_stream_next,
     sinmdm_stream_step, sinmdm_stream_supply,

@@ -20,7 +20,7 @@ fn made_by_the_run(e: sinmdm::TaskError) -> Failure {
 
 /// A stream (opaque): motion handed out a chunk at a time, forever, in flat memory.
 pub struct SinmdmStream {
-    stream: Stream,
+    pub(crate) stream: Stream,
     /// The model it was made on.
     model: u64,
 }

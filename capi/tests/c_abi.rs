@@ -128,6 +128,7 @@ fn run_check(valgrind: bool) -> String {
         .arg(model_path())
         .arg(&not_a_model)
         .arg(&bvh)
+        .arg(steer_model_path())
         .env("ORT_DYLIB_PATH", onnxruntime_path())
         .output()
         .expect("could not start the check program (valgrind missing? run scripts/setup.sh)");
@@ -225,7 +226,7 @@ fn a_fuzz_of_every_entry_point_never_crashes_nor_fails_inside() {
     let cases = 10_000;
     let output = Command::new(&exe)
         .arg(model_path())
-        .arg(repo().join("onnx-models/fox_survey_khronos.onnx"))
+        .arg(steer_model_path())
         .arg(&dir)
         .arg(cases.to_string())
         .env("ORT_DYLIB_PATH", onnxruntime_path())

@@ -40,6 +40,7 @@ fn the_csharp_binding_gets_the_rust_values_under_mono() {
         .arg(&exe)
         .arg(model_path())
         .arg(&bvh)
+        .arg(steer_model_path())
         .env("LD_LIBRARY_PATH", library_dir())
         .env("ORT_DYLIB_PATH", onnxruntime_path())
         .output()

@@ -28,9 +28,9 @@ static class Example
 
     static int Main(string[] args)
     {
-        if (args.Length != 2)
+        if (args.Length != 3)
         {
-            Console.Error.WriteLine("usage: example.exe MODEL.onnx OUT.bvh");
+            Console.Error.WriteLine("usage: example.exe MODEL.onnx OUT.bvh STEERABLE_MODEL.onnx");
             return 2;
         }
         using (var model = Model.Open(args[0], 1))
@@ -79,6 +79,25 @@ static class Example
                 Console.WriteLine("unknown joint: status " + (int)e.Status);
             }
             model.WriteBvh(first, args[1]);
+        }
+        // Steering a heading-relative model: 40 frames at 12 units/s turning 0.3 rad/s, and a
+        // stream told 10 units/s turning -0.2 rad/s.
+        using (var zombie = Model.Open(args[2], 1))
+        {
+            var limits = zombie.SteerLimits();
+            Console.WriteLine("steer limits forward " + limits.ForwardMin.ToString("F2") + " to " + limits.ForwardMax.ToString("F2"));
+            var ahead = new SteerFrame[40];
+            for (int i = 0; i < ahead.Length; i++) ahead[i] = SteerFrame.Velocity(12.0, 0.3);
+            using (var steered = zombie.Steer(40, ahead, 5, seed: 3, steps: 4))
+                Print("steer", steered.Poses(0));
+            using (var stream = new MotionStream(zombie, seed: 11, steps: 3, blockFrames: 30))
+            {
+                var told = new SteerFrame[60];
+                for (int i = 0; i < told.Length; i++) told[i] = SteerFrame.Velocity(10.0, -0.2);
+                stream.Steer(told);
+                Print("steerstream20", stream.Next(20));
+                Print("steerstream25", stream.Next(25));
+            }
         }
         return 0;
     }

@@ -3,7 +3,8 @@
  * Rust test can compare them with the Rust API's exactly; then every entry point fed bad
  * arguments, each of which must give its status code and a message, never a crash.
  *
- * Usage: api_check MODEL.onnx NOT_A_MODEL_FILE OUT.bvh
+ * Usage: api_check MODEL.onnx NOT_A_MODEL_FILE OUT.bvh STEERABLE_MODEL.onnx (a heading-relative
+ * model, for the steering checks)
  * Prints "<label> <hex> <hex> ..." lines, then "bad arguments: N checks" on success. */
 #include <math.h>
 #include <stdint.h>
@@ -236,9 +237,74 @@ static void check_stepping(SinmdmModel *model, size_t joints, const SinmdmPoses 
   poses_free(&once);
 }
 
+static void steer_velocity(SinmdmSteerFrame *frames, size_t count, double forward, double turn) {
+  for (size_t i = 0; i < count; i++) {
+    SinmdmSteerFrame f = {SINMDM_STEER_VELOCITY, forward, turn, {0.0, 0.0, 0.0}};
+    frames[i] = f;
+  }
+}
+
+/* Steering the zombie walk (a heading-relative model): its limits, a one-shot run of 40 frames
+   at 12 units/s turning 0.3 rad/s, a stream told 10 units/s turning -0.2 rad/s, and the
+   refusals: a world-root model, a bad kind, a non-finite value, a NULL array. */
+static void check_steering(const char *path, SinmdmModel *world) {
+  SinmdmModel *zombie = NULL;
+  CHECK_OK(sinmdm_model_open(path, 1, &zombie));
+  SinmdmModelInfo info;
+  CHECK_OK(sinmdm_model_info(zombie, &info));
+  SinmdmSteerLimits limits;
+  CHECK_OK(sinmdm_steer_limits(zombie, &limits));
+  expect_true(limits.forward_max > limits.forward_min && limits.turn_max > 0.0,
+              "steering limits are a range");
+  SinmdmSteerFrame commands[60];
+  steer_velocity(commands, 40, 12.0, 0.3);
+  SinmdmSampling once = {3, 1, 4, SINMDM_FEET_PLANTED, SINMDM_METHOD_ANCESTRAL, 0.0};
+  SinmdmResult *steered = NULL;
+  CHECK_OK(sinmdm_steer(zombie, &once, 40, commands, 40, 5, &steered));
+  Poses steer_poses = poses_alloc(40, info.joints);
+  SinmdmPoseBuffers bs = buffers_of(&steer_poses);
+  CHECK_OK(sinmdm_result_poses(steered, 0, &bs));
+  print_poses("steer", &steer_poses);
+  poses_free(&steer_poses);
+  sinmdm_result_free(steered);
+
+  SinmdmStreamOptions options = {11, 3, 30, SINMDM_FEET_PLANTED, NULL, 0, 0, SINMDM_METHOD_ANCESTRAL, 0.0};
+  SinmdmStream *stream = NULL;
+  CHECK_OK(sinmdm_stream_new(zombie, &options, &stream));
+  steer_velocity(commands, 60, 10.0, -0.2);
+  CHECK_OK(sinmdm_stream_steer(stream, commands, 60));
+  Poses a = poses_alloc(20, info.joints), b = poses_alloc(25, info.joints);
+  SinmdmPoseBuffers ba = buffers_of(&a), bb = buffers_of(&b);
+  CHECK_OK(sinmdm_stream_next(stream, zombie, 20, &ba));
+  CHECK_OK(sinmdm_stream_next(stream, zombie, 25, &bb));
+  print_poses("steerstream20", &a);
+  print_poses("steerstream25", &b);
+  poses_free(&a);
+  poses_free(&b);
+
+  SinmdmResult *unused = NULL;
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_steer_limits(world, &limits));
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_steer(world, &once, 40, commands, 40, 5, &unused));
+  SinmdmStream *world_stream = NULL;
+  CHECK_OK(sinmdm_stream_new(world, &options, &world_stream));
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_stream_steer(world_stream, commands, 1));
+  sinmdm_stream_free(world_stream);
+  commands[3].kind = 7;
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_stream_steer(stream, commands, 10));
+  commands[3].kind = SINMDM_STEER_POSITION;
+  commands[3].position[1] = NAN;
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_steer(zombie, &once, 40, commands, 10, 5, &unused));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_stream_steer(stream, NULL, 3));
+  CHECK_OK(sinmdm_stream_steer(stream, NULL, 0));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_steer_limits(NULL, &limits));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_steer_limits(zombie, NULL));
+  sinmdm_stream_free(stream);
+  sinmdm_model_free(zombie);
+}
+
 int main(int argc, char **argv) {
-  if (argc != 4) {
-    fprintf(stderr, "usage: api_check MODEL.onnx NOT_A_MODEL OUT.bvh\n");
+  if (argc != 5) {
+    fprintf(stderr, "usage: api_check MODEL.onnx NOT_A_MODEL OUT.bvh STEERABLE_MODEL.onnx\n");
     return 2;
   }
   CHECK_OK(sinmdm_load_onnxruntime(NULL));
@@ -333,6 +399,8 @@ int main(int argc, char **argv) {
   CHECK_OK(sinmdm_stream_next(stream, model, 25, &bb));
   print_poses("stream20", &chunk_a);
   print_poses("stream25", &chunk_b);
+
+  check_steering(argv[4], model);
 
   CHECK_OK(sinmdm_write_bvh(model, &reference, argv[3]));
 

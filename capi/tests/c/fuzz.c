@@ -4,7 +4,8 @@
  * fails, never SINMDM_INTERNAL, and the program must not crash. Memory the library is told
  * about is always really there: a fuzz cannot lie about a buffer's size without being the bug.
  *
- * Usage: fuzz MODEL_A.onnx MODEL_B.onnx WORK_DIR CASES
+ * Usage: fuzz MODEL_A.onnx MODEL_B.onnx WORK_DIR CASES (model B a heading-relative one, which
+ * steering takes)
  * Prints "fuzz: N cases" and a count per status on success. */
 #include <math.h>
 #include <stdint.h>
@@ -201,7 +202,7 @@ static void one_case(const char *model_a, const char *work) {
   SinmdmRun **run_out = pick(10) ? &run : NULL;
   SinmdmResult **result_out = pick(10) ? &result : NULL;
   size_t needed = 0;
-  switch (pick(31)) {
+  switch (pick(32)) {
     case 0: {
       SinmdmModel *opened = NULL;
       const char *paths[] = {NULL, "", "/no/such/model.onnx", model_a, work};
@@ -423,6 +424,39 @@ static void one_case(const char *model_a, const char *work) {
           CALL("dance_reference_beats",
                sinmdm_dance_reference_beats(model, poses_ptr, coin() ? beats : NULL, pick(17),
                                             coin() ? &needed : NULL));
+          break;
+      }
+      break;
+    }
+    case 30: {
+      /* Steering: commands of any kind and value (NaN, infinities, unknown kinds), counts past
+         the bound, NULL arrays, either model (only model B can be steered). */
+      static SinmdmSteerFrame commands[16];
+      for (size_t i = 0; i < 16; i++) {
+        SinmdmSteerFrame f = {pick(4) ? (uint32_t)pick(3) : any_u32(), coin() ? 12.0 : any_double(),
+                              coin() ? 0.2 : any_double(),
+                              {coin() ? 1.0 * i : any_double(), any_double(), coin() ? -2.0 * i : any_double()}};
+        commands[i] = f;
+      }
+      size_t counts[] = {0, 1, 7, 16, SINMDM_MAX_SAMPLE_FRAMES + 1, SIZE_MAX};
+      size_t count = counts[pick(6)];
+      const SinmdmSteerFrame *commands_ptr = (count <= 16 || coin()) && pick(6) ? commands : NULL;
+      if (count > 16 && commands_ptr != NULL) commands_ptr = NULL;
+      size_t frames = coin() ? 30 + pick(20) : any_size(SINMDM_MAX_SAMPLE_FRAMES);
+      size_t ramp = coin() ? pick(12) : any_size(SINMDM_MAX_RAMP_FRAMES);
+      SinmdmSteerLimits limits;
+      switch (pick(4)) {
+        case 0:
+          CALL("steer", sinmdm_steer(model, sampling_ptr, frames, commands_ptr, count, ramp, result_out));
+          break;
+        case 1:
+          CALL("steer_begin", sinmdm_steer_begin(model, sampling_ptr, frames, commands_ptr, count, ramp, run_out));
+          break;
+        case 2:
+          CALL("steer_limits", sinmdm_steer_limits(model, coin() ? &limits : NULL));
+          break;
+        default:
+          CALL("stream_steer", sinmdm_stream_steer(ANY_OF(streams), commands_ptr, count));
           break;
       }
       break;

@@ -19,6 +19,17 @@ pub fn model_path() -> PathBuf {
     repo().join("onnx-models/human_walk_cmu.onnx")
 }
 
+/// The shipped heading-relative model the steering checks run on.
+pub fn steer_model_path() -> PathBuf {
+    repo().join("onnx-models/human_zombie_walk_fair.onnx")
+}
+
+/// The velocity commands the steering checks give: `frames` frames of `forward` units/s and
+/// `turn` radians/s.
+pub fn steer_commands(frames: usize, forward: f64, turn: f64) -> Vec<sinmdm::steer::SteerFrame> {
+    vec![sinmdm::steer::SteerFrame::Velocity { forward, turn }; frames]
+}
+
 /// The folder of the test binary's profile (`target/release`), where `libsinmdm_c.so` is,
 /// with the shared library built now: `cargo test` builds the crate's rlib for the tests, not
 /// its cdylib, which could otherwise be stale.
@@ -206,6 +217,42 @@ pub fn expected() -> BTreeMap<String, String> {
     let b = stream.next(&mut model, 25).unwrap();
     pose_lines("stream20", &a.poses(), &mut out);
     pose_lines("stream25", &b.poses(), &mut out);
+    // Steering the zombie walk: 40 frames at 12 units/s turning 0.3 rad/s, one-shot; and a
+    // stream told 10 units/s turning -0.2 rad/s for 60 frames, read in chunks of 20 and 25.
+    let mut zombie = Model::open(steer_model_path(), &ModelOptions { threads: Some(1) }).unwrap();
+    let steered = sinmdm::run(
+        &mut zombie,
+        &Request {
+            task: Task::Steer {
+                frames: 40,
+                commands: steer_commands(40, 12.0, 0.3),
+                ramp: 5,
+            },
+            count: 1,
+            seed: 3,
+            steps: Some(4),
+            feet: Feet::Planted,
+            method: Default::default(),
+        },
+        go,
+    )
+    .unwrap();
+    pose_lines("steer", &steered.poses(0).unwrap(), &mut out);
+    let mut stream = Stream::new(
+        zombie.metadata(),
+        StreamOptions {
+            seed: 11,
+            steps: Some(3),
+            block_frames: Some(30),
+            ..StreamOptions::default()
+        },
+    )
+    .unwrap();
+    stream.steer(&steer_commands(60, 10.0, -0.2)).unwrap();
+    let a = stream.next(&mut zombie, 20).unwrap();
+    let b = stream.next(&mut zombie, 25).unwrap();
+    pose_lines("steerstream20", &a.poses(), &mut out);
+    pose_lines("steerstream25", &b.poses(), &mut out);
     out
 }
 
