@@ -6,6 +6,8 @@
 #  - three new fox motions from the fox model,
 #  - two dances (seeds 1 and 2) to a CC0 breakbeat loop from the model of the Rokoko dance (with
 #    a GIF, the beats each used, and the loop with a click on each beat the tracker found),
+#  - two zombie walks steered round a circle of three heights' radius (the heading-relative
+#    model), with how closely each followed it,
 # as BVH files (they open in Blender with the clip's skeleton, units and frame rate),
 #  - and a crowd of eight walks as ONE glTF file (walk_crowd.glb: one animation each, metres,
 #    +Y up), which Godot, Blender, three.js and Unity's glTFast open as it is.
@@ -33,6 +35,8 @@ for seed in 1 2; do
     -o "$out/dance_$seed.bvh" --beats-out "$out/dance_beats_$seed.json"
 done
 "$sinmdm" render "$out/dance_1.bvh" "$out/dance_2.bvh" -o "$out/dance.gif"
+"$sinmdm" steer -m onnx-models/human_zombie_walk_fair.onnx --circle 3 --count 2 --seed 1 \
+  -o "$out/zombie_circle.bvh" --report
 # CMU's unit is unsure from the skeleton's height alone; it is 1/0.45 inch.
 "$sinmdm" generate -m "$walk_model" --count 8 --seed 2 -o "$out/walk_crowd.glb" --unit-scale 0.056444
 echo
