@@ -197,77 +197,70 @@ pub fn print_following(generated: &Generated, commands: &[SteerFrame]) {
     }
 }
 
-fn numbers(line: &str) -> Vec<&str> {
-    line.split([',', ';', ' ', '\t'])
-        .map(str::trim)
-        .filter(|s| !s.is_empty())
-        .collect()
-}
-
-/// One position per frame, `x,y,z` per line; a first line that is not numbers is a header.
-fn read_path(file: &Path) -> Result<Vec<SteerFrame>> {
-    let text = std::fs::read_to_string(file)
-        .with_context(|| format!("cannot read the path {}", file.display()))?;
-    let mut out = Vec::new();
+/// The rows of three finite numbers of a CSV-like file (commas, semicolons, spaces or tabs
+/// between them), each with its line number; a first line that is not numbers is a header.
+/// `what` names the three columns in errors.
+fn triples(file: &Path, what: &str) -> Result<Vec<(usize, [f64; 3])>> {
+    let text =
+        std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
+    let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {
-        let fields = numbers(line);
+        let fields: Vec<&str> = line
+            .split([',', ';', ' ', '\t'])
+            .map(str::trim)
+            .filter(|s| !s.is_empty())
+            .collect();
         if fields.is_empty() {
             continue;
         }
         let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
         match values {
             Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => {
-                out.push(SteerFrame::Position(Vec3::new(v[0], v[1], v[2])))
+                rows.push((i + 1, [v[0], v[1], v[2]]))
             }
-            Err(_) if out.is_empty() && i == 0 => continue,
+            Err(_) if i == 0 => continue,
             _ => bail!(
-                "{} line {}: expected three numbers x,y,z, got '{line}'",
+                "{} line {}: expected three numbers {what}, got '{line}'",
                 file.display(),
                 i + 1
             ),
         }
     }
-    if out.len() < 2 {
+    Ok(rows)
+}
+
+/// One position per frame, `x,y,z` per line.
+fn read_path(file: &Path) -> Result<Vec<SteerFrame>> {
+    let rows = triples(file, "x,y,z")?;
+    if rows.len() < 2 {
         bail!("{}: a path needs at least two positions", file.display());
     }
-    Ok(out)
+    Ok(rows
+        .into_iter()
+        .map(|(_, v)| SteerFrame::Position(Vec3(v)))
+        .collect())
 }
 
 /// Lines `seconds,speed,turn` (turn in degrees per second), each holding until the next, as
 /// per-frame velocity commands over `frames` frames.
 fn read_velocities(file: &Path, fps: f64, frames: usize) -> Result<Vec<SteerFrame>> {
-    let text = std::fs::read_to_string(file)
-        .with_context(|| format!("cannot read the schedule {}", file.display()))?;
-    let mut entries: Vec<(f64, f64, f64)> = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let fields = numbers(line);
-        if fields.is_empty() {
-            continue;
-        }
-        let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
-        match values {
-            Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => {
-                if entries.last().is_some_and(|e| v[0] <= e.0) {
-                    bail!("{} line {}: times must increase", file.display(), i + 1);
-                }
-                entries.push((v[0], v[1], v[2].to_radians()));
-            }
-            Err(_) if entries.is_empty() && i == 0 => continue,
-            _ => bail!(
-                "{} line {}: expected seconds,speed,turn, got '{line}'",
-                file.display(),
-                i + 1
-            ),
-        }
-    }
-    if entries.is_empty() {
+    let rows = triples(file, "seconds,speed,turn")?;
+    if rows.is_empty() {
         bail!("{}: the schedule is empty", file.display());
+    }
+    for pair in rows.windows(2) {
+        if pair[1].1[0] <= pair[0].1[0] {
+            bail!("{} line {}: times must increase", file.display(), pair[1].0);
+        }
     }
     Ok((0..frames)
         .map(|f| {
             let t = f as f64 / fps;
-            match entries.iter().rev().find(|e| e.0 <= t) {
-                Some(&(_, forward, turn)) => SteerFrame::Velocity { forward, turn },
+            match rows.iter().rev().find(|(_, e)| e[0] <= t) {
+                Some(&(_, [_, forward, turn])) => SteerFrame::Velocity {
+                    forward,
+                    turn: turn.to_radians(),
+                },
                 None => SteerFrame::Free,
             }
         })

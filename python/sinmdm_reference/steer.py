@@ -224,21 +224,27 @@ def start_course(model):
     return [float(v) for v in root["start_position"]], float(root["heading"]["start"])
 
 
-def read_velocities(path, fps, frames):
-    """`seconds,speed,turn` lines (turn in degrees per second) as per-frame commands."""
-    entries = []
+def _triples(path):
+    """Rows of three numbers (commas, semicolons, spaces or tabs between them); a first line
+    that is not numbers is a header (as the command line reads them)."""
+    rows = []
     with open(path) as f:
         for i, line in enumerate(f):
             fields = [x for x in line.replace(";", ",").replace("\t", ",").replace(" ", ",").split(",") if x.strip()]
             if not fields:
                 continue
             try:
-                v = [float(x) for x in fields]
+                rows.append([float(x) for x in fields])
             except ValueError:
-                if not entries and i == 0:
+                if i == 0:
                     continue
                 raise
-            entries.append((v[0], v[1], math.radians(v[2])))
+    return rows
+
+
+def read_velocities(path, fps, frames):
+    """`seconds,speed,turn` lines (turn in degrees per second) as per-frame commands."""
+    entries = [(v[0], v[1], math.radians(v[2])) for v in _triples(path)]
     out = []
     for f in range(frames):
         t = f / fps
@@ -248,17 +254,4 @@ def read_velocities(path, fps, frames):
 
 
 def read_path(path):
-    out = []
-    with open(path) as f:
-        for i, line in enumerate(f):
-            fields = [x for x in line.replace(";", ",").replace("\t", ",").replace(" ", ",").split(",") if x.strip()]
-            if not fields:
-                continue
-            try:
-                v = [float(x) for x in fields]
-            except ValueError:
-                if not out and i == 0:
-                    continue
-                raise
-            out.append(("position", (v[0], v[1], v[2])))
-    return out
+    return [("position", (v[0], v[1], v[2])) for v in _triples(path)]
