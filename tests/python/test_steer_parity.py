@@ -63,6 +63,10 @@ def test_a_steered_stream_is_the_same_in_rust_and_python(course, tmp_path):
                            "-o", str(py_json)], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     a, b = features(rust_json), features(py_json)
+    # The heading root's rows are named alike on both sides.
+    columns = [json.loads(p.read_text())["columns"] for p in (rust_json, py_json)]
+    assert columns[0] == columns[1]
+    assert columns[0][:4] == ["Hips.forward", "Hips.leftward", "Hips.turn", "Hips.Y"]
     assert a.shape == b.shape == (1, 168, 300)
     # Steering moved the root: the forward row follows the commands, not the free walk.
     free_json = tmp_path / "free.json"
