@@ -82,6 +82,8 @@ namespace Sinmdm
     public struct SteerFrame
     {
         public SteerKind Kind;
+        /// <summary>0 (keeps the numbers 8-byte aligned; the C struct is 48 bytes).</summary>
+        public uint Reserved;
         /// <summary>Velocity: forward speed, file units per second.</summary>
         public double Forward;
         /// <summary>Velocity: turn rate, radians per second; positive turns left.</summary>
@@ -634,7 +636,8 @@ namespace Sinmdm
             Native.Check(Native.WithInput(poses, model.Joints, input => Native.sinmdm_stream_supply(handle, model.Handle, ref input)));
 
         /// <summary>Steering commands for the frames after the last commanded ones (a
-        /// heading-relative model); commands given 2 x block + 10 frames ahead reach the motion.</summary>
+        /// heading-relative model; command i given in all is stream frame i). Give them at least
+        /// 2 x block + 10 frames ahead of what was handed out, plus what Prepare made ahead.</summary>
         public void Steer(SteerFrame[] commands)
         {
             if (commands == null) throw new ArgumentNullException(nameof(commands));

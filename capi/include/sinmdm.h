@@ -520,6 +520,11 @@ typedef struct SinmdmSteerFrame {
    */
   uint32_t kind;
   /*
+   Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
+   included, so the struct is 48 bytes everywhere).
+   */
+  uint32_t reserved;
+  /*
    `SINMDM_STEER_VELOCITY`: forward speed, file units per second.
    */
   double forward;
@@ -904,9 +909,12 @@ enum SinmdmStatus sinmdm_steer(struct SinmdmModel *model,
 
 /*
  Steering commands for the frames after the last commanded one (the first call commands
- frame 0 on): a block uses the commands given when it starts, so commands given
- `2 x block_frames + 10` frames ahead of what has been handed out reach the motion.
- `SINMDM_INVALID_ARGUMENT` for a model without a heading-relative root.
+ frame 0 on; command `i` given in all belongs to stream frame `i`). A block uses the
+ commands given when it starts, so give them at least `2 x block + 10` frames ahead of what
+ has been handed out (`block`: the stream's block frames, the training clip's length by
+ default), plus whatever `sinmdm_stream_step` prepared ahead; commands for frames a block
+ has already started on are not used. `SINMDM_INVALID_ARGUMENT` for a model without a
+ heading-relative root or a value that is not finite.
 
  # Safety
  `stream` is a live handle; `commands` readable for `count` values.

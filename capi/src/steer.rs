@@ -29,6 +29,9 @@ pub const SINMDM_STEER_POSITION: u32 = 2;
 pub struct SinmdmSteerFrame {
     /// `SINMDM_STEER_FREE`, `SINMDM_STEER_VELOCITY` or `SINMDM_STEER_POSITION`.
     pub kind: u32,
+    /// Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
+    /// included, so the struct is 48 bytes everywhere).
+    pub reserved: u32,
     /// `SINMDM_STEER_VELOCITY`: forward speed, file units per second.
     pub forward: f64,
     /// `SINMDM_STEER_VELOCITY`: turn rate, radians per second; positive turns left
@@ -37,6 +40,9 @@ pub struct SinmdmSteerFrame {
     /// `SINMDM_STEER_POSITION`: the root's position, file frame (the up component is ignored).
     pub position: [f64; 3],
 }
+
+const _: () = assert!(std::mem::size_of::<SinmdmSteerFrame>() == 48);
+const _: () = assert!(std::mem::offset_of!(SinmdmSteerFrame, forward) == 8);
 
 /// The range of commands a model's clip supports (what is beyond it is clamped).
 #[repr(C)]
@@ -182,9 +188,12 @@ pub unsafe extern "C" fn sinmdm_steer(
 }
 
 /// Steering commands for the frames after the last commanded one (the first call commands
-/// frame 0 on): a block uses the commands given when it starts, so commands given
-/// `2 x block_frames + 10` frames ahead of what has been handed out reach the motion.
-/// `SINMDM_INVALID_ARGUMENT` for a model without a heading-relative root.
+/// frame 0 on; command `i` given in all belongs to stream frame `i`). A block uses the
+/// commands given when it starts, so give them at least `2 x block + 10` frames ahead of what
+/// has been handed out (`block`: the stream's block frames, the training clip's length by
+/// default), plus whatever `sinmdm_stream_step` prepared ahead; commands for frames a block
+/// has already started on are not used. `SINMDM_INVALID_ARGUMENT` for a model without a
+/// heading-relative root or a value that is not finite.
 ///
 /// # Safety
 /// `stream` is a live handle; `commands` readable for `count` values.

@@ -45,7 +45,8 @@ pub struct CourseArgs {
     /// degrees per second), each holding until the next.
     #[arg(long, value_name = "SCHEDULE.csv", group = "course")]
     pub velocity: Option<PathBuf>,
-    /// Speed along --circle and --figure8, file units per second (default: the clip's mean).
+    /// Speed along --circle and --figure8, file units per second (default: the clip's mean
+    /// forward speed, or half its top speed when that is faster).
     #[arg(long)]
     pub speed: Option<f64>,
 }

@@ -44,7 +44,11 @@ def transpose(m):
 
 
 def round_half_away(x):
-    return math.copysign(math.floor(abs(x) + 0.5), x)
+    """Rust's f64::round: to the nearest integer, halves away from zero (exactly)."""
+    t = float(math.trunc(x))
+    if abs(x - t) >= 0.5:
+        t += math.copysign(1.0, x)
+    return t
 
 
 def wrap(angle):
@@ -152,8 +156,13 @@ class Steering:
                 path_step = [p[c] - before[c] for c in range(3)]
                 path_step[UP] = 0.0
                 if span is None:
-                    if norm(path_step) > 1e-12:
-                        direction = math.atan2(path_step[0], path_step[2])
+                    lead = path_step
+                    following = self.goals[i + 1] if i + 1 < n else None
+                    if norm(lead) <= 1e-12 and following is not None and following[0] == "position":
+                        lead = [following[1][c] - p[c] for c in range(3)]
+                        lead[UP] = 0.0
+                    if norm(lead) > 1e-12:
+                        direction = math.atan2(lead[0], lead[2])
                     else:
                         direction = heading[i - 1]
                     last_direction = heading[i - 1] + wrap(direction - heading[i - 1])
@@ -188,7 +197,7 @@ class Steering:
             current = raw[k]
             pull = [0.0 if targets[k][i] is None else self.weights[i] * (targets[k][i] - current[i])
                     for i in range(n)]
-            on_path = any(g is not None and g[0] == "position" for g in self.goals)
+            on_path = any(g is not None and g[0] == "position" for g in self.goals[self.anchor + 1:])
             slow = triangular(pull, self.facing_reach if k == TURN and on_path else self.reach)
             x0[k] = np.array([np.float32(float(v) + d / self.std[k]) for v, d in zip(x0[k], slow)],
                              dtype=np.float32)

@@ -260,3 +260,38 @@ fn a_world_root_model_refuses_steering() {
     let mut stream = Stream::new(&metadata, StreamOptions::default()).unwrap();
     assert!(stream.steer(&[SteerFrame::Free]).is_err());
 }
+
+#[test]
+fn commands_that_are_not_finite_are_refused() {
+    let model = zombie();
+    let metadata = model.metadata().clone();
+    let bad = vec![
+        SteerFrame::Velocity {
+            forward: 10.0,
+            turn: 0.0,
+        },
+        SteerFrame::Velocity {
+            forward: f64::NAN,
+            turn: 0.0,
+        },
+    ];
+    let request = Request {
+        task: Task::Steer {
+            frames: 60,
+            commands: bad.clone(),
+            ramp: 10,
+        },
+        count: 1,
+        seed: 0,
+        steps: Some(5),
+        feet: Feet::Raw,
+        method: Default::default(),
+    };
+    let e = sinmdm::plan(&metadata, &request).unwrap_err();
+    assert!(e.to_string().contains("command 1"), "{e}");
+    let mut stream = Stream::new(&metadata, StreamOptions::default()).unwrap();
+    let e = stream.steer(&bad).unwrap_err();
+    assert!(e.to_string().contains("not finite"), "{e}");
+    let position = SteerFrame::Position(sinmdm::motion::math::Vec3::new(0.0, f64::INFINITY, 0.0));
+    assert!(stream.steer(&[position]).is_err());
+}

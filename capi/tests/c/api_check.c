@@ -239,7 +239,7 @@ static void check_stepping(SinmdmModel *model, size_t joints, const SinmdmPoses 
 
 static void steer_velocity(SinmdmSteerFrame *frames, size_t count, double forward, double turn) {
   for (size_t i = 0; i < count; i++) {
-    SinmdmSteerFrame f = {SINMDM_STEER_VELOCITY, forward, turn, {0.0, 0.0, 0.0}};
+    SinmdmSteerFrame f = {SINMDM_STEER_VELOCITY, 0, forward, turn, {0.0, 0.0, 0.0}};
     frames[i] = f;
   }
 }

@@ -51,17 +51,19 @@ pub fn path_following(
     commands: &[SteerFrame],
 ) -> Option<PathFollowing> {
     let to_canonical = layout.up.canonical_from_file();
-    let path: Vec<Vec3> = commands
+    // The path's points with the frames they are for (frames without a position are left out).
+    let (frames_of, path): (Vec<usize>, Vec<Vec3>) = commands
         .iter()
-        .filter_map(|c| match c {
+        .enumerate()
+        .filter_map(|(f, c)| match c {
             SteerFrame::Position(p) => {
                 let mut q = to_canonical * *p;
                 q[UP] = 0.0;
-                Some(q)
+                Some((f, q))
             }
             _ => None,
         })
-        .collect();
+        .unzip();
     if path.len() < 2 {
         return None;
     }
@@ -71,13 +73,15 @@ pub fn path_following(
         along[i] = along[i - 1] + (path[i] - path[i - 1]).norm();
     }
     let length = along[path.len() - 1].max(1e-12);
-    // Nearest point of the polyline near frame `frame`'s point: (distance, arc length there).
+    // Nearest point of the polyline among the segments whose points are for frames near
+    // `frame`: (distance, arc length there).
     let reach = (PROGRESS_WINDOW_SECONDS * layout.fps).ceil() as usize;
     let nearest = |frame: usize, p: Vec3| -> (f64, f64) {
         let mut best = (f64::INFINITY, 0.0);
-        let from = frame.saturating_sub(reach).max(1);
-        let to = (frame + reach + 1).min(path.len());
-        for i in from..to {
+        for i in 1..path.len() {
+            if frames_of[i] + reach < frame || frames_of[i - 1] > frame + reach {
+                continue;
+            }
             let (a, b) = (path[i - 1], path[i]);
             let ab = b - a;
             let len2 = ab.dot(ab);
@@ -93,13 +97,20 @@ pub fn path_following(
         }
         best
     };
-    let height = layout.skeleton_height;
-    let n = positions.len().min(path.len());
-    let distances: Vec<(f64, f64)> = positions[..n]
-        .iter()
-        .enumerate()
-        .map(|(f, &p)| nearest(f, p))
+    // The frames the path covers.
+    let (first, last) = (
+        frames_of[0],
+        frames_of[path.len() - 1].min(positions.len() - 1),
+    );
+    let distances: Vec<(f64, f64)> = (first..=last)
+        .map(|f| nearest(f, positions[f]))
+        .filter(|d| d.0.is_finite())
         .collect();
+    if distances.is_empty() {
+        return None;
+    }
+    let n = distances.len();
+    let height = layout.skeleton_height;
     Some(PathFollowing {
         mean_distance: distances.iter().map(|d| d.0).sum::<f64>() / n as f64 / height,
         max_distance: distances.iter().map(|d| d.0).fold(0.0, f64::max) / height,

@@ -14,9 +14,11 @@
 //!   fps).
 //! - **Path** commands give the ground position of each frame. Their displacement from frame to
 //!   frame, turned into the facing the prediction has at that frame (re-integrated from its own
-//!   turn rows at every step), targets the forward and leftward rows; the path's own turn, plus
-//!   the facing's error against the path's direction corrected over [`FACING_CATCH_UP_SECONDS`],
-//!   targets the turn row. A start off the path is caught up over the same time.
+//!   turn rows at every step), targets the forward and leftward rows; the path's own turn
+//!   targets the turn row. Where a span of path commands starts, the prediction's offset from
+//!   the path, in position and in facing, fades out over [`FACING_CATCH_UP_SECONDS`]; after
+//!   that the targets are the path's own steps (open loop: each pass re-reads the facing, and
+//!   the low-pass keeps the integrated course on the path).
 //!
 //! Commands beyond what the clip showed are clamped ([`SteerLimits`]) and reported.
 
@@ -45,7 +47,8 @@ pub const FACING_REACH_SECONDS: f64 = 1.5;
 /// Passes of the pull per denoising step (see [`Steering::apply`]).
 pub const STEER_PASSES: usize = 4;
 
-/// How fast a path's facing and position errors are caught up, seconds.
+/// Over how long the offset between the prediction and a path, where a span of path commands
+/// starts, fades out, seconds.
 pub const FACING_CATCH_UP_SECONDS: f64 = 1.0;
 
 /// The smallest turn rate steering allows, radians per second, whatever the clip: a clip that
@@ -74,6 +77,17 @@ pub enum SteerFrame {
     /// The root's position on the ground at this frame (file frame; the up component is
     /// ignored).
     Position(Vec3),
+}
+
+impl SteerFrame {
+    /// Whether every number of the command is finite (a position's up component too).
+    pub fn is_finite(&self) -> bool {
+        match *self {
+            SteerFrame::Free => true,
+            SteerFrame::Velocity { forward, turn } => forward.is_finite() && turn.is_finite(),
+            SteerFrame::Position(p) => p.is_finite(),
+        }
+    }
 }
 
 /// The range of commands a model's clip supports: its forward speed and turn rate, each as the
@@ -160,6 +174,11 @@ pub fn plan_steering(
         "steering needs a model with a heading-relative root (train it with --root-layout heading)"
             .to_string()
     })?;
+    if let Some((i, c)) = commands.iter().enumerate().find(|(_, c)| !c.is_finite()) {
+        return Err(format!(
+            "command {i} holds a value that is not finite: {c:?}"
+        ));
+    }
     let layout = &metadata.layout;
     let fps = layout.fps;
     let to_canonical = layout.up.canonical_from_file();
@@ -305,9 +324,18 @@ impl Steering {
                     let (start, offset, facing_offset) = match span {
                         Some(s) => s,
                         None => {
-                            // The direction the path leaves in (or the facing, standing still).
-                            let direction = if path_step.norm() > 1e-12 {
-                                path_step[0].atan2(path_step[2])
+                            // The direction the path leaves in: its first step, or, for a span
+                            // that starts after other goals, its step to the next frame (or the
+                            // facing, standing still).
+                            let mut lead = path_step;
+                            if lead.norm() <= 1e-12
+                                && let Some(Goal::Position(next)) = self.goals.get(i + 1)
+                            {
+                                lead = *next - p;
+                                lead[UP] = 0.0;
+                            }
+                            let direction = if lead.norm() > 1e-12 {
+                                lead[0].atan2(lead[2])
                             } else {
                                 heading[i - 1]
                             };
@@ -355,7 +383,12 @@ impl Steering {
                 .collect();
             // A path's facing is pulled over a longer reach than its travel: the course is
             // followed on average, and a clip's own turns away from its travel (a glide) stay.
-            let reach = if k == TURN && self.goals.iter().any(|g| matches!(g, Goal::Position(_))) {
+            let on_path = self
+                .goals
+                .iter()
+                .skip(self.anchor + 1)
+                .any(|g| matches!(g, Goal::Position(_)));
+            let reach = if k == TURN && on_path {
                 self.facing_reach
             } else {
                 self.reach

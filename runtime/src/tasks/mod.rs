@@ -233,7 +233,8 @@ pub enum Task {
     Steer {
         /// Frames per sample.
         frames: usize,
-        /// One command per frame (shorter lists leave the later frames free).
+        /// One command per frame from frame 0 (shorter lists leave the later frames free;
+        /// commands past `frames` are not used).
         commands: Vec<crate::steer::SteerFrame>,
         /// Soft border at the ends of each span of commands, in frames.
         ramp: usize,
