@@ -59,6 +59,8 @@ pub mod motion;
 pub mod network;
 mod onnxruntime;
 #[doc(hidden)]
+pub mod soft_border;
+#[doc(hidden)]
 pub mod steer;
 #[doc(hidden)]
 pub mod stream;

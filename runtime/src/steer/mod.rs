@@ -33,7 +33,7 @@ use crate::motion::RootStart;
 use crate::motion::features::heading::{wrap, yaw};
 use crate::motion::math::Vec3;
 use crate::motion::up::UP;
-use crate::tasks::mask::soft_mask;
+use crate::soft_border::soft_mask;
 
 /// The half-width of the steering low-pass, seconds: about a stride, so the commanded average
 /// is over a whole step.
