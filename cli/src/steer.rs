@@ -183,16 +183,11 @@ pub fn print_following(generated: &Generated, commands: &[SteerFrame]) {
                 100.0 * worst(&v.turn, 10f64.to_radians())
             );
         }
-        if let Some(mut a) = facing_against_travel(layout, raw) {
-            a.sort_by(f64::total_cmp);
-            if !a.is_empty() {
-                let over = a.iter().filter(|&&x| x > 45.0).count() as f64 / a.len() as f64;
-                line += &format!(
-                    " facing against travel median {:.1} degrees, {:.0} % over 45",
-                    a[a.len() / 2],
-                    100.0 * over
-                );
-            }
+        if let Some((median, over)) = facing_against_travel(layout, raw).and_then(facing_summary) {
+            line += &format!(
+                " facing against travel median {median:.1} degrees, {:.0} % over 45",
+                100.0 * over
+            );
         }
         println!("{line}");
     }

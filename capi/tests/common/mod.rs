@@ -100,6 +100,31 @@ pub fn pose_lines(label: &str, poses: &[Pose], out: &mut BTreeMap<String, String
     );
 }
 
+/// The lines of a stream of `model` (seed 11, 3 steps, blocks of 30 frames) steered by
+/// `commands` (none: a free stream), read in chunks of 20 and 25 frames: `{label}20` and
+/// `{label}25`.
+fn stream_lines(
+    model: &mut Model,
+    label: &str,
+    commands: &[sinmdm::steer::SteerFrame],
+    out: &mut BTreeMap<String, String>,
+) {
+    let options = StreamOptions {
+        seed: 11,
+        steps: Some(3),
+        block_frames: Some(30),
+        ..StreamOptions::default()
+    };
+    let mut stream = Stream::new(model.metadata(), options).unwrap();
+    if !commands.is_empty() {
+        stream.steer(commands).unwrap();
+    }
+    let a = stream.next(model, 20).unwrap();
+    let b = stream.next(model, 25).unwrap();
+    pose_lines(&format!("{label}20"), &a.poses(), out);
+    pose_lines(&format!("{label}25"), &b.poses(), out);
+}
+
 /// What the check program must print, from the Rust API.
 pub fn expected() -> BTreeMap<String, String> {
     let mut model = Model::open(model_path(), &ModelOptions { threads: Some(1) }).unwrap();
@@ -203,20 +228,7 @@ pub fn expected() -> BTreeMap<String, String> {
     )
     .unwrap();
     pose_lines("dance", &dance.poses(0).unwrap(), &mut out);
-    let mut stream = Stream::new(
-        model.metadata(),
-        StreamOptions {
-            seed: 11,
-            steps: Some(3),
-            block_frames: Some(30),
-            ..StreamOptions::default()
-        },
-    )
-    .unwrap();
-    let a = stream.next(&mut model, 20).unwrap();
-    let b = stream.next(&mut model, 25).unwrap();
-    pose_lines("stream20", &a.poses(), &mut out);
-    pose_lines("stream25", &b.poses(), &mut out);
+    stream_lines(&mut model, "stream", &[], &mut out);
     // Steering the zombie walk: 40 frames at 12 units/s turning 0.3 rad/s, one-shot; and a
     // stream told 10 units/s turning -0.2 rad/s for 60 frames, read in chunks of 20 and 25.
     let mut zombie = Model::open(steer_model_path(), &ModelOptions { threads: Some(1) }).unwrap();
@@ -238,21 +250,12 @@ pub fn expected() -> BTreeMap<String, String> {
     )
     .unwrap();
     pose_lines("steer", &steered.poses(0).unwrap(), &mut out);
-    let mut stream = Stream::new(
-        zombie.metadata(),
-        StreamOptions {
-            seed: 11,
-            steps: Some(3),
-            block_frames: Some(30),
-            ..StreamOptions::default()
-        },
-    )
-    .unwrap();
-    stream.steer(&steer_commands(60, 10.0, -0.2)).unwrap();
-    let a = stream.next(&mut zombie, 20).unwrap();
-    let b = stream.next(&mut zombie, 25).unwrap();
-    pose_lines("steerstream20", &a.poses(), &mut out);
-    pose_lines("steerstream25", &b.poses(), &mut out);
+    stream_lines(
+        &mut zombie,
+        "steerstream",
+        &steer_commands(60, 10.0, -0.2),
+        &mut out,
+    );
     out
 }
 

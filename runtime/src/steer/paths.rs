@@ -2,6 +2,7 @@
 //! a given speed, as per-frame positions in the model's file frame.
 
 use crate::model_file::ModelMetadata;
+use crate::motion::RootStart;
 use crate::motion::features::heading::yaw;
 use crate::motion::math::Vec3;
 
@@ -20,11 +21,12 @@ pub enum Shape {
 /// The start course of a heading-relative model: its root's canonical ground position and
 /// facing at frame 0; `None` for another root layout.
 pub fn start_course(metadata: &ModelMetadata) -> Option<(Vec3, f64)> {
-    let root = metadata.layout.root.as_ref()?;
-    let heading = root.heading.as_ref()?;
-    let mut p = root.start_position;
-    p[crate::motion::up::UP] = 0.0;
-    Some((p, heading.start))
+    let RootStart {
+        mut position,
+        heading,
+    } = RootStart::of(&metadata.layout)?;
+    position[crate::motion::up::UP] = 0.0;
+    Some((position, heading))
 }
 
 /// The clip's mean forward speed, file units per second (what a path is walked at unless told

@@ -476,21 +476,7 @@ impl Stream {
         } else {
             let course = match (self.last_course, window.context) {
                 (Some(last), c) if c > 0 => Some((c - 1, last)),
-                _ => self
-                    .metadata
-                    .layout
-                    .root
-                    .as_ref()
-                    .and_then(|r| r.heading.as_ref().map(|h| (r, h)))
-                    .map(|(r, h)| {
-                        (
-                            0,
-                            RootStart {
-                                position: r.start_position,
-                                heading: h.start,
-                            },
-                        )
-                    }),
+                _ => RootStart::of(&self.metadata.layout).map(|start| (0, start)),
             };
             match course {
                 Some((anchor, course)) => {
@@ -553,31 +539,24 @@ impl Stream {
         let rows = raw.slice(s![.., ..done.end]);
         let mut last_root = self.last_root;
         let mut last_course = self.last_course;
-        let mut motion = match layout.root.as_ref().and_then(|r| r.heading.as_ref()) {
+        let mut motion = match RootStart::of(layout) {
             // A heading-relative root: the block's course is turned and moved so that it goes
             // on from the last final frame's position and facing.
-            Some(heading) => {
-                let root = layout
-                    .root
-                    .as_ref()
-                    .map_or(Vec3::ZERO, |r| r.start_position);
+            Some(first) => {
                 let start = match (self.last_course, done.start > 0) {
                     (Some(last), true) => {
                         let from_layout = root_track(layout, rows, None);
                         let (positions, headings) = from_layout.unwrap_or_default();
                         let k = done.start - 1;
                         let turn = last.heading - headings[k];
-                        let mut travelled = positions[k] - root;
+                        let mut travelled = positions[k] - first.position;
                         travelled[UP] = 0.0;
                         RootStart {
                             position: last.position - yaw(turn) * travelled,
-                            heading: heading.start + turn,
+                            heading: first.heading + turn,
                         }
                     }
-                    _ => RootStart {
-                        position: root,
-                        heading: heading.start,
-                    },
+                    _ => first,
                 };
                 let (positions, headings) =
                     root_track(layout, rows, Some(start)).unwrap_or_default();

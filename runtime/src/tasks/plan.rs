@@ -272,18 +272,12 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
             let ramp = check_ramp(*ramp)?;
             let mut per_frame = commands.clone();
             per_frame.resize(*frames, crate::steer::SteerFrame::Free);
-            let start = metadata
-                .layout
-                .root
-                .as_ref()
-                .and_then(|r| r.heading.as_ref().map(|h| (r.start_position, h.start)))
-                .map(|(position, heading)| crate::motion::RootStart { position, heading })
-                .ok_or_else(|| {
-                    TaskError::Steer(
-                        "the model has no heading-relative root (train it with --root-layout heading)"
-                            .into(),
-                    )
-                })?;
+            let start = crate::motion::RootStart::of(&metadata.layout).ok_or_else(|| {
+                TaskError::Steer(
+                    "the model has no heading-relative root (train it with --root-layout heading)"
+                        .into(),
+                )
+            })?;
             let planned = crate::steer::plan_steering(metadata, &per_frame, 0, start, ramp)
                 .map_err(TaskError::Steer)?;
             warnings = planned.warnings;

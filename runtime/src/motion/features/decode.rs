@@ -20,6 +20,18 @@ pub struct RootStart {
     pub heading: f64,
 }
 
+impl RootStart {
+    /// Where a layout's heading-relative root starts: its training clip's first position and
+    /// facing; `None` for another root layout.
+    pub fn of(layout: &FeatureLayout) -> Option<RootStart> {
+        let root = layout.root.as_ref()?;
+        Some(RootStart {
+            position: root.start_position,
+            heading: root.heading.as_ref()?.start,
+        })
+    }
+}
+
 /// Turns features `[F, N]` back into local joint transforms in the file's frame (its up axis,
 /// [`FeatureLayout::up`]). Contact labels are not needed to rebuild the pose and are ignored.
 pub fn decode(
@@ -36,12 +48,8 @@ pub fn root_track(
     features: ArrayView2<'_, f32>,
     start: Option<RootStart>,
 ) -> Option<(Vec<Vec3>, Vec<f64>)> {
-    let root = layout.root.as_ref()?;
-    let heading = root.heading.as_ref()?;
-    let start = start.unwrap_or(RootStart {
-        position: root.start_position,
-        heading: heading.start,
-    });
+    let first = RootStart::of(layout)?;
+    let start = start.unwrap_or(first);
     // Filled by a plain loop: collecting a mapped row iterator has memcheck report a branch on
     // the iterator's uninitialised size hint (a false report, but one that hides real ones).
     let column = |r: usize| -> Vec<f64> {
