@@ -12,4 +12,7 @@ CARGO_TARGET_DIR=target/burn-import-check \
 # MP3/OGG/FLAC input is a feature of the beat tracker's crate (symphonia), tested in its own
 # target folder so the workspace's default-feature build is not rebuilt back and forth.
 CARGO_TARGET_DIR=target/compressed cargo test --release -p sinmdm-beats --features compressed
+# The Bevy plugin: its own workspace and lockfile (Bevy's crates stay out of the main build),
+# tested with its AnimationClip feature in its own target folder.
+CARGO_TARGET_DIR=target/bevy cargo test --locked --manifest-path bindings/bevy/Cargo.toml --features animation-clip
 .venv/bin/python -m pytest -q tests/python

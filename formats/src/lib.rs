@@ -12,7 +12,7 @@ pub mod error;
 pub mod fbx;
 pub mod gltf;
 mod sampled;
-pub mod units;
+pub use sinmdm::motion::units;
 
 use std::path::Path;
 

@@ -16,6 +16,7 @@ pub mod resample;
 pub mod rotation;
 pub mod skeleton;
 pub mod smooth;
+pub mod units;
 pub mod up;
 pub mod up_detect;
 

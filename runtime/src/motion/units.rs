@@ -1,5 +1,5 @@
-//! The length unit of a clip, guessed from its skeleton height, for formats that fix one (glTF
-//! is in metres).
+//! The length unit of a clip, guessed from its skeleton height, for writers and engines that fix
+//! one (glTF and Bevy are in metres).
 
 /// What a file's unit was taken to be.
 #[derive(Debug, Clone, Copy, PartialEq)]

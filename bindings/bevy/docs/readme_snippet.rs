@@ -1,0 +1,15 @@
+// The Bevy snippet of the repository's README.md, section "Steering" (the lines from `use` to
+// the closing brace of `spawn_zombie`, line for line): change both together.
+// tests/readme_snippet.rs compiles it and runs it in a headless app.
+use bevy::prelude::*; // a game's Bevy, with DefaultPlugins
+use sinmdm_bevy::{CharacterOptions, MotionModel, SinmdmPlugin, Steering, spawn_character};
+
+// App::new().add_plugins((DefaultPlugins, SinmdmPlugin)).add_systems(Startup, spawn_zombie).run();
+fn spawn_zombie(mut commands: Commands) {
+    let model = MotionModel::open("onnx-models/human_zombie_walk_fair.onnx", Some(1)).unwrap();
+    let options = CharacterOptions::for_fps(model.fps());
+    let zombie = spawn_character(&mut commands, &model, options, Transform::default()).unwrap();
+    // 0.35 m/s, turning left at 0.3 rad/s; change the component to steer
+    commands.entity(zombie).insert(Steering::Velocity { forward: 0.35, turn: 0.3 });
+    // each joint is an entity with a Transform (a child of its parent joint, named after it)
+}

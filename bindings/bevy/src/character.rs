@@ -1,0 +1,390 @@
+//! A character driven by a stream: one entity per joint, poses written every frame from motion
+//! made ahead on Bevy's async compute pool.
+
+use std::collections::VecDeque;
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use bevy_ecs::prelude::*;
+use bevy_tasks::{AsyncComputeTaskPool, Task, block_on, futures::check_ready};
+use bevy_transform::components::Transform;
+use sinmdm::steer::SteerFrame;
+use sinmdm::{Model, ModelError, ModelOptions, Pose, Skeleton, Stream, StreamOptions, TaskError};
+
+use crate::frame::{EngineFrame, interpolate};
+use crate::steering::Steering;
+
+/// A model shared by any number of characters (each stream locks it while it denoises).
+#[derive(Clone)]
+pub struct MotionModel(Arc<Mutex<Model>>);
+
+impl MotionModel {
+    /// Opens a `.onnx` model file; `threads` as [`ModelOptions::threads`] (a stream denoises one
+    /// sample, so one thread is the usual choice in a game).
+    pub fn open(path: impl AsRef<Path>, threads: Option<usize>) -> Result<MotionModel, ModelError> {
+        Ok(MotionModel::from(Model::open(
+            path,
+            &ModelOptions { threads },
+        )?))
+    }
+
+    /// The model's frames per second.
+    pub fn fps(&self) -> f64 {
+        self.with(|m| m.fps())
+    }
+
+    /// Runs `f` on the model (waiting while a stream denoises on it).
+    pub fn with<R>(&self, f: impl FnOnce(&mut Model) -> R) -> R {
+        let mut guard = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        f(&mut guard)
+    }
+}
+
+impl From<Model> for MotionModel {
+    fn from(model: Model) -> MotionModel {
+        MotionModel(Arc::new(Mutex::new(model)))
+    }
+}
+
+/// How a character's motion is made and played.
+#[derive(Debug, Clone)]
+pub struct CharacterOptions {
+    /// The stream's options (seed, steps, block size, feet).
+    pub stream: StreamOptions,
+    /// Frames the stream hands out per request to the compute pool.
+    pub chunk_frames: usize,
+    /// Frames kept ready past the one on show; a new request starts when fewer are. `None`
+    /// adapts to the machine: a chunk plus twice the longest request so far, in frames, so
+    /// the next block is made before the frames ready run out.
+    pub ahead_frames: Option<usize>,
+    /// Metres per file unit; `None` guesses from the figure's height.
+    pub metres_per_unit: Option<f64>,
+    /// Whether the pose between two model frames is interpolated (otherwise the last frame is
+    /// held until the next one is due).
+    pub interpolate: bool,
+}
+
+impl CharacterOptions {
+    /// Options for a model at `fps`: half-second chunks, frames ready ahead as the machine
+    /// needs, interpolated, the stream's defaults.
+    pub fn for_fps(fps: f64) -> CharacterOptions {
+        CharacterOptions {
+            stream: StreamOptions::default(),
+            chunk_frames: (fps / 2.0).ceil().max(1.0) as usize,
+            ahead_frames: None,
+            metres_per_unit: None,
+            interpolate: true,
+        }
+    }
+}
+
+/// What a character's motion maker is doing.
+enum Maker {
+    /// Waiting for the next request.
+    Idle(Box<Engine>),
+    /// A request on the compute pool.
+    Busy(Task<Made>),
+    /// Stopped by an error (kept in [`MotionCharacter::error`]).
+    Stopped,
+}
+
+/// What a request gives back: the engine, the frames (or why there are none) and the seconds
+/// it took.
+type Made = (Box<Engine>, Result<Vec<Pose>, TaskError>, f64);
+
+/// The model and the stream on it, moved to the compute pool for each request.
+struct Engine {
+    model: MotionModel,
+    stream: Stream,
+}
+
+/// A character driven by a stream (on the entity that parents its top joints).
+#[derive(Component)]
+pub struct MotionCharacter {
+    joints: Vec<Entity>,
+    parents: Vec<Option<usize>>,
+    frame: EngineFrame,
+    fps: f64,
+    options: CharacterOptions,
+    steerable: bool,
+    clock: Option<f64>,
+    buffer: VecDeque<Pose>,
+    buffer_start: usize,
+    /// Stream frames given a steering command so far.
+    commanded: usize,
+    /// In a mutex only to make the component `Sync` (a stream is `Send`, not `Sync`); reached
+    /// through `&mut self`, so it is never locked.
+    maker: Mutex<Maker>,
+    frames_shown: u64,
+    waits: Vec<u64>,
+    slowest_request: f64,
+    error: Option<String>,
+    steering_note: Option<String>,
+}
+
+impl MotionCharacter {
+    /// The joint entities, in the model's skeleton order.
+    pub fn joints(&self) -> &[Entity] {
+        &self.joints
+    }
+
+    /// How the model's poses are placed in Bevy's frame.
+    pub fn frame(&self) -> EngineFrame {
+        self.frame
+    }
+
+    /// The model frame on show (fractional between two frames); `None` before the first.
+    pub fn clock(&self) -> Option<f64> {
+        self.clock
+    }
+
+    /// The model's frames per second.
+    pub fn fps(&self) -> f64 {
+        self.fps
+    }
+
+    /// The Bevy frames (counted from the character's first, 0) that had to wait for motion:
+    /// the first does (nothing is made before it); later ones only when the compute pool fell
+    /// behind.
+    pub fn waits(&self) -> &[u64] {
+        &self.waits
+    }
+
+    /// Bevy frames shown so far.
+    pub fn frames_shown(&self) -> u64 {
+        self.frames_shown
+    }
+
+    /// Frames kept ready past the one on show ([`CharacterOptions::ahead_frames`]).
+    pub fn ahead_frames(&self) -> usize {
+        let chunk = self.options.chunk_frames.max(1);
+        self.options
+            .ahead_frames
+            .unwrap_or_else(|| chunk + (2.0 * self.slowest_request * self.fps).ceil() as usize)
+    }
+
+    /// How many frames past the one on show already have their steering command: a change of
+    /// [`Steering`] shows in the motion within this many frames (the stream's lookahead plus
+    /// the frames made ahead of the one on show).
+    pub fn steering_reach(&self) -> usize {
+        let shown = self.clock.map_or(0, |c| c.floor() as usize);
+        self.commanded.saturating_sub(shown)
+    }
+
+    /// Why the motion stopped, if it did (the character then holds its last pose).
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_deref()
+    }
+
+    /// What became of a [`Steering`] the model cannot follow, if any.
+    pub fn steering_note(&self) -> Option<&str> {
+        self.steering_note.as_deref()
+    }
+
+    /// Advances the clock by `seconds` and writes the pose due into the joints' transforms.
+    pub(crate) fn drive(
+        &mut self,
+        seconds: f64,
+        steering: Option<&Steering>,
+        transforms: &mut Query<&mut Transform, Without<MotionCharacter>>,
+    ) {
+        let clock = self.clock.map_or(0.0, |c| c + seconds * self.fps);
+        self.clock = Some(clock);
+        let base = clock.floor() as usize;
+        let frac = (clock - base as f64) as f32;
+        let needed = if self.options.interpolate && frac > 0.0 {
+            base + 2
+        } else {
+            base + 1
+        };
+        self.collect(false);
+        if self.buffer_start + self.buffer.len() < needed && self.error.is_none() {
+            self.waits.push(self.frames_shown);
+            while self.buffer_start + self.buffer.len() < needed && self.error.is_none() {
+                self.request(steering);
+                self.collect(true);
+            }
+        }
+        // Frames before the one on show are not needed again.
+        let drop = base
+            .saturating_sub(self.buffer_start)
+            .min(self.buffer.len().saturating_sub(1));
+        self.buffer.drain(..drop);
+        self.buffer_start += drop;
+        if let Some(pose) = self.pose_at(base, frac) {
+            self.write(&pose, transforms);
+        }
+        let ready = (self.buffer_start + self.buffer.len()).saturating_sub(base);
+        if ready < self.ahead_frames() {
+            self.request(steering);
+        }
+        self.frames_shown += 1;
+    }
+
+    /// The pose at model frame `base` plus `frac`, from the frames ready (the last one ready
+    /// when the motion stopped short of it).
+    fn pose_at(&self, base: usize, frac: f32) -> Option<Pose> {
+        let i = base.checked_sub(self.buffer_start)?;
+        let a = self.buffer.get(i).or_else(|| self.buffer.back())?;
+        match self.buffer.get(i + 1) {
+            Some(b) if self.options.interpolate && frac > 0.0 => Some(interpolate(a, b, frac)),
+            _ => Some(a.clone()),
+        }
+    }
+
+    /// Writes `pose` into the joint entities' transforms.
+    fn write(&self, pose: &Pose, transforms: &mut Query<&mut Transform, Without<MotionCharacter>>) {
+        for (j, &entity) in self.joints.iter().enumerate() {
+            if let Ok(mut t) = transforms.get_mut(entity) {
+                *t = self
+                    .frame
+                    .joint_transform(pose, j, self.parents[j].is_none());
+            }
+        }
+    }
+
+    /// Takes the frames of a finished request (waiting for it when `wait`).
+    fn collect(&mut self, wait: bool) {
+        let Maker::Busy(task) = self.maker_mut() else {
+            return;
+        };
+        let done = if wait {
+            Some(block_on(task))
+        } else {
+            check_ready(task)
+        };
+        let Some((engine, result, seconds)) = done else {
+            return;
+        };
+        self.slowest_request = self.slowest_request.max(seconds);
+        match result {
+            Ok(poses) => {
+                self.buffer.extend(poses);
+                *self.maker_mut() = Maker::Idle(engine);
+            }
+            Err(e) => {
+                self.error = Some(e.to_string());
+                *self.maker_mut() = Maker::Stopped;
+            }
+        }
+    }
+
+    /// Starts the next request on the compute pool, if none is under way: steering commands
+    /// for every frame a block made by it may reach, then the next chunk of frames.
+    fn request(&mut self, steering: Option<&Steering>) {
+        let maker = std::mem::replace(self.maker_mut(), Maker::Stopped);
+        let Maker::Idle(mut engine) = maker else {
+            *self.maker_mut() = maker;
+            return;
+        };
+        let chunk = self.options.chunk_frames.max(1);
+        let command = self.command(steering);
+        let until = engine.stream.frames_handed_out() + chunk + engine.stream.lookahead();
+        if self.steerable && until > self.commanded {
+            let commands = vec![command; until - self.commanded];
+            if let Err(e) = engine.stream.steer(&commands) {
+                self.error = Some(e.to_string());
+                return;
+            }
+            self.commanded = until;
+        }
+        let task = AsyncComputeTaskPool::get().spawn(async move {
+            let started = Instant::now();
+            let model = engine.model.clone();
+            let result = model.with(|m| engine.stream.next(m, chunk).map(|c| c.poses()));
+            (engine, result, started.elapsed().as_secs_f64())
+        });
+        *self.maker_mut() = Maker::Busy(task);
+    }
+
+    /// The motion maker (the mutex is never contended: it is reached through `&mut self`).
+    fn maker_mut(&mut self) -> &mut Maker {
+        self.maker.get_mut().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The stream command for `steering` (free without one, or when the model cannot steer).
+    fn command(&mut self, steering: Option<&Steering>) -> SteerFrame {
+        match steering {
+            Some(s) if !self.steerable => {
+                if self.steering_note.is_none() {
+                    self.steering_note = Some(format!(
+                        "{s:?} ignored: the model has no heading-relative root (train it with --root-layout heading)"
+                    ));
+                }
+                SteerFrame::Free
+            }
+            Some(s) => s.command(&self.frame),
+            None => SteerFrame::Free,
+        }
+    }
+}
+
+/// Spawns a skeleton: an entity at `transform` and under it one entity per joint (named after
+/// it, with a [`Transform`] at its rest offset in Bevy's frame), parented as the skeleton is.
+/// Returns the entity and the joints' entities in skeleton order. [`spawn_character`] uses it;
+/// on its own it is a rig for baked clips.
+pub fn spawn_skeleton(
+    commands: &mut Commands,
+    skeleton: &Skeleton,
+    frame: &EngineFrame,
+    transform: Transform,
+) -> (Entity, Vec<Entity>) {
+    let root = commands.spawn(transform).id();
+    let mut joints: Vec<Entity> = Vec::with_capacity(skeleton.len());
+    for joint in &skeleton.joints {
+        let parent = joint.parent.map_or(root, |p| joints[p]);
+        let offset = bevy_math::Vec3::from_array(joint.offset.0.map(|v| v as f32));
+        let entity = commands
+            .spawn((
+                Name::new(joint.name.clone()),
+                Transform::from_translation(offset * frame.metres_per_unit),
+                ChildOf(parent),
+            ))
+            .id();
+        joints.push(entity);
+    }
+    (root, joints)
+}
+
+/// Spawns a character from `model`: a skeleton ([`spawn_skeleton`]) whose entity holds a
+/// [`MotionCharacter`] at `transform` (where the character stands in the world). Returns the
+/// character's entity.
+pub fn spawn_character(
+    commands: &mut Commands,
+    model: &MotionModel,
+    options: CharacterOptions,
+    transform: Transform,
+) -> Result<Entity, TaskError> {
+    let (metadata, stream) = model.with(|m| {
+        let metadata = m.metadata().clone();
+        Stream::new(&metadata, options.stream.clone()).map(|s| (metadata, s))
+    })?;
+    let frame = EngineFrame::of(&metadata, options.metres_per_unit);
+    let skeleton = &metadata.layout.skeleton;
+    let (character, joints) = spawn_skeleton(commands, skeleton, &frame, transform);
+    let steerable = sinmdm::steer::SteerLimits::of(&metadata).is_some();
+    let parents = skeleton.joints.iter().map(|j| j.parent).collect();
+    commands.entity(character).insert(MotionCharacter {
+        joints,
+        parents,
+        frame,
+        fps: metadata.layout.fps,
+        options,
+        steerable,
+        clock: None,
+        buffer: VecDeque::new(),
+        buffer_start: 0,
+        commanded: 0,
+        maker: Mutex::new(Maker::Idle(Box::new(Engine {
+            model: model.clone(),
+            stream,
+        }))),
+        frames_shown: 0,
+        waits: Vec::new(),
+        slowest_request: 0.0,
+        error: None,
+        steering_note: None,
+    });
+    Ok(character)
+}
