@@ -101,6 +101,7 @@ struct EvalFile<'a> {
     seed: u64,
     sampling_seconds: f64,
     report: &'a Report,
+    body_report: &'a Report,
     raw_motion_report: &'a Report,
     planted_report: &'a Report,
     feet: &'a FeetReport,
@@ -267,6 +268,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     let ModelEvaluation {
         generated,
         report,
+        body_report,
         raw_motion_report,
         planted_report,
         feet,
@@ -315,6 +317,15 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     println!("samples as the network made them (--feet raw):");
     print!("{}", report.markdown_table());
     print_rarely_made(&report, layout.fps);
+    println!(
+        "the body alone (no root rotation, which the root layouts mean differently): coverage {:.1}, \
+         global diversity {:.3}, local {:.3}, intra diversity diff {:.3} (clip's own {:.3})",
+        body_report.coverage.mean,
+        body_report.global_diversity.mean,
+        body_report.local_diversity.mean,
+        body_report.intra_diversity_diff,
+        body_report.clip_intra_diversity
+    );
     println!();
     println!("samples with their feet planted (the default output):");
     print!("{}", planted_report.markdown_table());
@@ -363,6 +374,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             seed: args.seed,
             sampling_seconds,
             report: &report,
+            body_report: &body_report,
             raw_motion_report: &raw_motion_report,
             planted_report: &planted_report,
             feet: &feet,

@@ -115,6 +115,32 @@ pub fn metric_features(layout: &FeatureLayout, features: ArrayView2<'_, f32>) ->
     })
 }
 
+/// The metric features of the body alone: as [`metric_features`] without the rotations of the
+/// top joints and of the joint that carries the root's travel, the columns whose meaning the
+/// root layout changes (a world rotation, or one relative to the facing). Two models of one
+/// clip with different root layouts are compared on these.
+pub fn body_metric_features(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> FrameRows {
+    let root = layout.root.as_ref().map(|r| r.joint);
+    let skeleton = &layout.skeleton;
+    let columns = layout.columns();
+    let keep: Vec<usize> = columns
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| match c.kind {
+            ColumnKind::Rotation6d(_) => {
+                skeleton.joints[c.joint].parent.is_some() && Some(c.joint) != root
+            }
+            ColumnKind::Contact => true,
+            _ => false,
+        })
+        .map(|(i, _)| i)
+        .collect();
+    let frames = features.len_of(Axis(1));
+    Array2::from_shape_fn((frames, keep.len()), |(n, c)| {
+        f64::from(features[[keep[c], n]])
+    })
+}
+
 /// The columns of `layout` whose kind `keep` accepts, as frame rows `[N, D]` (f64) of
 /// features `[F, N]`.
 pub(crate) fn frame_rows(

@@ -10,8 +10,8 @@ use sinmdm::{Denoiser, Generated, ModelMetadata, Request, TaskError};
 use thiserror::Error;
 
 use crate::{
-    COVERAGE_WINDOW, EvalError, FeetReport, REPLAY_TOLERANCE, ReplayReport, Report, evaluate,
-    metric_features, motion_metric_features,
+    COVERAGE_WINDOW, EvalError, FeetReport, REPLAY_TOLERANCE, ReplayReport, Report,
+    body_metric_features, evaluate, metric_features, motion_metric_features,
 };
 
 /// Why a model could not be scored.
@@ -35,6 +35,9 @@ pub struct ModelEvaluation {
     pub generated: Generated,
     /// Their scores against the clip, as the network made them.
     pub report: Report,
+    /// The same scores on the body alone ([`body_metric_features`]: no root rotation), which
+    /// compare models of one clip with different root layouts.
+    pub body_report: Report,
     /// The same scores of the raw motion as `--feet raw` writes it: decoded and re-encoded,
     /// as the planted motion is (the network's 6D values are not exact rotations, so decoding
     /// alone moves the scores a little). Planting's cost is `planted_report` against this.
@@ -106,6 +109,13 @@ pub fn evaluate_generated(
         .map(|sample| metric_features(layout, sample))
         .collect();
     let report = evaluate(clip_metric.view(), &samples, threads.max(1))?;
+    let body_samples: Vec<Array2<f64>> = generated
+        .features
+        .outer_iter()
+        .map(|sample| body_metric_features(layout, sample))
+        .collect();
+    let body_clip = body_metric_features(layout, clip);
+    let body_report = evaluate(body_clip.view(), &body_samples, threads.max(1))?;
     let replay =
         ReplayReport::of_features(layout, clip, generated.features.view(), REPLAY_TOLERANCE);
     let raw = (0..generated.count())
@@ -129,6 +139,7 @@ pub fn evaluate_generated(
     Ok(ModelEvaluation {
         generated,
         report,
+        body_report,
         raw_motion_report,
         planted_report,
         feet,

@@ -4,7 +4,7 @@
 use ndarray::{Array2, Axis, concatenate, s};
 use sinmdm::bvh::read_bvh;
 use sinmdm::motion::{EncodeOptions, encode};
-use sinmdm_eval::{Report, evaluate, metric_features};
+use sinmdm_eval::{Report, body_metric_features, evaluate, metric_features};
 
 fn walk() -> Array2<f64> {
     let path = concat!(
@@ -118,4 +118,25 @@ fn thread_count_does_not_change_the_result() {
     let one = evaluate(clip.view(), &samples, 1).unwrap();
     let two = evaluate(clip.view(), &samples, 2).unwrap();
     assert_eq!(one, two);
+}
+
+#[test]
+fn the_body_metric_leaves_out_the_root_rotation_and_nothing_else() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/data/bvh/human_walk_cmu_131_01.bvh"
+    );
+    let encoded = encode(&read_bvh(path).unwrap(), &EncodeOptions::default()).unwrap();
+    let layout = &encoded.layout;
+    let all = metric_features(layout, encoded.features.view());
+    let body = body_metric_features(layout, encoded.features.view());
+    // The CMU walk's Hips are both its top joint and the joint that travels, and its rotation
+    // comes first among the metric's columns: the body's are the rest, in order.
+    assert_eq!(layout.skeleton.joints[0].parent, None);
+    assert_eq!(layout.root.as_ref().unwrap().joint, 0);
+    assert_eq!(body.ncols(), all.ncols() - 6);
+    assert_eq!(body.nrows(), all.nrows());
+    for (i, column) in body.columns().into_iter().enumerate() {
+        assert_eq!(column, all.column(i + 6), "column {i}");
+    }
 }

@@ -14,7 +14,8 @@
 #   SHARED_BVH_DIR  the shared clip folder, if you have it: adds the MANN dog walk (60 fps,
 #                   learned at 30 fps and at its own rate) and the zombie walk
 # TRAIN_ARGS (environment) adds sinmdm-train arguments to every new run, for example
-# TRAIN_ARGS="--root-layout heading" for the heading-relative root's table.
+# TRAIN_ARGS="--root-layout world" or "--root-layout heading" for one root layout on every clip
+# (the default, auto, gives travelling clips the heading root and the rest the world root).
 # Pause any other training or benchmark while this runs: the times are wall-clock on this machine.
 set -euo pipefail
 cd "$(dirname "$0")/../.."

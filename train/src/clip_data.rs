@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use sinmdm::model_file::ClipSourceFacts;
-use sinmdm::motion::{ContactConfig, EncodeOptions, FeatureLayout, Normalizer, encode};
+use sinmdm::motion::{ContactConfig, EncodeOptions, FeatureLayout, Normalizer, RootLayout, encode};
 use sinmdm_formats::{AnimationChoice, ClipFormat, ReadOptions, read_clip};
 
 use crate::config::{DataConfig, ModelConfig};
@@ -36,6 +36,19 @@ pub struct ClipFacts {
     /// What the file was, when not BVH: its format and the animation read.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub source: Option<ClipSourceFacts>,
+    /// The root layout the features use and why (absent in runs made before it was recorded).
+    #[serde(default)]
+    pub root: String,
+}
+
+impl ClipFacts {
+    /// The root layout the clip's features use.
+    pub fn root_layout(&self) -> RootLayout {
+        self.layout
+            .root
+            .as_ref()
+            .map_or(RootLayout::World, |r| r.layout())
+    }
 }
 
 /// A clip ready for training: its facts and normalised features `[F, N]`.
@@ -134,8 +147,10 @@ impl ClipData {
             Some(found) => format!("{} (read from the motion)", found.describe()),
             None => format!("{} (data.up in the config)", encoded.layout.up),
         };
+        let root = describe_root(&encoded, data.root_layout);
         Ok(ClipData {
             facts: ClipFacts {
+                root,
                 up,
                 in_place: encoded.in_place,
                 name,
@@ -147,5 +162,33 @@ impl ClipData {
             },
             features,
         })
+    }
+}
+
+/// The root layout of `encoded` in words, with why it was chosen when `asked` was
+/// [`RootLayout::Auto`].
+fn describe_root(encoded: &sinmdm::motion::EncodedClip, asked: RootLayout) -> String {
+    let skeleton = &encoded.layout.skeleton;
+    let heading = encoded
+        .layout
+        .root
+        .as_ref()
+        .and_then(|r| r.heading.as_ref());
+    match (heading, &encoded.world_root_reason) {
+        (Some(h), _) => format!(
+            "heading-relative: facing across {} and {} (sides by {:?}){}",
+            skeleton.joints[h.left].name,
+            skeleton.joints[h.right].name,
+            h.sides,
+            if asked == RootLayout::Auto {
+                ", chosen from the clip (data.root_layout auto)"
+            } else {
+                ""
+            }
+        ),
+        (None, Some(why)) => format!(
+            "world: ground displacement in world axes; the heading-relative root needs what this clip lacks: {why} (data.root_layout auto)"
+        ),
+        (None, None) => "world: ground displacement in world axes (data.root_layout world)".into(),
     }
 }

@@ -150,8 +150,10 @@ impl Trainer {
             });
         }
         let data = ClipData::load(clip, &config.data, &config.model)?;
-        // The run saves the shape it trains: a window that follows the frame rate, resolved.
-        let config = config.at_fps(data.facts.layout.fps);
+        // The run saves the shape it trains: a window that follows the frame rate and a root
+        // layout chosen from the clip, resolved.
+        let mut config = config.at_fps(data.facts.layout.fps);
+        config.data.root_layout = data.facts.root_layout();
         std::fs::create_dir_all(run).map_err(io("create the output folder", run))?;
         let yaml = serde_yaml::to_string(&config).expect("config serialises");
         sinmdm::files::write_atomically(&run.join(CONFIG_COPY), yaml.as_bytes())
@@ -197,7 +199,11 @@ impl Trainer {
         })?;
         let mut state = checkpoint::load_state(&dir)?;
         if let Some(asked) = &config {
-            let asked = asked.at_fps(state.clip.layout.fps);
+            let mut asked = asked.at_fps(state.clip.layout.fps);
+            // `auto` chose from this clip when the run started: the choice stands.
+            if asked.data.root_layout == sinmdm::motion::RootLayout::Auto {
+                asked.data.root_layout = state.config.data.root_layout;
+            }
             if let Some(message) = state.config.resume_difference(&asked) {
                 return Err(TrainError::Checkpoint { path: dir, message });
             }

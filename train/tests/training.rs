@@ -154,6 +154,46 @@ fn a_window_that_follows_the_frame_rate_is_saved_resolved_and_resumes() {
 }
 
 #[test]
+fn an_automatic_root_layout_is_chosen_from_the_clip_saved_and_resumes() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let mut config = tiny();
+    config.data.root_layout = sinmdm::motion::RootLayout::Auto;
+    config.training.steps = 1;
+    config.training.checkpoint_every = 1;
+    let fox = root().join("tests/data/bvh/fox_survey_khronos.bvh");
+    for (clip, chosen) in [
+        (walk(), sinmdm::motion::RootLayout::Heading),
+        (fox, sinmdm::motion::RootLayout::World),
+    ] {
+        let run = scratch(&format!("auto-root-{chosen}"));
+        let _ = std::fs::remove_dir_all(&run);
+        let mut trainer =
+            Trainer::start(&clip, config.clone(), &run, Device::flex().autodiff()).unwrap();
+        trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
+        let saved = TrainConfig::load(&run.join("config.yaml")).unwrap();
+        assert_eq!(saved.data.root_layout, chosen);
+        assert_eq!(trainer.state().clip.root_layout(), chosen);
+        let words = &trainer.state().clip.root;
+        match chosen {
+            sinmdm::motion::RootLayout::Heading => {
+                assert!(words.contains("chosen from the clip"), "{words}")
+            }
+            _ => assert!(words.contains("nothing to steer"), "{words}"),
+        }
+        drop(trainer);
+        // The unresolved config resumes the run: the choice stands.
+        let mut longer = config.clone();
+        longer.training.steps = 2;
+        let mut resumed =
+            Trainer::resume(&run, None, Some(longer), Device::flex().autodiff()).unwrap();
+        resumed.run(&AtomicBool::new(false), |_| {}).unwrap();
+        assert_eq!(resumed.state().step, 2);
+        drop(resumed);
+        std::fs::remove_dir_all(&run).unwrap();
+    }
+}
+
+#[test]
 fn each_checkpoint_records_the_batch_its_steps_had() {
     let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
     let run = scratch("batch-shape");
@@ -389,7 +429,10 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
                 default.training.steps
             ))
             && text.contains("(249 frames at 30 fps)")
-            && text.contains("receptive field 23 frames (QnA window 3)"),
+            && text.contains("receptive field 23 frames (QnA window 3)")
+            // The default gives a walk the heading-relative root, and says so.
+            && text.contains("root            heading-relative: facing across LeftHip and RightHip")
+            && text.contains("chosen from the clip (data.root_layout auto)"),
         "{text}"
     );
     let out = Command::new(bin)

@@ -9,7 +9,7 @@ fn spawn_zombie(mut commands: Commands) {
     let model = MotionModel::open("onnx-models/human_zombie_walk_fair.onnx", Some(1)).unwrap();
     let options = CharacterOptions::for_fps(model.fps());
     let zombie = spawn_character(&mut commands, &model, options, Transform::default()).unwrap();
-    // 0.35 m/s, turning left at 0.3 rad/s; change the component to steer
-    commands.entity(zombie).insert(Steering::Velocity { forward: 0.35, turn: 0.3 });
+    // at the clip's speed, turning left at 0.3 rad/s (or Velocity { forward, turn } in m/s)
+    commands.entity(zombie).insert(Steering::Turn { turn: 0.3 });
     // each joint is an entity with a Transform (a child of its parent joint, named after it)
 }

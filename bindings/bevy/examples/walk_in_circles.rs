@@ -1,5 +1,7 @@
 //! A character from the shipped zombie walk, steered round a circle: a headless app at 60 fps
-//! that prints where the character is each second. A game adds its own plugins (rendering,
+//! that prints where the character is each second. The zombie rig's unit is not written in its
+//! file; 44 units tall, it is guessed as centimetres (set `CharacterOptions::metres_per_unit`
+//! when you know better). A game adds its own plugins (rendering,
 //! input) and a mesh skinned to the joint entities; the sinmdm part is the same.
 //!
 //! `cargo run --release --example walk_in_circles -- [MODEL] [SECONDS]`
@@ -60,9 +62,8 @@ fn spawn(mut commands: Commands, settings: Res<Settings>) {
     let character =
         sinmdm_bevy::spawn_character(&mut commands, &settings.model, options, Transform::IDENTITY)
             .expect("the model makes a stream");
-    // About 0.35 m/s, a full turn every 20 s.
-    commands.entity(character).insert(Steering::Velocity {
-        forward: 0.35,
+    // The clip's own speed, a full turn every 20 s.
+    commands.entity(character).insert(Steering::Turn {
         turn: std::f32::consts::TAU / 20.0,
     });
 }

@@ -9,15 +9,23 @@ use std::time::Instant;
 use bevy_ecs::prelude::*;
 use bevy_tasks::{AsyncComputeTaskPool, Task, block_on, futures::check_ready};
 use bevy_transform::components::Transform;
-use sinmdm::steer::SteerFrame;
-use sinmdm::{Model, ModelError, ModelOptions, Pose, Skeleton, Stream, StreamOptions, TaskError};
+use sinmdm::steer::SteerLimits;
+use sinmdm::{
+    Model, ModelError, ModelMetadata, ModelOptions, Pose, Skeleton, Stream, StreamOptions,
+    TaskError,
+};
 
 use crate::frame::{EngineFrame, interpolate};
 use crate::steering::Steering;
 
-/// A model shared by any number of characters (each stream locks it while it denoises).
+/// A model shared by any number of characters. Its metadata is read without waiting; its
+/// network is locked by one stream at a time while it denoises, so characters on one model take
+/// turns (open the file once per character to run them side by side on several threads).
 #[derive(Clone)]
-pub struct MotionModel(Arc<Mutex<Model>>);
+pub struct MotionModel {
+    model: Arc<Mutex<Model>>,
+    metadata: Arc<ModelMetadata>,
+}
 
 impl MotionModel {
     /// Opens a `.onnx` model file; `threads` as [`ModelOptions::threads`] (a stream denoises one
@@ -29,21 +37,30 @@ impl MotionModel {
         )?))
     }
 
-    /// The model's frames per second.
-    pub fn fps(&self) -> f64 {
-        self.with(|m| m.fps())
+    /// The model file's metadata (skeleton, frame rate, layout).
+    pub fn metadata(&self) -> &ModelMetadata {
+        &self.metadata
     }
 
-    /// Runs `f` on the model (waiting while a stream denoises on it).
+    /// The model's frames per second.
+    pub fn fps(&self) -> f64 {
+        self.metadata.layout.fps
+    }
+
+    /// Runs `f` on the model, waiting while a stream denoises on it.
     pub fn with<R>(&self, f: impl FnOnce(&mut Model) -> R) -> R {
-        let mut guard = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        let mut guard = self.model.lock().unwrap_or_else(|p| p.into_inner());
         f(&mut guard)
     }
 }
 
 impl From<Model> for MotionModel {
     fn from(model: Model) -> MotionModel {
-        MotionModel(Arc::new(Mutex::new(model)))
+        let metadata = Arc::new(model.metadata().clone());
+        MotionModel {
+            model: Arc::new(Mutex::new(model)),
+            metadata,
+        }
     }
 }
 
@@ -107,7 +124,8 @@ pub struct MotionCharacter {
     frame: EngineFrame,
     fps: f64,
     options: CharacterOptions,
-    steerable: bool,
+    /// The clip's speed range, for a heading-relative model (`None`: it cannot steer).
+    limits: Option<SteerLimits>,
     clock: Option<f64>,
     buffer: VecDeque<Pose>,
     buffer_start: usize,
@@ -121,6 +139,7 @@ pub struct MotionCharacter {
     slowest_request: f64,
     error: Option<String>,
     steering_note: Option<String>,
+    stream_warnings: Vec<String>,
 }
 
 impl MotionCharacter {
@@ -164,9 +183,9 @@ impl MotionCharacter {
             .unwrap_or_else(|| chunk + (2.0 * self.slowest_request * self.fps).ceil() as usize)
     }
 
-    /// How many frames past the one on show already have their steering command: a change of
-    /// [`Steering`] shows in the motion within this many frames (the stream's lookahead plus
-    /// the frames made ahead of the one on show).
+    /// How many model frames past the one on show already have their steering command: a
+    /// change of [`Steering`] shows in the motion within this many frames (the frames made
+    /// ahead, and the rest of the last block started; shorter blocks steer sooner).
     pub fn steering_reach(&self) -> usize {
         let shown = self.clock.map_or(0, |c| c.floor() as usize);
         self.commanded.saturating_sub(shown)
@@ -177,20 +196,39 @@ impl MotionCharacter {
         self.error.as_deref()
     }
 
-    /// What became of a [`Steering`] the model cannot follow, if any.
+    /// What the stream changed of the steering commands (speeds and turns clamped to the clip's
+    /// range), one line per kind, as of the last request.
+    pub fn warnings(&self) -> &[String] {
+        &self.stream_warnings
+    }
+
+    /// What became of a [`Steering`] that could not be followed as given, if any (a model
+    /// without a heading-relative root, a value that is not finite), the latest.
     pub fn steering_note(&self) -> Option<&str> {
         self.steering_note.as_deref()
     }
 
-    /// Advances the clock by `seconds` and writes the pose due into the joints' transforms.
-    pub(crate) fn drive(
+    /// Advances the clock by `seconds`, takes the frames of a finished request and starts the
+    /// next one if fewer than [`Self::ahead_frames`] frames are ready; never waits.
+    pub(crate) fn advance(&mut self, seconds: f64, steering: Option<&Steering>) {
+        let clock = self.clock.map_or(0.0, |c| c + seconds * self.fps);
+        self.clock = Some(clock);
+        self.collect(false);
+        let base = clock.floor() as usize;
+        let past_shown = (self.buffer_start + self.buffer.len()).saturating_sub(base + 1);
+        if past_shown < self.ahead_frames() {
+            self.request(steering);
+        }
+    }
+
+    /// Writes the pose due into the joints' transforms, waiting for the frames it needs when
+    /// they are not ready (recorded in [`Self::waits`]). Runs after [`Self::advance`].
+    pub(crate) fn show(
         &mut self,
-        seconds: f64,
         steering: Option<&Steering>,
         transforms: &mut Query<&mut Transform, Without<MotionCharacter>>,
     ) {
-        let clock = self.clock.map_or(0.0, |c| c + seconds * self.fps);
-        self.clock = Some(clock);
+        let clock = self.clock.unwrap_or(0.0);
         let base = clock.floor() as usize;
         let frac = (clock - base as f64) as f32;
         let needed = if self.options.interpolate && frac > 0.0 {
@@ -198,7 +236,6 @@ impl MotionCharacter {
         } else {
             base + 1
         };
-        self.collect(false);
         if self.buffer_start + self.buffer.len() < needed && self.error.is_none() {
             self.waits.push(self.frames_shown);
             while self.buffer_start + self.buffer.len() < needed && self.error.is_none() {
@@ -213,11 +250,13 @@ impl MotionCharacter {
         self.buffer.drain(..drop);
         self.buffer_start += drop;
         if let Some(pose) = self.pose_at(base, frac) {
-            self.write(&pose, transforms);
-        }
-        let ready = (self.buffer_start + self.buffer.len()).saturating_sub(base);
-        if ready < self.ahead_frames() {
-            self.request(steering);
+            for (j, &entity) in self.joints.iter().enumerate() {
+                if let Ok(mut t) = transforms.get_mut(entity) {
+                    *t = self
+                        .frame
+                        .joint_transform(&pose, j, self.parents[j].is_none());
+                }
+            }
         }
         self.frames_shown += 1;
     }
@@ -230,17 +269,6 @@ impl MotionCharacter {
         match self.buffer.get(i + 1) {
             Some(b) if self.options.interpolate && frac > 0.0 => Some(interpolate(a, b, frac)),
             _ => Some(a.clone()),
-        }
-    }
-
-    /// Writes `pose` into the joint entities' transforms.
-    fn write(&self, pose: &Pose, transforms: &mut Query<&mut Transform, Without<MotionCharacter>>) {
-        for (j, &entity) in self.joints.iter().enumerate() {
-            if let Ok(mut t) = transforms.get_mut(entity) {
-                *t = self
-                    .frame
-                    .joint_transform(pose, j, self.parents[j].is_none());
-            }
         }
     }
 
@@ -261,6 +289,9 @@ impl MotionCharacter {
         match result {
             Ok(poses) => {
                 self.buffer.extend(poses);
+                if self.stream_warnings.as_slice() != engine.stream.warnings() {
+                    self.stream_warnings = engine.stream.warnings().to_vec();
+                }
                 *self.maker_mut() = Maker::Idle(engine);
             }
             Err(e) => {
@@ -271,7 +302,7 @@ impl MotionCharacter {
     }
 
     /// Starts the next request on the compute pool, if none is under way: steering commands
-    /// for every frame a block made by it may reach, then the next chunk of frames.
+    /// for every frame the blocks it may start reach, then the next chunk of frames.
     fn request(&mut self, steering: Option<&Steering>) {
         let maker = std::mem::replace(self.maker_mut(), Maker::Stopped);
         let Maker::Idle(mut engine) = maker else {
@@ -279,15 +310,28 @@ impl MotionCharacter {
             return;
         };
         let chunk = self.options.chunk_frames.max(1);
-        let command = self.command(steering);
-        let until = engine.stream.frames_handed_out() + chunk + engine.stream.lookahead();
-        if self.steerable && until > self.commanded {
-            let commands = vec![command; until - self.commanded];
-            if let Err(e) = engine.stream.steer(&commands) {
-                self.error = Some(e.to_string());
-                return;
+        if self.limits.is_some() {
+            // `next(chunk)` starts blocks until the frames made final reach `handed_out +
+            // chunk`; block k's window ends at (k + 1) B + R, so the last one started ends at
+            // the next multiple of B past that, plus R.
+            let sizes = engine.stream.sizes();
+            let block = sizes.block.max(1);
+            let finals = engine.stream.frames_handed_out() + chunk;
+            let until = finals.div_ceil(block) * block + sizes.ramp;
+            if until > self.commanded {
+                let command = self.command(steering);
+                let commands = vec![command; until - self.commanded];
+                match engine.stream.steer(&commands) {
+                    Ok(()) => self.commanded = until,
+                    Err(e) => self.steering_note = Some(e.to_string()),
+                }
             }
-            self.commanded = until;
+        } else if let Some(s) = steering
+            && self.steering_note.is_none()
+        {
+            self.steering_note = Some(format!(
+                "{s:?} ignored: the model has no heading-relative root (train it with --root-layout heading)"
+            ));
         }
         let task = AsyncComputeTaskPool::get().spawn(async move {
             let started = Instant::now();
@@ -298,32 +342,31 @@ impl MotionCharacter {
         *self.maker_mut() = Maker::Busy(task);
     }
 
+    /// The stream command for `steering` (free without one, or for a value that is not
+    /// finite, which is noted).
+    fn command(&mut self, steering: Option<&Steering>) -> sinmdm::steer::SteerFrame {
+        let (Some(steering), Some(limits)) = (steering, self.limits.as_ref()) else {
+            return sinmdm::steer::SteerFrame::Free;
+        };
+        match steering.command(&self.frame, limits) {
+            Ok(command) => command,
+            Err(why) => {
+                self.steering_note = Some(why);
+                sinmdm::steer::SteerFrame::Free
+            }
+        }
+    }
+
     /// The motion maker (the mutex is never contended: it is reached through `&mut self`).
     fn maker_mut(&mut self) -> &mut Maker {
         self.maker.get_mut().unwrap_or_else(|p| p.into_inner())
     }
-
-    /// The stream command for `steering` (free without one, or when the model cannot steer).
-    fn command(&mut self, steering: Option<&Steering>) -> SteerFrame {
-        match steering {
-            Some(s) if !self.steerable => {
-                if self.steering_note.is_none() {
-                    self.steering_note = Some(format!(
-                        "{s:?} ignored: the model has no heading-relative root (train it with --root-layout heading)"
-                    ));
-                }
-                SteerFrame::Free
-            }
-            Some(s) => s.command(&self.frame),
-            None => SteerFrame::Free,
-        }
-    }
 }
 
 /// Spawns a skeleton: an entity at `transform` and under it one entity per joint (named after
-/// it, with a [`Transform`] at its rest offset in Bevy's frame), parented as the skeleton is.
-/// Returns the entity and the joints' entities in skeleton order. [`spawn_character`] uses it;
-/// on its own it is a rig for baked clips.
+/// it, with a [`Transform`] at its rest offset, the top joints turned into Bevy's frame),
+/// parented as the skeleton is. Returns the entity and the joints' entities in skeleton order.
+/// [`spawn_character`] uses it; on its own it is a rig for baked clips.
 pub fn spawn_skeleton(
     commands: &mut Commands,
     skeleton: &Skeleton,
@@ -333,14 +376,17 @@ pub fn spawn_skeleton(
     let root = commands.spawn(transform).id();
     let mut joints: Vec<Entity> = Vec::with_capacity(skeleton.len());
     for joint in &skeleton.joints {
-        let parent = joint.parent.map_or(root, |p| joints[p]);
-        let offset = bevy_math::Vec3::from_array(joint.offset.0.map(|v| v as f32));
+        let offset =
+            bevy_math::Vec3::from_array(joint.offset.0.map(|v| v as f32)) * frame.metres_per_unit;
+        let (parent, rest) = match joint.parent {
+            Some(p) => (joints[p], Transform::from_translation(offset)),
+            None => (
+                root,
+                Transform::from_translation(frame.turn * offset).with_rotation(frame.turn),
+            ),
+        };
         let entity = commands
-            .spawn((
-                Name::new(joint.name.clone()),
-                Transform::from_translation(offset * frame.metres_per_unit),
-                ChildOf(parent),
-            ))
+            .spawn((Name::new(joint.name.clone()), rest, ChildOf(parent)))
             .id();
         joints.push(entity);
     }
@@ -349,21 +395,19 @@ pub fn spawn_skeleton(
 
 /// Spawns a character from `model`: a skeleton ([`spawn_skeleton`]) whose entity holds a
 /// [`MotionCharacter`] at `transform` (where the character stands in the world). Returns the
-/// character's entity.
+/// character's entity, or why the stream cannot be made (options it refuses, a unit scale that
+/// is not a positive number).
 pub fn spawn_character(
     commands: &mut Commands,
     model: &MotionModel,
     options: CharacterOptions,
     transform: Transform,
 ) -> Result<Entity, TaskError> {
-    let (metadata, stream) = model.with(|m| {
-        let metadata = m.metadata().clone();
-        Stream::new(&metadata, options.stream.clone()).map(|s| (metadata, s))
-    })?;
-    let frame = EngineFrame::of(&metadata, options.metres_per_unit);
+    let metadata = model.metadata();
+    let frame = EngineFrame::of(metadata, options.metres_per_unit).map_err(TaskError::Stream)?;
+    let stream = Stream::new(metadata, options.stream.clone())?;
     let skeleton = &metadata.layout.skeleton;
     let (character, joints) = spawn_skeleton(commands, skeleton, &frame, transform);
-    let steerable = sinmdm::steer::SteerLimits::of(&metadata).is_some();
     let parents = skeleton.joints.iter().map(|j| j.parent).collect();
     commands.entity(character).insert(MotionCharacter {
         joints,
@@ -371,7 +415,7 @@ pub fn spawn_character(
         frame,
         fps: metadata.layout.fps,
         options,
-        steerable,
+        limits: SteerLimits::of(metadata),
         clock: None,
         buffer: VecDeque::new(),
         buffer_start: 0,
@@ -385,6 +429,7 @@ pub fn spawn_character(
         slowest_request: 0.0,
         error: None,
         steering_note: None,
+        stream_warnings: Vec::new(),
     });
     Ok(character)
 }

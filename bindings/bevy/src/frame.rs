@@ -20,18 +20,29 @@ pub struct EngineFrame {
 
 impl EngineFrame {
     /// The frame of a model: its up axis from the model file, its unit guessed from the
-    /// figure's height (as the glTF writer does) unless `metres_per_unit` says it.
-    pub fn of(metadata: &ModelMetadata, metres_per_unit: Option<f64>) -> EngineFrame {
+    /// figure's height (as the glTF writer does) unless `metres_per_unit` says it (which must
+    /// then be a positive number).
+    pub fn of(
+        metadata: &ModelMetadata,
+        metres_per_unit: Option<f64>,
+    ) -> Result<EngineFrame, String> {
         let layout = &metadata.layout;
         let m = layout.up.canonical_from_file();
         let columns = m.transpose().0.map(|c| c.map(|v| v as f32));
         let turn = Quat::from_mat3(&Mat3::from_cols_array_2d(&columns)).normalize();
-        let metres = metres_per_unit
-            .unwrap_or_else(|| UnitGuess::from_height(layout.skeleton_height).metres_per_unit());
-        EngineFrame {
+        let metres = match metres_per_unit {
+            Some(m) if m.is_finite() && m > 0.0 => m,
+            Some(m) => {
+                return Err(format!(
+                    "metres_per_unit must be a positive number of metres per file unit, got {m}"
+                ));
+            }
+            None => UnitGuess::from_height(layout.skeleton_height).metres_per_unit(),
+        };
+        Ok(EngineFrame {
             turn,
             metres_per_unit: metres as f32,
-        }
+        })
     }
 
     /// The local transform of joint `joint` of `pose` in Bevy's frame (`top` when the joint is
@@ -46,9 +57,14 @@ impl EngineFrame {
         }
     }
 
-    /// A speed in metres per second as file units per second.
+    /// A length in metres as file units.
     pub fn to_file_units(&self, metres: f32) -> f64 {
-        f64::from(metres / self.metres_per_unit)
+        f64::from(metres) / f64::from(self.metres_per_unit)
+    }
+
+    /// A length in file units as metres.
+    pub fn to_metres(&self, units: f64) -> f32 {
+        (units * f64::from(self.metres_per_unit)) as f32
     }
 }
 

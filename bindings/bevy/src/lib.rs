@@ -23,7 +23,7 @@ pub mod steering;
 #[cfg(feature = "animation-clip")]
 pub mod bake;
 
-use bevy_app::{App, Plugin, PostUpdate};
+use bevy_app::{AnimationSystems, App, Plugin, PostUpdate};
 use bevy_ecs::prelude::*;
 use bevy_time::Time;
 use bevy_transform::TransformSystems;
@@ -36,7 +36,8 @@ pub use frame::EngineFrame;
 pub use steering::Steering;
 
 /// The plugin: drives every [`MotionCharacter`] in [`PostUpdate`], in [`SinmdmSystems::Drive`],
-/// before transform propagation.
+/// after Bevy's animation systems (so a stream's pose wins over a clip playing on the same
+/// joints) and before transform propagation.
 pub struct SinmdmPlugin;
 
 /// The plugin's system sets, for ordering a game's own systems around them.
@@ -50,13 +51,16 @@ impl Plugin for SinmdmPlugin {
     fn build(&self, app: &mut App) {
         app.configure_sets(
             PostUpdate,
-            SinmdmSystems::Drive.before(TransformSystems::Propagate),
+            SinmdmSystems::Drive
+                .after(AnimationSystems)
+                .before(TransformSystems::Propagate),
         )
         .add_systems(PostUpdate, drive_characters.in_set(SinmdmSystems::Drive));
     }
 }
 
-/// Advances every character by the frame's time and writes its pose.
+/// Advances every character by the frame's time and writes its pose: first every character's
+/// clock and requests (so the compute pool works on all of them at once), then the poses.
 fn drive_characters(
     time: Res<Time>,
     mut characters: Query<(&mut MotionCharacter, Option<&Steering>)>,
@@ -64,6 +68,9 @@ fn drive_characters(
 ) {
     let seconds = time.delta_secs_f64();
     for (mut character, steering) in &mut characters {
-        character.drive(seconds, steering, &mut transforms);
+        character.advance(seconds, steering);
+    }
+    for (mut character, steering) in &mut characters {
+        character.show(steering, &mut transforms);
     }
 }

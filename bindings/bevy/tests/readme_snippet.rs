@@ -7,7 +7,7 @@ use std::time::Duration;
 /// What the snippet's `use bevy::prelude::*` brings that it uses, from Bevy's own crates.
 mod bevy {
     pub mod prelude {
-        pub use bevy_ecs::prelude::{Commands, Component};
+        pub use bevy_ecs::prelude::Commands;
         pub use bevy_transform::components::Transform;
     }
 }
@@ -36,19 +36,29 @@ fn the_readme_snippet_spawns_a_walking_zombie() {
     )))
     .add_systems(Startup, spawn_zombie);
     let mut roots = Vec::new();
-    for _ in 0..120 {
+    for _ in 0..240 {
         app.update();
         let world = app.world_mut();
         let mut query = world.query::<&MotionCharacter>();
         let character = query.single(world).expect("one character");
         assert_eq!(character.joints().len(), 27);
+        assert!(character.steering_note().is_none());
         let root = character.joints()[0];
         roots.push(world.get::<GlobalTransform>(root).unwrap().translation());
     }
-    // Two seconds at the commanded 0.35 m/s: it walks (the clip's own speed varies round it).
-    let d = roots[119] - roots[0];
-    let walked = d.x.hypot(d.z);
-    assert!((0.2..1.4).contains(&walked), "walked {walked} m in 2 s");
+    // The direction of travel over the first second and over the fourth: turned left (a left
+    // turn about +Y takes +Z toward +X) by about the commanded 0.3 rad/s over 3 s.
+    let heading = |a: usize, b: usize| {
+        let d = roots[b] - roots[a];
+        f64::from(d.x).atan2(f64::from(d.z))
+    };
+    let mut turned = heading(180, 239) - heading(0, 59);
+    if turned > std::f64::consts::PI {
+        turned -= std::f64::consts::TAU;
+    } else if turned < -std::f64::consts::PI {
+        turned += std::f64::consts::TAU;
+    }
+    assert!((0.45..1.35).contains(&turned), "turned {turned} rad in 3 s");
 }
 
 #[test]

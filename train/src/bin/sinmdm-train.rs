@@ -56,9 +56,10 @@ struct Args {
     #[arg(long, value_name = "K")]
     window: Option<usize>,
     /// How a new run describes the root, replacing the config's data.root_layout: `world`
-    /// (ground displacement in world axes and a world rotation) or `heading` (speeds and turn
-    /// in the character's facing frame, which steering needs).
-    #[arg(long, value_name = "world|heading")]
+    /// (ground displacement in world axes and a world rotation), `heading` (speeds and turn
+    /// in the character's facing frame, which steering needs) or `auto` (the default: heading
+    /// where the clip has a facing pair and a travelling root, world otherwise).
+    #[arg(long, value_name = "world|heading|auto")]
     root_layout: Option<sinmdm::motion::RootLayout>,
     /// Run folder: checkpoints, loss.csv, loss.png.
     #[arg(long)]
@@ -253,16 +254,7 @@ fn dry_run(args: &Args) -> Result<()> {
         println!("cycle           in place: contacts measured against the treadmill");
     }
     println!("features F      {features}");
-    if let Some(root) = &data.facts.layout.root {
-        let skeleton = &data.facts.layout.skeleton;
-        match &root.heading {
-            Some(h) => println!(
-                "root            heading-relative: facing across {} and {} (sides by {:?})",
-                skeleton.joints[h.left].name, skeleton.joints[h.right].name, h.sides
-            ),
-            None => println!("root            world: ground displacement in world axes"),
-        }
-    }
+    println!("root            {}", data.facts.root);
     println!("channels C      {}", config.model.channels);
     println!("parameters      {}", model.num_params());
     println!(
@@ -381,6 +373,9 @@ fn main() -> Result<()> {
         state.config.training.steps
     );
     eprintln!("up axis {}", state.clip.up);
+    if !state.clip.root.is_empty() {
+        eprintln!("root {}", state.clip.root);
+    }
     if state.clip.in_place {
         eprintln!("in-place cycle: contacts measured against the treadmill");
     }

@@ -194,8 +194,10 @@ pub struct DataConfig {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub animation: Option<String>,
     /// How the root is described: `world` (ground displacement in world axes and a world
-    /// rotation, as SinMDM) or `heading` (speeds and turn in the character's facing frame, what
-    /// steering needs; SPEC section 2).
+    /// rotation, as SinMDM), `heading` (speeds and turn in the character's facing frame, what
+    /// steering needs; SPEC section 2) or `auto` (heading where the clip has a facing pair and
+    /// a travelling root, world otherwise; a run's saved configuration holds what was chosen).
+    /// Absent: `world`, as configurations written before the heading root read.
     #[serde(default, skip_serializing_if = "is_world")]
     pub root_layout: sinmdm::motion::RootLayout,
 }

@@ -5,8 +5,8 @@ use ndarray::Array2;
 use super::FeatureMatrix;
 use super::error::MotionError;
 use super::heading::{
-    HEADING_SMOOTHING_SECONDS, Heading, RootLayout, SideEvidence, facing_angles, facing_pair,
-    left_by_name, root_columns, yaw,
+    HEADING_MIN_TRAVEL, HEADING_SMOOTHING_SECONDS, Heading, RootLayout, SideEvidence,
+    facing_angles, facing_pair, left_by_name, median_travel, root_columns, yaw,
 };
 use super::layout::{FeatureLayout, RootFeatures};
 use crate::limits::MAX_ENCODED_FRAMES;
@@ -59,6 +59,9 @@ pub struct EncodedClip {
     /// The clip is an in-place cycle (its root does not travel) and its contacts were labelled
     /// relative to the treadmill.
     pub in_place: bool,
+    /// Why [`RootLayout::Auto`] chose the world root (the clip lacks what the heading-relative
+    /// root needs); `None` when it chose the heading root or the layout was asked for.
+    pub world_root_reason: Option<String>,
 }
 
 /// Relative change under which a channel counts as constant.
@@ -264,12 +267,37 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         ground: Some(ground_level(&layout.contact_joints, &poses)),
         ..layout
     };
-    if options.root == RootLayout::Heading {
-        let heading = choose_heading(&layout, &local, &poses)?;
-        if let Some(root) = layout.root.as_mut() {
-            root.axes = vec![Axis::X, Axis::Y, Axis::Z];
-            root.heading = Some(heading);
+    let mut world_root_reason = None;
+    let heading = match options.root {
+        RootLayout::World => None,
+        RootLayout::Heading => Some(choose_heading(&layout, &local, &poses)?),
+        RootLayout::Auto => {
+            let travel = layout.root.as_ref().map_or(0.0, |r| {
+                median_travel(&poses, r.joint, layout.fps, layout.skeleton_height)
+            });
+            if travel < HEADING_MIN_TRAVEL {
+                world_root_reason = Some(format!(
+                    "its root travels {travel:.2} heights/s (the median over 1-second windows), \
+                     under the {HEADING_MIN_TRAVEL} of locomotion, so there is nothing to steer"
+                ));
+                None
+            } else {
+                match choose_heading(&layout, &local, &poses) {
+                    Ok(heading) => Some(heading),
+                    Err(MotionError::Heading(why)) => {
+                        world_root_reason = Some(why);
+                        None
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
         }
+    };
+    if let Some(heading) = heading
+        && let Some(root) = layout.root.as_mut()
+    {
+        root.axes = vec![Axis::X, Axis::Y, Axis::Z];
+        root.heading = Some(heading);
     }
 
     let filled = fill_features(&layout, &local, &poses);
@@ -279,6 +307,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         contact_share: filled.contact_share,
         up_detection,
         in_place: filled.in_place,
+        world_root_reason,
     })
 }
 

@@ -30,16 +30,26 @@ use crate::motion::up::{GROUND_PLANE, UP};
 /// second, so the hips' sway about the course is smoothed out and a turn is not.
 pub const HEADING_SMOOTHING_SECONDS: f64 = 0.2;
 
-/// Which root description a model's features use.
+/// Which root description a model's features use, or (as a request) which to choose.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RootLayout {
     /// As SinMDM: ground displacement in world axes, height, and the root's world rotation.
+    /// The default of a request that names none (a configuration written before the heading
+    /// layout existed).
     #[default]
     World,
     /// Forward and leftward speed in the facing frame, turn rate, height, and the root's
     /// rotation relative to the facing frame.
     Heading,
+    /// A request only (configurations, encode options), chosen from the clip: [`Heading`]
+    /// for locomotion that has what it needs (a root that travels at least
+    /// [`HEADING_MIN_TRAVEL`] and a facing pair), [`World`] otherwise, saying why. Encoded
+    /// features are always one of the two.
+    ///
+    /// [`Heading`]: RootLayout::Heading
+    /// [`World`]: RootLayout::World
+    Auto,
 }
 
 impl std::fmt::Display for RootLayout {
@@ -47,6 +57,7 @@ impl std::fmt::Display for RootLayout {
         f.write_str(match self {
             RootLayout::World => "world",
             RootLayout::Heading => "heading",
+            RootLayout::Auto => "auto",
         })
     }
 }
@@ -57,8 +68,9 @@ impl std::str::FromStr for RootLayout {
         match s.trim().to_ascii_lowercase().as_str() {
             "world" => Ok(RootLayout::World),
             "heading" => Ok(RootLayout::Heading),
+            "auto" => Ok(RootLayout::Auto),
             other => Err(format!(
-                "unknown root layout '{other}': use 'world' or 'heading'"
+                "unknown root layout '{other}': use 'world', 'heading' or 'auto'"
             )),
         }
     }
@@ -140,6 +152,34 @@ pub fn wrap(angle: f64) -> f64 {
     } else {
         a
     }
+}
+
+/// The least travel, in skeleton heights per second, at which [`RootLayout::Auto`] takes a clip
+/// for locomotion and gives it the heading-relative root: the median of the root's ground
+/// distance over 1-second windows. Walks, hops and dog walks travel 0.25-1.0 heights per
+/// second by that measure and a dog's run 6; a kick 0.13, the Rokoko dance 0.10, the fox's
+/// survey and in-place cycles 0. A clip that hardly travels has nothing to steer, and on the
+/// dance the heading root's samples were 3 % less diverse (docs/STEERING.md).
+pub const HEADING_MIN_TRAVEL: f64 = 0.15;
+
+/// The median ground distance the joint `root` covers in 1-second windows (windows starting a
+/// quarter second apart), in `height`s per second; 0 for a clip shorter than a second.
+pub fn median_travel(poses: &[GlobalPose], root: usize, fps: f64, height: f64) -> f64 {
+    let window = fps.round().max(1.0) as usize;
+    let step = (window / 4).max(1);
+    let mut distances: Vec<f64> = (0..poses.len().saturating_sub(window))
+        .step_by(step)
+        .map(|f| {
+            let mut d = poses[f + window].joints[root] - poses[f].joints[root];
+            d[UP] = 0.0;
+            d.norm() / height
+        })
+        .collect();
+    if distances.is_empty() {
+        return 0.0;
+    }
+    distances.sort_by(f64::total_cmp);
+    distances[distances.len() / 2] * fps / window as f64
 }
 
 /// The facing pair of `skeleton`: two joints whose chains mirror each other (the same depth,
