@@ -129,6 +129,7 @@ fn run_check(valgrind: bool) -> String {
         .arg(&not_a_model)
         .arg(&bvh)
         .arg(steer_model_path())
+        .arg(world_root_model_path())
         .env("ORT_DYLIB_PATH", onnxruntime_path())
         .output()
         .expect("could not start the check program (valgrind missing? run scripts/setup.sh)");

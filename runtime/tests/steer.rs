@@ -239,8 +239,9 @@ fn a_heading_streams_blocks_continue_the_course() {
 
 #[test]
 fn a_world_root_model_refuses_steering() {
-    let mut walk = model("human_walk_cmu.onnx");
-    let metadata = walk.metadata().clone();
+    // The shipped hop keeps the world root it was trained with.
+    let mut hop = model("human_hop_cmu.onnx");
+    let metadata = hop.metadata().clone();
     assert!(SteerLimits::of(&metadata).is_none());
     let request = Request {
         task: Task::Steer {
@@ -254,7 +255,7 @@ fn a_world_root_model_refuses_steering() {
         feet: Feet::Raw,
         method: Default::default(),
     };
-    let e = sinmdm::run(&mut walk, &request, &mut go()).unwrap_err();
+    let e = sinmdm::run(&mut hop, &request, &mut go()).unwrap_err();
     assert!(matches!(e, TaskError::Steer(_)), "{e}");
     assert!(e.to_string().contains("heading-relative"), "{e}");
     let mut stream = Stream::new(&metadata, StreamOptions::default()).unwrap();

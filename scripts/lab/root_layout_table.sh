@@ -2,7 +2,7 @@
 # Scores models of the same clips with the world and the heading-relative root side by side:
 # coverage and global diversity on the whole metric (which includes the root joint's rotation,
 # meant differently by the two layouts) and on the body alone (the joints below the root, which
-# `sinmdm eval` reports as body_report), replay and jitter. 20 samples of twice the clip's
+# `sinmdm eval` reports as body_report), replay, jitter and foot skating (SPEC section 9). 20 samples of twice the clip's
 # length, default sampling, eval seeds 0-2 (mean and standard error).
 #
 # Usage: scripts/lab/root_layout_table.sh WORLD_DIR HEADING_DIR [SHARED_BVH_DIR]
@@ -52,8 +52,8 @@ def stat(folder, name, pick):
     return statistics.mean(values), statistics.stdev(values) / len(values) ** 0.5
 
 
-print("| clip | root | coverage | global diversity | body coverage | body global diversity | body: clip's own intra diversity | replay (s) | jitter x clip |")
-print("|---|---|---|---|---|---|---|---|---|")
+print("| clip | root | coverage | global diversity | body coverage | body global diversity | body: clip's own intra diversity | replay (s) | jitter x clip | skating, planted (clip) |")
+print("|---|---|---|---|---|---|---|---|---|---|")
 for name in names:
     for label, folder in (("world", world), ("heading", heading)):
         cells = [
@@ -65,8 +65,11 @@ for name in names:
         clip_intra = json.loads((folder / f"{name}.layouts.seed0.json").read_text())["body_report"]["clip_intra_diversity"]
         replay = stat(folder, name, lambda d: d["replay"]["mean_seconds"])
         jitter = stat(folder, name, lambda d: d["feet"]["raw"]["jitter_ratio"])
+        skating = stat(folder, name, lambda d: d["feet"]["planted"]["mean"]["skating_ratio"])
+        clip_skating = json.loads((folder / f"{name}.layouts.seed0.json").read_text())["feet"]["clip"]["skating_ratio"]
         print(f"| {name if label == 'world' else ''} | {label} | "
               f"{cells[0][0]:.1f} ± {cells[0][1]:.1f} | {cells[1][0]:.3f} ± {cells[1][1]:.3f} | "
               f"{cells[2][0]:.1f} ± {cells[2][1]:.1f} | {cells[3][0]:.3f} ± {cells[3][1]:.3f} | "
-              f"{clip_intra:.3f} | {replay[0]:.2f} | {jitter[0]:.2f} |")
+              f"{clip_intra:.3f} | {replay[0]:.2f} | {jitter[0]:.2f} | "
+              f"{skating[0]:.3f} ({clip_skating:.3f}) |")
 PY

@@ -3,8 +3,9 @@
  * Rust test can compare them with the Rust API's exactly; then every entry point fed bad
  * arguments, each of which must give its status code and a message, never a crash.
  *
- * Usage: api_check MODEL.onnx NOT_A_MODEL_FILE OUT.bvh STEERABLE_MODEL.onnx (a heading-relative
- * model, for the steering checks)
+ * Usage: api_check MODEL.onnx NOT_A_MODEL_FILE OUT.bvh STEERABLE_MODEL.onnx WORLD_ROOT_MODEL.onnx
+ * (a heading-relative model, for the steering checks, and one with the world root, which refuses
+ * steering)
  * Prints "<label> <hex> <hex> ..." lines, then "bad arguments: N checks" on success. */
 #include <math.h>
 #include <stdint.h>
@@ -247,9 +248,10 @@ static void steer_velocity(SinmdmSteerFrame *frames, size_t count, double forwar
 /* Steering the zombie walk (a heading-relative model): its limits, a one-shot run of 40 frames
    at 12 units/s turning 0.3 rad/s, a stream told 10 units/s turning -0.2 rad/s, and the
    refusals: a world-root model, a bad kind, a non-finite value, a NULL array. */
-static void check_steering(const char *path, SinmdmModel *world) {
-  SinmdmModel *zombie = NULL;
+static void check_steering(const char *path, const char *world_path) {
+  SinmdmModel *zombie = NULL, *world = NULL;
   CHECK_OK(sinmdm_model_open(path, 1, &zombie));
+  CHECK_OK(sinmdm_model_open(world_path, 1, &world));
   SinmdmModelInfo info;
   CHECK_OK(sinmdm_model_info(zombie, &info));
   SinmdmSteerLimits limits;
@@ -300,11 +302,13 @@ static void check_steering(const char *path, SinmdmModel *world) {
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_steer_limits(zombie, NULL));
   sinmdm_stream_free(stream);
   sinmdm_model_free(zombie);
+  sinmdm_model_free(world);
 }
 
 int main(int argc, char **argv) {
-  if (argc != 5) {
-    fprintf(stderr, "usage: api_check MODEL.onnx NOT_A_MODEL OUT.bvh STEERABLE_MODEL.onnx\n");
+  if (argc != 6) {
+    fprintf(stderr,
+            "usage: api_check MODEL.onnx NOT_A_MODEL OUT.bvh STEERABLE_MODEL.onnx WORLD_ROOT_MODEL.onnx\n");
     return 2;
   }
   CHECK_OK(sinmdm_load_onnxruntime(NULL));
@@ -400,7 +404,7 @@ int main(int argc, char **argv) {
   print_poses("stream20", &chunk_a);
   print_poses("stream25", &chunk_b);
 
-  check_steering(argv[4], model);
+  check_steering(argv[4], argv[5]);
 
   CHECK_OK(sinmdm_write_bvh(model, &reference, argv[3]));
 

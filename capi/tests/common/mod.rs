@@ -19,6 +19,11 @@ pub fn model_path() -> PathBuf {
     repo().join("onnx-models/human_walk_cmu.onnx")
 }
 
+/// A shipped world-root model (the hop), which refuses steering.
+pub fn world_root_model_path() -> PathBuf {
+    repo().join("onnx-models/human_hop_cmu.onnx")
+}
+
 /// The shipped heading-relative model the steering checks run on.
 pub fn steer_model_path() -> PathBuf {
     repo().join("onnx-models/human_zombie_walk_fair.onnx")
