@@ -42,7 +42,7 @@ mod window_match;
 use ndarray::{Array2, ArrayView2, Axis};
 use thiserror::Error;
 
-use sinmdm::motion::{ColumnKind, FeatureLayout, LocalMotion, encode_motion};
+use sinmdm::motion::{Column, ColumnKind, FeatureLayout, LocalMotion, encode_motion};
 
 pub use report::{RarelyMade, Report, SampleScores, Stat, harmonic_mean, normalised_scores};
 
@@ -110,8 +110,8 @@ pub type FrameRows = Array2<f64>;
 /// The metric features of a motion: rows are frames, columns every 6D rotation component and
 /// every contact label of `layout`, from features `[F, N]` in file units.
 pub fn metric_features(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> FrameRows {
-    frame_rows(layout, features, |kind| {
-        matches!(kind, ColumnKind::Rotation6d(_) | ColumnKind::Contact)
+    frame_rows(layout, features, |column| {
+        matches!(column.kind, ColumnKind::Rotation6d(_) | ColumnKind::Contact)
     })
 }
 
@@ -122,37 +122,27 @@ pub fn metric_features(layout: &FeatureLayout, features: ArrayView2<'_, f32>) ->
 pub fn body_metric_features(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> FrameRows {
     let root = layout.root.as_ref().map(|r| r.joint);
     let skeleton = &layout.skeleton;
-    let columns = layout.columns();
-    let keep: Vec<usize> = columns
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| match c.kind {
-            ColumnKind::Rotation6d(_) => {
-                skeleton.joints[c.joint].parent.is_some() && Some(c.joint) != root
-            }
-            ColumnKind::Contact => true,
-            _ => false,
-        })
-        .map(|(i, _)| i)
-        .collect();
-    let frames = features.len_of(Axis(1));
-    Array2::from_shape_fn((frames, keep.len()), |(n, c)| {
-        f64::from(features[[keep[c], n]])
+    frame_rows(layout, features, |column| match column.kind {
+        ColumnKind::Rotation6d(_) => {
+            skeleton.joints[column.joint].parent.is_some() && Some(column.joint) != root
+        }
+        ColumnKind::Contact => true,
+        _ => false,
     })
 }
 
-/// The columns of `layout` whose kind `keep` accepts, as frame rows `[N, D]` (f64) of
+/// The columns of `layout` that `keep` accepts, as frame rows `[N, D]` (f64) of
 /// features `[F, N]`.
 pub(crate) fn frame_rows(
     layout: &FeatureLayout,
     features: ArrayView2<'_, f32>,
-    keep: impl Fn(ColumnKind) -> bool,
+    keep: impl Fn(&Column) -> bool,
 ) -> FrameRows {
     let columns: Vec<usize> = layout
         .columns()
         .iter()
         .enumerate()
-        .filter(|(_, c)| keep(c.kind))
+        .filter(|(_, c)| keep(c))
         .map(|(i, _)| i)
         .collect();
     let frames = features.len_of(Axis(1));

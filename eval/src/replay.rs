@@ -24,8 +24,8 @@ pub const REPLAY_TOLERANCE: f64 = 0.05;
 /// The 6D rotation values of a motion: rows are frames, columns every `Rotation6d` column of
 /// `layout`, from features `[F, N]` in file units.
 pub fn rotation_rows(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> Array2<f64> {
-    crate::frame_rows(layout, features, |kind| {
-        matches!(kind, ColumnKind::Rotation6d(_))
+    crate::frame_rows(layout, features, |column| {
+        matches!(column.kind, ColumnKind::Rotation6d(_))
     })
 }
 
