@@ -51,7 +51,7 @@ namespace Sinmdm
         }
 
         [StructLayout(LayoutKind.Sequential)]
-        internal struct SteerLimits { public double ForwardMin, ForwardMax, TurnMax; }
+        internal struct SteerLimits { public double ForwardMin, ForwardMax, TurnMax, SidewaysMin, SidewaysMax; }
 
         [StructLayout(LayoutKind.Sequential)]
         internal struct StreamOptions

@@ -74,7 +74,7 @@ namespace Sinmdm
     }
 
     /// <summary>What a steering frame asks for.</summary>
-    public enum SteerKind : uint { Free = 0, Velocity = 1, Position = 2 }
+    public enum SteerKind : uint { Free = 0, Velocity = 1, Position = 2, Facing = 3, PositionFacing = 4 }
 
     /// <summary>One frame's steering command for a heading-relative model (file frame: the
     /// model's up axis and units); the layout of the C ABI's SinmdmSteerFrame.</summary>
@@ -82,26 +82,38 @@ namespace Sinmdm
     public struct SteerFrame
     {
         public SteerKind Kind;
-        /// <summary>0 (keeps the numbers 8-byte aligned; the C struct is 48 bytes).</summary>
+        /// <summary>0 (keeps the numbers 8-byte aligned; the C struct is 72 bytes).</summary>
         public uint Reserved;
         /// <summary>Velocity: forward speed, file units per second.</summary>
         public double Forward;
         /// <summary>Velocity: turn rate, radians per second; positive turns left.</summary>
         public double Turn;
-        /// <summary>Position: the root's ground position (the up component is ignored).</summary>
+        /// <summary>Position and PositionFacing: the root's ground position (the up component
+        /// is ignored).</summary>
         public double X, Y, Z;
+        /// <summary>Facing and PositionFacing: the direction the character faces (the up
+        /// component is ignored; the rest must not be zero).</summary>
+        public double FacingX, FacingY, FacingZ;
 
         public static SteerFrame Velocity(double forward, double turn) =>
             new SteerFrame { Kind = SteerKind.Velocity, Forward = forward, Turn = turn };
 
         public static SteerFrame Position(double x, double y, double z) =>
             new SteerFrame { Kind = SteerKind.Position, X = x, Y = y, Z = z };
+
+        public static SteerFrame Facing(double x, double y, double z) =>
+            new SteerFrame { Kind = SteerKind.Facing, FacingX = x, FacingY = y, FacingZ = z };
+
+        public static SteerFrame PositionFacing(double x, double y, double z, double facingX, double facingY, double facingZ) =>
+            new SteerFrame { Kind = SteerKind.PositionFacing, X = x, Y = y, Z = z, FacingX = facingX, FacingY = facingY, FacingZ = facingZ };
     }
 
     /// <summary>The range of steering commands a model's clip supports.</summary>
     public struct SteerLimits
     {
         public double ForwardMin, ForwardMax, TurnMax;
+        /// <summary>Fastest rightward (negative) and leftward speeds, file units per second.</summary>
+        public double SidewaysMin, SidewaysMax;
     }
 
     /// <summary>The order of a dance's keyframes.</summary>
@@ -359,7 +371,7 @@ namespace Sinmdm
         public SteerLimits SteerLimits()
         {
             Native.Check(Native.sinmdm_steer_limits(Handle, out Native.SteerLimits l));
-            return new SteerLimits { ForwardMin = l.ForwardMin, ForwardMax = l.ForwardMax, TurnMax = l.TurnMax };
+            return new SteerLimits { ForwardMin = l.ForwardMin, ForwardMax = l.ForwardMax, TurnMax = l.TurnMax, SidewaysMin = l.SidewaysMin, SidewaysMax = l.SidewaysMax };
         }
 
         /// <summary>New motion of `frames` frames whose root goes where `commands` say (one per

@@ -226,9 +226,20 @@
 #define SINMDM_STEER_VELOCITY 1
 
 /*
- A frame that asks for the root's position on the ground.
+ A frame that asks for the root's position on the ground (facing the way the path goes).
  */
 #define SINMDM_STEER_POSITION 2
+
+/*
+ A frame that asks for the direction the character faces (where it goes is the model's).
+ */
+#define SINMDM_STEER_FACING 3
+
+/*
+ A frame that asks for the root's position on the ground and, apart, the direction the
+ character faces (a path walked sideways or backwards).
+ */
+#define SINMDM_STEER_POSITION_FACING 4
 
 /*
  What a call did. Every function returns one; on anything but `SINMDM_OK`,
@@ -509,6 +520,14 @@ typedef struct SinmdmSteerLimits {
    Largest turn rate either way, radians per second.
    */
   double turn_max;
+  /*
+   Fastest rightward speed (as a negative leftward one), file units per second.
+   */
+  double sideways_min;
+  /*
+   Fastest leftward speed, file units per second.
+   */
+  double sideways_max;
 } SinmdmSteerLimits;
 
 /*
@@ -516,12 +535,12 @@ typedef struct SinmdmSteerLimits {
  */
 typedef struct SinmdmSteerFrame {
   /*
-   `SINMDM_STEER_FREE`, `SINMDM_STEER_VELOCITY` or `SINMDM_STEER_POSITION`.
+   `SINMDM_STEER_FREE`, `_VELOCITY`, `_POSITION`, `_FACING` or `_POSITION_FACING`.
    */
   uint32_t kind;
   /*
    Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
-   included, so the struct is 48 bytes everywhere).
+   included, so the struct is 72 bytes everywhere).
    */
   uint32_t reserved;
   /*
@@ -534,9 +553,15 @@ typedef struct SinmdmSteerFrame {
    */
   double turn;
   /*
-   `SINMDM_STEER_POSITION`: the root's position, file frame (the up component is ignored).
+   `SINMDM_STEER_POSITION` and `_POSITION_FACING`: the root's position, file frame (the up
+   component is ignored).
    */
   double position[3];
+  /*
+   `SINMDM_STEER_FACING` and `_POSITION_FACING`: the direction the character faces, file
+   frame (the up component is ignored; the rest must not be zero).
+   */
+  double facing[3];
 } SinmdmSteerFrame;
 
 /*

@@ -20,28 +20,37 @@ use crate::text::{handle, slice_arg};
 pub const SINMDM_STEER_FREE: u32 = 0;
 /// A frame that asks for a forward speed and a turn rate.
 pub const SINMDM_STEER_VELOCITY: u32 = 1;
-/// A frame that asks for the root's position on the ground.
+/// A frame that asks for the root's position on the ground (facing the way the path goes).
 pub const SINMDM_STEER_POSITION: u32 = 2;
+/// A frame that asks for the direction the character faces (where it goes is the model's).
+pub const SINMDM_STEER_FACING: u32 = 3;
+/// A frame that asks for the root's position on the ground and, apart, the direction the
+/// character faces (a path walked sideways or backwards).
+pub const SINMDM_STEER_POSITION_FACING: u32 = 4;
 
 /// One frame's steering command (file frame: the model's up axis and units).
 #[repr(C)]
 #[derive(Debug, Clone, Copy)]
 pub struct SinmdmSteerFrame {
-    /// `SINMDM_STEER_FREE`, `SINMDM_STEER_VELOCITY` or `SINMDM_STEER_POSITION`.
+    /// `SINMDM_STEER_FREE`, `_VELOCITY`, `_POSITION`, `_FACING` or `_POSITION_FACING`.
     pub kind: u32,
     /// Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
-    /// included, so the struct is 48 bytes everywhere).
+    /// included, so the struct is 72 bytes everywhere).
     pub reserved: u32,
     /// `SINMDM_STEER_VELOCITY`: forward speed, file units per second.
     pub forward: f64,
     /// `SINMDM_STEER_VELOCITY`: turn rate, radians per second; positive turns left
     /// (counter-clockwise seen from above).
     pub turn: f64,
-    /// `SINMDM_STEER_POSITION`: the root's position, file frame (the up component is ignored).
+    /// `SINMDM_STEER_POSITION` and `_POSITION_FACING`: the root's position, file frame (the up
+    /// component is ignored).
     pub position: [f64; 3],
+    /// `SINMDM_STEER_FACING` and `_POSITION_FACING`: the direction the character faces, file
+    /// frame (the up component is ignored; the rest must not be zero).
+    pub facing: [f64; 3],
 }
 
-const _: () = assert!(std::mem::size_of::<SinmdmSteerFrame>() == 48);
+const _: () = assert!(std::mem::size_of::<SinmdmSteerFrame>() == 72);
 const _: () = assert!(std::mem::offset_of!(SinmdmSteerFrame, forward) == 8);
 
 /// The range of commands a model's clip supports (what is beyond it is clamped).
@@ -54,6 +63,10 @@ pub struct SinmdmSteerLimits {
     pub forward_max: f64,
     /// Largest turn rate either way, radians per second.
     pub turn_max: f64,
+    /// Fastest rightward speed (as a negative leftward one), file units per second.
+    pub sideways_min: f64,
+    /// Fastest leftward speed, file units per second.
+    pub sideways_max: f64,
 }
 
 /// The library's commands from a caller array of at most `SINMDM_MAX_SAMPLE_FRAMES` frames.
@@ -97,8 +110,20 @@ unsafe fn commands_arg(
                     finite(&f.position, "position")?;
                     Ok(SteerFrame::Position(Vec3(f.position)))
                 }
+                SINMDM_STEER_FACING => {
+                    finite(&f.facing, "facing")?;
+                    Ok(SteerFrame::Facing(Vec3(f.facing)))
+                }
+                SINMDM_STEER_POSITION_FACING => {
+                    finite(&f.position, "position")?;
+                    finite(&f.facing, "facing")?;
+                    Ok(SteerFrame::PositionFacing {
+                        position: Vec3(f.position),
+                        facing: Vec3(f.facing),
+                    })
+                }
                 other => Err(Failure::invalid(format!(
-                    "commands[{i}].kind must be SINMDM_STEER_FREE (0), _VELOCITY (1) or _POSITION (2), got {other}"
+                    "commands[{i}].kind must be SINMDM_STEER_FREE (0), _VELOCITY (1), _POSITION (2), _FACING (3) or _POSITION_FACING (4), got {other}"
                 ))),
             }
         })
@@ -127,6 +152,8 @@ pub unsafe extern "C" fn sinmdm_steer_limits(
             forward_min: limits.forward.0,
             forward_max: limits.forward.1,
             turn_max: limits.turn,
+            sideways_min: limits.sideways.0,
+            sideways_max: limits.sideways.1,
         };
         Ok(())
     })

@@ -290,7 +290,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     };
 
     if let Some(commands) = &commands {
-        crate::steer::print_following(&generated, commands);
+        crate::steer::print_following(&generated, model.metadata(), commands);
     }
     crate::steer::print_facing(&generated, clip.view());
     let steps_text = steps.map_or("all".to_string(), |s| s.to_string());

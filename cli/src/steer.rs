@@ -12,9 +12,9 @@ use sinmdm::Generated;
 use sinmdm::model_file::ModelMetadata;
 use sinmdm::motion::features::heading::facing_against_travel;
 use sinmdm::motion::math::Vec3;
-use sinmdm::steer::follow::{path_following, velocity_following};
+use sinmdm::steer::follow::{facing_following, path_following, velocity_following};
 use sinmdm::steer::paths::{Shape, clip_speed, path};
-use sinmdm::steer::{SteerFrame, SteerLimits};
+use sinmdm::steer::{SteerFrame, SteerLimits, facing_of_direction};
 use sinmdm::tasks::{INBETWEEN_RAMP, Task};
 
 pub(crate) const EXAMPLES: &str = "Examples:
@@ -22,12 +22,17 @@ pub(crate) const EXAMPLES: &str = "Examples:
   sinmdm steer -m onnx-models/human_zombie_walk_fair.onnx --figure8 3 --count 8 -o out/eight.glb
   sinmdm steer -m zombie.onnx --velocity schedule.csv --seconds 12 -o out/steered.bvh --report
   sinmdm steer -m zombie.onnx --path path.csv -o out/along.bvh
+  sinmdm steer -m zombie.onnx --circle 3 --face 1,0,0 -o out/strafe.bvh --report
+  sinmdm steer -m zombie.onnx --face 0,1,0 --seconds 8 -o out/turned.bvh
 
 --circle and --figure8 take the radius in character heights and start where the model's clip
 starts, facing its way. --path reads one ground position per frame (x,y,z in the model's file
-frame and units; the up component is ignored). --velocity reads lines `seconds,speed,turn`: from
-that time on, forward speed in file units per second and turn rate in degrees per second
-(positive turns left). Commands the clip never showed are clamped to its range, with a warning.";
+frame and units; the up component is ignored), or x,y,z,fx,fy,fz: the position and the
+direction to face there. --velocity reads lines `seconds,speed,turn`: from that time on, forward
+speed in file units per second and turn rate in degrees per second (positive turns left).
+--face X,Y,Z (file frame) keeps the character facing that way: alone, it goes where the model
+likes; with a path, it walks the path in that facing (sideways or backwards where the path asks).
+Commands the clip never showed are clamped to its range, with a warning.";
 
 /// Where a steered run goes: shared by `sinmdm steer` and `sinmdm eval`.
 #[derive(Debug, Clone, Args)]
@@ -38,13 +43,24 @@ pub struct CourseArgs {
     /// Walk a figure eight of two circles of this radius, in character heights.
     #[arg(long, value_name = "R", group = "course")]
     pub figure8: Option<f64>,
-    /// Follow a path: one ground position per frame, `x,y,z` per line (file frame and units).
+    /// Follow a path: one ground position per frame, `x,y,z` per line (file frame and units),
+    /// or `x,y,z,fx,fy,fz`: the position and the direction to face there.
     #[arg(long, value_name = "PATH.csv", group = "course")]
     pub path: Option<PathBuf>,
     /// Follow a schedule of velocities: lines `seconds,speed,turn` (file units per second,
     /// degrees per second), each holding until the next.
     #[arg(long, value_name = "SCHEDULE.csv", group = "course")]
     pub velocity: Option<PathBuf>,
+    /// Face this direction, `x,y,z` in the file frame (the up component is ignored): alone, the
+    /// model goes where it likes; with --circle, --figure8 or --path, the path is walked in this
+    /// facing.
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        conflicts_with = "velocity",
+        allow_hyphen_values = true
+    )]
+    pub face: Option<String>,
     /// Speed along --circle and --figure8, file units per second (default: the clip's mean
     /// forward speed, or half its top speed when that is faster).
     #[arg(long)]
@@ -58,6 +74,7 @@ impl CourseArgs {
             || self.figure8.is_some()
             || self.path.is_some()
             || self.velocity.is_some()
+            || self.face.is_some()
     }
 
     /// The commands of `frames` frames (a --path brings its own length), checked against the
@@ -102,12 +119,31 @@ impl CourseArgs {
             Some(read_path(file)?)
         } else if let Some(file) = &self.velocity {
             Some(read_velocities(file, fps, frames)?)
+        } else if self.face.is_some() {
+            Some(vec![SteerFrame::Free; frames])
         } else {
             bail!(
-                "say where to go: --circle R, --figure8 R, --path PATH.csv or --velocity SCHEDULE.csv"
+                "say where to go: --circle R, --figure8 R, --path PATH.csv, --velocity SCHEDULE.csv or --face X,Y,Z"
             )
         };
-        commands.context("the model has no heading-relative root")
+        let commands = commands.context("the model has no heading-relative root")?;
+        let Some(face) = &self.face else {
+            return Ok(commands);
+        };
+        let facing = Vec3(parse_direction(face)?);
+        if facing_of_direction(metadata, facing).is_none() {
+            bail!(
+                "--face {face}: the direction has no part on the ground (the model's up axis is {})",
+                metadata.layout.up
+            );
+        }
+        Ok(commands
+            .into_iter()
+            .map(|c| match c.position() {
+                Some(position) => SteerFrame::PositionFacing { position, facing },
+                None => SteerFrame::Facing(facing),
+            })
+            .collect())
     }
 }
 
@@ -150,13 +186,13 @@ pub fn run(args: &SteerArgs) -> Result<()> {
     };
     let generated = run_task(&args.sampling, &mut model, task)?;
     if args.report {
-        print_following(&generated, &commands);
+        print_following(&generated, &metadata, &commands);
     }
     Ok(())
 }
 
 /// One line per sample: how closely it did what `commands` asked.
-pub fn print_following(generated: &Generated, commands: &[SteerFrame]) {
+pub fn print_following(generated: &Generated, metadata: &ModelMetadata, commands: &[SteerFrame]) {
     let layout = generated.layout();
     let fps = layout.fps;
     for i in 0..generated.count() {
@@ -183,6 +219,12 @@ pub fn print_following(generated: &Generated, commands: &[SteerFrame]) {
                 100.0 * worst(&v.turn, 10f64.to_radians())
             );
         }
+        if let Some(f) = facing_following(metadata, raw, commands) {
+            line += &format!(
+                " facing off the commanded one by {:.1} degrees at the median, {:.1} at the 90th percentile;",
+                f.median, f.p90
+            );
+        }
         if let Some((median, over)) = facing_against_travel(layout, raw).and_then(facing_summary) {
             line += &format!(
                 " facing against travel median {median:.1} degrees, {:.0} % over 45",
@@ -193,10 +235,10 @@ pub fn print_following(generated: &Generated, commands: &[SteerFrame]) {
     }
 }
 
-/// The rows of three finite numbers of a CSV-like file (commas, semicolons, spaces or tabs
-/// between them), each with its line number; a first line that is not numbers is a header.
-/// `what` names the three columns in errors.
-fn triples(file: &Path, what: &str) -> Result<Vec<(usize, [f64; 3])>> {
+/// The rows of finite numbers of a CSV-like file (commas, semicolons, spaces or tabs between
+/// them), each with its line number, every row as wide as one of `widths`; a first line that is
+/// not numbers is a header. `what` names the columns in errors.
+fn numbers(file: &Path, widths: &[usize], what: &str) -> Result<Vec<(usize, Vec<f64>)>> {
     let text =
         std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
     let mut rows = Vec::new();
@@ -211,12 +253,12 @@ fn triples(file: &Path, what: &str) -> Result<Vec<(usize, [f64; 3])>> {
         }
         let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
         match values {
-            Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => {
-                rows.push((i + 1, [v[0], v[1], v[2]]))
+            Ok(v) if widths.contains(&v.len()) && v.iter().all(|x| x.is_finite()) => {
+                rows.push((i + 1, v))
             }
             Err(_) if i == 0 => continue,
             _ => bail!(
-                "{} line {}: expected three numbers {what}, got '{line}'",
+                "{} line {}: expected {what}, got '{line}'",
                 file.display(),
                 i + 1
             ),
@@ -225,22 +267,49 @@ fn triples(file: &Path, what: &str) -> Result<Vec<(usize, [f64; 3])>> {
     Ok(rows)
 }
 
-/// One position per frame, `x,y,z` per line.
+/// Three numbers `x,y,z` (commas, semicolons or spaces between them).
+fn parse_direction(text: &str) -> Result<[f64; 3]> {
+    let values: Vec<f64> = text
+        .split([',', ';', ' '])
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| s.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("--face takes three numbers x,y,z, got '{text}'"))?;
+    match values.as_slice() {
+        &[x, y, z] if values.iter().all(|v| v.is_finite()) => Ok([x, y, z]),
+        _ => bail!("--face takes three finite numbers x,y,z, got '{text}'"),
+    }
+}
+
+/// One position per frame, `x,y,z` per line, or `x,y,z,fx,fy,fz` with the direction to face.
 fn read_path(file: &Path) -> Result<Vec<SteerFrame>> {
-    let rows = triples(file, "x,y,z")?;
+    let rows = numbers(
+        file,
+        &[3, 6],
+        "three numbers x,y,z or six x,y,z,fx,fy,fz (a position and the direction to face)",
+    )?;
     if rows.len() < 2 {
         bail!("{}: a path needs at least two positions", file.display());
     }
     Ok(rows
         .into_iter()
-        .map(|(_, v)| SteerFrame::Position(Vec3(v)))
+        .map(|(_, v)| {
+            let position = Vec3([v[0], v[1], v[2]]);
+            match v[..] {
+                [_, _, _, fx, fy, fz] => SteerFrame::PositionFacing {
+                    position,
+                    facing: Vec3([fx, fy, fz]),
+                },
+                _ => SteerFrame::Position(position),
+            }
+        })
         .collect())
 }
 
 /// Lines `seconds,speed,turn` (turn in degrees per second), each holding until the next, as
 /// per-frame velocity commands over `frames` frames.
 fn read_velocities(file: &Path, fps: f64, frames: usize) -> Result<Vec<SteerFrame>> {
-    let rows = triples(file, "seconds,speed,turn")?;
+    let rows = numbers(file, &[3], "three numbers seconds,speed,turn")?;
     if rows.is_empty() {
         bail!("{}: the schedule is empty", file.display());
     }
@@ -253,9 +322,9 @@ fn read_velocities(file: &Path, fps: f64, frames: usize) -> Result<Vec<SteerFram
         .map(|f| {
             let t = f as f64 / fps;
             match rows.iter().rev().find(|(_, e)| e[0] <= t) {
-                Some(&(_, [_, forward, turn])) => SteerFrame::Velocity {
-                    forward,
-                    turn: turn.to_radians(),
+                Some((_, e)) => SteerFrame::Velocity {
+                    forward: e[1],
+                    turn: e[2].to_radians(),
                 },
                 None => SteerFrame::Free,
             }

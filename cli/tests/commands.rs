@@ -382,3 +382,53 @@ fn dance_and_beats_name_what_they_refuse_and_write_nothing() {
     assert!(!ok && err.contains("no/such/song.wav"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn steer_takes_facings_and_names_what_it_refuses() {
+    let dir = std::env::temp_dir().join(format!("sinmdm-steer-face-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let zombie = repo_file("onnx-models/human_zombie_walk_fair.onnx");
+    let zombie = zombie.to_str().unwrap();
+    let out = dir.join("out.bvh");
+    let out_text = out.to_str().unwrap();
+    // A path with a facing per line: along +X, facing +Y (the zombie's file is +Z up).
+    let path = dir.join("path.csv");
+    let lines: Vec<String> = (0..90)
+        .map(|i| format!("{},0,0,0,1,0", 0.3 * f64::from(i)))
+        .collect();
+    std::fs::write(&path, format!("x,y,z,fx,fy,fz\n{}\n", lines.join("\n"))).unwrap();
+    let path_text = path.to_str().unwrap();
+    let (ok, stdout, stderr) = run_text(&[
+        "steer", "-m", zombie, "--path", path_text, "--steps", "5", "-o", out_text, "--report",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("facing off the commanded one by"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("path distance"), "{stdout}");
+    std::fs::remove_file(&out).unwrap();
+    // Refusals name the flag or the line, and write nothing.
+    let refusals: [(&[&str], &str); 4] = [
+        (&["--face", "0,0,1"], "no part on the ground"),
+        (&["--face", "1,0"], "--face takes three"),
+        (&["--face", "1,0,0", "--velocity", path_text], "--velocity"),
+        (&["--path", path_text, "--face", "1,nan,0"], "--face"),
+    ];
+    for (flags, said) in refusals {
+        let mut args = vec!["steer", "-m", zombie, "--steps", "5", "-o", out_text];
+        args.extend_from_slice(flags);
+        let (ok, _, stderr) = run_text(&args);
+        assert!(!ok, "{flags:?} was taken");
+        assert!(stderr.contains(said), "{flags:?}: {stderr}");
+        assert!(!out.exists(), "{flags:?} wrote {out_text}");
+    }
+    std::fs::write(&path, "1,0,0,0,1\n2,0,0,0,1\n").unwrap();
+    let (ok, _, stderr) = run_text(&["steer", "-m", zombie, "--path", path_text, "-o", out_text]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("line 1") && stderr.contains("six"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}

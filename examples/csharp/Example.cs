@@ -85,11 +85,19 @@ static class Example
         using (var zombie = Model.Open(args[2], 1))
         {
             var limits = zombie.SteerLimits();
-            Console.WriteLine("steer limits forward " + limits.ForwardMin.ToString("F2") + " to " + limits.ForwardMax.ToString("F2"));
+            Console.WriteLine("steer limits forward " + limits.ForwardMin.ToString("F2") + " to " + limits.ForwardMax.ToString("F2")
+                + " sideways " + limits.SidewaysMin.ToString("F2") + " to " + limits.SidewaysMax.ToString("F2"));
             var ahead = new SteerFrame[40];
             for (int i = 0; i < ahead.Length; i++) ahead[i] = SteerFrame.Velocity(12.0, 0.3);
             using (var steered = zombie.Steer(40, ahead, 5, seed: 3, steps: 4))
                 Print("steer", steered.Poses(0));
+            // Facing commands: 20 frames facing (1, 0.5) on the ground (+Z is up), then 20 at
+            // positions (0.5 i, 0.2 i) facing +Y.
+            var faced = new SteerFrame[40];
+            for (int i = 0; i < faced.Length; i++)
+                faced[i] = i < 20 ? SteerFrame.Facing(1.0, 0.5, 0.0) : SteerFrame.PositionFacing(0.5 * i, 0.2 * i, 0.0, 0.0, 1.0, 0.0);
+            using (var steered = zombie.Steer(40, faced, 5, seed: 3, steps: 4))
+                Print("steerfacing", steered.Poses(0));
             using (var stream = new MotionStream(zombie, seed: 11, steps: 3, blockFrames: 30))
             {
                 var told = new SteerFrame[60];

@@ -81,7 +81,9 @@ def main(argv=None):
     st.add_argument("--frames", type=int, required=True)
     st.add_argument("--block", type=int, default=None)
     st.add_argument("--velocity", default=None, help="a schedule of seconds,speed,turn (degrees/s) lines")
-    st.add_argument("--path", default=None, help="one x,y,z ground position per frame (file frame)")
+    st.add_argument("--path", default=None, help="one x,y,z ground position per frame (file frame), "
+                    "or x,y,z,fx,fy,fz with the direction to face")
+    st.add_argument("--face", default=None, help="x,y,z: the direction to face (file frame)")
     args = parser.parse_args(argv)
 
     method = (args.sampler, args.eta) if args.sampler == "ddim" else (args.sampler,)
@@ -103,6 +105,9 @@ def main(argv=None):
                 commands = steer.read_velocities(args.velocity, fps, args.frames)
             elif args.path:
                 commands = steer.read_path(args.path)
+            if args.face:
+                facing = tuple(float(x) for x in args.face.replace(";", ",").split(","))
+                commands = steer.with_facing(commands, facing, args.frames)
             feats = stream_features(model, schedule, args.seed, args.frames, block=args.block, method=method,
                                     commands=commands)
             write_features(args.output, model.layout, feats[None])

@@ -88,6 +88,30 @@ def limits(model):
     return fm - 2.0 * fs, fm + 2.0 * fs, max(abs(tm) + 2.0 * ts, MIN_TURN_LIMIT)
 
 
+def sideways_limits(model):
+    """(leftward lo, leftward hi) of SteerLimits::of, units per second."""
+    fps = model.layout["fps"]
+    lm, ls = float(model.mean[LEFTWARD]) * fps, float(model.std[LEFTWARD]) * fps
+    return lm - 2.0 * ls, lm + 2.0 * ls
+
+
+def to_canonical(model):
+    return transpose(FILE_FROM_CANONICAL[model.layout.get("up", "+Y").upper()])
+
+
+def facing_of_direction(model, direction):
+    """facing_of_direction: the canonical heading facing a file-frame ground direction, or None."""
+    d = mat_vec(to_canonical(model), direction)
+    d[UP] = 0.0
+    if not norm(d) > 1e-9 * max(norm(direction), 1e-300):
+        return None
+    return math.atan2(d[0], d[2])
+
+
+def goal_position(goal):
+    return goal[1] if goal is not None and goal[0] == "course" else None
+
+
 def integrate(features, start_position, start_heading):
     """A heading root's canonical positions and facings from raw features [F, N] (integrate)."""
     n = features.shape[1]
@@ -120,7 +144,11 @@ class Steering:
         self.reach = int(round_half_away(STEER_REACH_SECONDS * fps))
         self.facing_reach = int(round_half_away(FACING_REACH_SECONDS * fps))
         self.catch_up = max(FACING_CATCH_UP_SECONDS * fps, 1.0)
-        self.max_step = max(limits(model)[1], 0.0) / fps
+        lo, hi, _ = limits(model)
+        self.max_step = max(hi, 0.0) / fps
+        self.backward_floor = min(lo / fps, 0.0)
+        side_lo, side_hi = sideways_limits(model)
+        self.sideways_range = (side_lo / fps, side_hi / fps)
 
     def apply(self, x0):
         """x0 [F, N] float32, normalised; changed in place."""
@@ -150,42 +178,57 @@ class Steering:
                 targets[TURN][i] = goal[2]
                 span = None
             else:
-                p = goal[1]
-                previous = self.goals[i - 1]
-                before = previous[1] if previous is not None and previous[0] == "position" else p
+                _, goal_pos, facing = goal
+                parts = (goal_pos is not None, facing is not None)
+                p = goal_pos if goal_pos is not None else position[i - 1]
+                before = goal_position(self.goals[i - 1])
+                if before is None:
+                    before = p
                 path_step = [p[c] - before[c] for c in range(3)]
                 path_step[UP] = 0.0
+                if span is not None and span[3] != parts:
+                    span = None
                 if span is None:
-                    lead = path_step
-                    following = self.goals[i + 1] if i + 1 < n else None
-                    if norm(lead) <= 1e-12 and following is not None and following[0] == "position":
-                        lead = [following[1][c] - p[c] for c in range(3)]
-                        lead[UP] = 0.0
-                    if norm(lead) > 1e-12:
-                        direction = math.atan2(lead[0], lead[2])
+                    if facing is not None:
+                        direction = facing
                     else:
-                        direction = heading[i - 1]
+                        lead = path_step
+                        following = goal_position(self.goals[i + 1]) if i + 1 < n else None
+                        if norm(lead) <= 1e-12 and following is not None:
+                            lead = [following[c] - p[c] for c in range(3)]
+                            lead[UP] = 0.0
+                        if norm(lead) > 1e-12:
+                            direction = math.atan2(lead[0], lead[2])
+                        else:
+                            direction = heading[i - 1]
                     last_direction = heading[i - 1] + wrap(direction - heading[i - 1])
                     offset = [before[c] - position[i - 1][c] for c in range(3)]
                     offset[UP] = 0.0
-                    span = (i, offset, heading[i - 1] - last_direction)
-                start, offset, facing_offset = span
+                    span = (i, offset, heading[i - 1] - last_direction, parts)
+                start, offset, facing_offset, _ = span
 
                 def fade(frame):
                     return max(1.0 - (frame + 1 - start) / self.catch_up, 0.0)
 
                 now = fade(i)
                 then = fade(i - 1) if i > start else 1.0
-                shift = then - now
-                want = [path_step[c] + offset[c] * shift for c in range(3)]
-                speed = norm(want)
-                if speed > self.max_step and speed > 0.0:
-                    scale = self.max_step / speed
-                    want = [w * scale for w in want]
-                local = mat_vec(transpose(yaw(heading[i])), want)
-                targets[FORWARD][i] = local[2]
-                targets[LEFTWARD][i] = local[0]
-                if norm(path_step) > 1e-12:
+                if goal_pos is not None:
+                    shift = then - now
+                    want = [path_step[c] + offset[c] * shift for c in range(3)]
+                    speed = norm(want)
+                    if speed > self.max_step and speed > 0.0:
+                        scale = self.max_step / speed
+                        want = [w * scale for w in want]
+                    local = mat_vec(transpose(yaw(heading[i])), want)
+                    ahead, aside = local[2], local[0]
+                    if facing is not None:
+                        ahead = max(ahead, self.backward_floor)
+                        aside = min(max(aside, self.sideways_range[0]), self.sideways_range[1])
+                    targets[FORWARD][i] = ahead
+                    targets[LEFTWARD][i] = aside
+                if facing is not None:
+                    direction = last_direction + wrap(facing - last_direction)
+                elif norm(path_step) > 1e-12:
                     direction = last_direction + wrap(math.atan2(path_step[0], path_step[2]) - last_direction)
                 else:
                     direction = last_direction
@@ -197,20 +240,22 @@ class Steering:
             current = raw[k]
             pull = [0.0 if targets[k][i] is None else self.weights[i] * (targets[k][i] - current[i])
                     for i in range(n)]
-            on_path = any(g is not None and g[0] == "position" for g in self.goals[self.anchor + 1:])
+            on_path = any(g is not None and g[0] == "course" and g[1] is not None and g[2] is None
+                          for g in self.goals[self.anchor + 1:])
             slow = triangular(pull, self.facing_reach if k == TURN and on_path else self.reach)
             x0[k] = np.array([np.float32(float(v) + d / self.std[k]) for v, d in zip(x0[k], slow)],
                              dtype=np.float32)
 
 
 def plan_steering(model, commands, anchor, course, ramp):
-    """commands: per window frame None, ("velocity", forward, turn) in units/s and rad/s, or
-    ("position", (x, y, z)) in the file frame. None when nothing is asked."""
+    """commands: per window frame None, ("velocity", forward, turn) in units/s and rad/s,
+    ("position", (x, y, z)), ("facing", (x, y, z)) or ("position_facing", (x, y, z), (fx, fy, fz))
+    in the file frame. None when nothing is asked."""
     fps = model.layout["fps"]
     lo, hi, turn_limit = limits(model)
-    to_canonical = transpose(FILE_FROM_CANONICAL[model.layout.get("up", "+Y").upper()])
+    canonical = to_canonical(model)
     goals = []
-    for c in commands:
+    for i, c in enumerate(commands):
         if c is None:
             goals.append(None)
         elif c[0] == "velocity":
@@ -218,9 +263,15 @@ def plan_steering(model, commands, anchor, course, ramp):
             t = min(max(c[2], -turn_limit), turn_limit)
             goals.append(("velocity", f / fps, t / fps))
         else:
-            q = mat_vec(to_canonical, c[1])
-            q[UP] = 0.0
-            goals.append(("position", q))
+            position = facing = None
+            if c[0] in ("position", "position_facing"):
+                position = mat_vec(canonical, c[1])
+                position[UP] = 0.0
+            if c[0] in ("facing", "position_facing"):
+                facing = facing_of_direction(model, c[-1])
+                if facing is None:
+                    raise ValueError(f"command {i} asks to face {c[-1]}, which has no direction on the ground")
+            goals.append(("course", position, facing))
     asked = np.array([i > anchor and g is not None for i, g in enumerate(goals)])
     if not asked.any():
         return None
@@ -263,4 +314,13 @@ def read_velocities(path, fps, frames):
 
 
 def read_path(path):
-    return [("position", (v[0], v[1], v[2])) for v in _triples(path)]
+    """x,y,z per line, or x,y,z,fx,fy,fz: a position and the direction to face there."""
+    return [("position", (v[0], v[1], v[2])) if len(v) == 3 else
+            ("position_facing", (v[0], v[1], v[2]), (v[3], v[4], v[5])) for v in _triples(path)]
+
+
+def with_facing(commands, facing, frames):
+    """--face: the path's positions walked in `facing`, or, without a path, `frames` frames of it."""
+    if commands is None:
+        return [("facing", facing)] * frames
+    return [("position_facing", c[1], facing) if c is not None and c[0] == "position" else c for c in commands]

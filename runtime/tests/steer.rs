@@ -1,14 +1,17 @@
 //! Steering a heading-relative model (the shipped zombie walk): a circle is followed, velocity
-//! commands are met on average in a stream, commands beyond the clip are clamped and reported,
-//! a stream's blocks continue the course without a jump, and a world-root model refuses.
+//! commands are met on average in a stream, a facing is kept, alone or along a path (strafing,
+//! on the shipped CMU walk), commands beyond the clip are clamped and reported, a stream's
+//! blocks continue the course without a jump, and a world-root model refuses.
 
+use std::f64::consts::FRAC_PI_2;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
-use sinmdm::motion::features::heading::facing_against_travel;
+use sinmdm::motion::features::heading::{facing_against_travel, yaw};
+use sinmdm::motion::math::Vec3;
 use sinmdm::motion::{global_poses, root_track};
-use sinmdm::steer::follow::{path_following, velocity_following};
-use sinmdm::steer::paths::{Shape, clip_speed, path};
+use sinmdm::steer::follow::{facing_following, path_following, velocity_following};
+use sinmdm::steer::paths::{Shape, clip_speed, path, start_course};
 use sinmdm::steer::{SteerFrame, SteerLimits};
 use sinmdm::{Feet, Model, ModelOptions, Request, Stream, StreamOptions, Task, TaskError};
 
@@ -293,6 +296,162 @@ fn commands_that_are_not_finite_are_refused() {
     let mut stream = Stream::new(&metadata, StreamOptions::default()).unwrap();
     let e = stream.steer(&bad).unwrap_err();
     assert!(e.to_string().contains("not finite"), "{e}");
-    let position = SteerFrame::Position(sinmdm::motion::math::Vec3::new(0.0, f64::INFINITY, 0.0));
+    let position = SteerFrame::Position(Vec3::new(0.0, f64::INFINITY, 0.0));
     assert!(stream.steer(&[position]).is_err());
+}
+
+/// The file-frame ground direction `angle` radians left of the model's start facing.
+fn turned_from_start(metadata: &sinmdm::model_file::ModelMetadata, angle: f64) -> Vec3 {
+    let (_, heading) = start_course(metadata).unwrap();
+    metadata.layout.up.file_from_canonical() * (yaw(heading + angle) * Vec3::new(0.0, 0.0, 1.0))
+}
+
+/// A facing alone: the character turns to face a quarter turn left of where it started and
+/// keeps that facing, walking where it faces as the clip does; a free run does not.
+#[test]
+fn a_facing_command_turns_the_character_and_leaves_its_walk_alone() {
+    let mut model = zombie();
+    let metadata = model.metadata().clone();
+    let frames = 300;
+    let commands = vec![SteerFrame::Facing(turned_from_start(&metadata, FRAC_PI_2)); frames];
+    let steered = run(
+        &mut model,
+        Task::Steer {
+            frames,
+            commands: commands.clone(),
+            ramp: 10,
+        },
+        2,
+    );
+    let free = run(&mut model, Task::Generate { frames }, 2);
+    for i in 0..2 {
+        let raw = steered.features.index_axis(ndarray::Axis(0), i);
+        let f = facing_following(&metadata, raw, &commands).unwrap();
+        println!("steered {i}: {f:?}");
+        assert!(f.frames > 200, "{f:?}");
+        assert!(f.median < 12.0 && f.p90 < 20.0, "{f:?}");
+        let mut angles = facing_against_travel(&metadata.layout, raw).unwrap();
+        angles.sort_by(f64::total_cmp);
+        let median = angles[angles.len() / 2];
+        assert!(median <= 20.0, "facing against travel {median}");
+        let loose = facing_following(
+            &metadata,
+            free.features.index_axis(ndarray::Axis(0), i),
+            &commands,
+        )
+        .unwrap();
+        println!("free {i}: {loose:?}");
+        assert!(loose.median > 45.0, "{loose:?}");
+    }
+}
+
+/// A path with a facing of its own: the shipped CMU walk (which glides backwards and sideways
+/// in its clip) walks a circle while facing one way, so it strafes and backs round it; the
+/// zombie, which never went sideways that fast, is clamped and says so.
+#[test]
+fn a_circle_walked_facing_one_way_is_followed_within_the_clips_range() {
+    let mut walk = model("human_walk_cmu.onnx");
+    let metadata = walk.metadata().clone();
+    let height = metadata.layout.skeleton_height;
+    let speed = clip_speed(&metadata).unwrap();
+    // Half a lap and two seconds: travel turns through 180 degrees while the facing holds.
+    let half_lap = std::f64::consts::PI * 3.0 * height / speed;
+    let frames = ((half_lap + 2.0) * metadata.layout.fps).ceil() as usize;
+    let facing = turned_from_start(&metadata, 0.0);
+    let circle = path(&metadata, Shape::Circle(3.0 * height), speed, frames).unwrap();
+    let commands: Vec<SteerFrame> = circle
+        .iter()
+        .map(|c| SteerFrame::PositionFacing {
+            position: c.position().unwrap(),
+            facing,
+        })
+        .collect();
+    let steered = run(
+        &mut walk,
+        Task::Steer {
+            frames,
+            commands: commands.clone(),
+            ramp: 10,
+        },
+        2,
+    );
+    for i in 0..2 {
+        let raw = steered.features.index_axis(ndarray::Axis(0), i);
+        let p = path_following(&metadata.layout, raw, &commands).unwrap();
+        let f = facing_following(&metadata, raw, &commands).unwrap();
+        println!("walk {i}: {p:?} {f:?}");
+        assert!(p.mean_distance < 0.2 && p.max_distance < 1.0, "{p:?}");
+        assert!(f.median < 10.0 && f.p90 < 20.0, "{f:?}");
+        // Round the circle facing one way, travel and facing part: half the time it walks more
+        // than sideways, backwards (the median of 0 to 180 degrees is 90).
+        let mut angles = facing_against_travel(&metadata.layout, raw).unwrap();
+        angles.sort_by(f64::total_cmp);
+        assert!(
+            angles[angles.len() / 2] > 60.0,
+            "{}",
+            angles[angles.len() / 2]
+        );
+    }
+    let zombie = zombie();
+    let metadata = zombie.metadata().clone();
+    let height = metadata.layout.skeleton_height;
+    let facing = turned_from_start(&metadata, 0.0);
+    let commands: Vec<SteerFrame> = path(
+        &metadata,
+        Shape::Circle(3.0 * height),
+        clip_speed(&metadata).unwrap(),
+        frames,
+    )
+    .unwrap()
+    .iter()
+    .map(|c| SteerFrame::PositionFacing {
+        position: c.position().unwrap(),
+        facing,
+    })
+    .collect();
+    let request = Request {
+        task: Task::Steer {
+            frames: 600,
+            commands,
+            ramp: 10,
+        },
+        count: 1,
+        seed: 1,
+        steps: Some(20),
+        feet: Feet::Raw,
+        method: Default::default(),
+    };
+    let plan = sinmdm::plan(&metadata, &request).unwrap();
+    assert!(
+        plan.warnings().iter().any(|w| w.contains("sideways")),
+        "{:?}",
+        plan.warnings()
+    );
+}
+
+#[test]
+fn a_facing_with_no_direction_on_the_ground_is_refused() {
+    let model = zombie();
+    let metadata = model.metadata().clone();
+    // The zombie's file frame is +Z up: facing +Z is facing nowhere on the ground.
+    let up = metadata.layout.up.file_from_canonical() * Vec3::new(0.0, 1.0, 0.0);
+    let commands = vec![SteerFrame::Free, SteerFrame::Facing(up)];
+    let request = Request {
+        task: Task::Steer {
+            frames: 60,
+            commands: commands.clone(),
+            ramp: 10,
+        },
+        count: 1,
+        seed: 0,
+        steps: Some(5),
+        feet: Feet::Raw,
+        method: Default::default(),
+    };
+    let e = sinmdm::plan(&metadata, &request).unwrap_err();
+    assert!(e.to_string().contains("command 1"), "{e}");
+    assert!(e.to_string().contains("no direction on the ground"), "{e}");
+    let mut stream = Stream::new(&metadata, StreamOptions::default()).unwrap();
+    let e = stream.steer(&commands).unwrap_err();
+    assert!(e.to_string().contains("no direction on the ground"), "{e}");
 }

@@ -11,7 +11,9 @@ use sinmdm::steer::SteerLimits;
 use sinmdm::{Stream, StreamOptions};
 use sinmdm_bevy::{CharacterOptions, MotionCharacter, MotionModel, Steering};
 
-use common::{BEVY_FPS, HEADING_HALF_WINDOW, app_with, model_path, travel_headings, unwrapped};
+use common::{
+    BEVY_FPS, HEADING_HALF_WINDOW, app_with, model_path, signed_angle, travel_headings, unwrapped,
+};
 
 #[test]
 fn a_steering_command_turns_the_character_left_within_its_reach() {
@@ -139,5 +141,77 @@ fn a_steering_command_turns_the_character_left_within_its_reach() {
         end > 0.4 * seconds_turning,
         "turned {end} rad, commanded {}",
         0.8 * seconds_turning
+    );
+}
+
+/// A facing command: the zombie walks freely for two seconds, then is told to face 120 degrees
+/// left of where it is going (in Bevy's axes); within its steering reach and a second and a
+/// half to turn, it walks that way.
+#[test]
+fn a_facing_command_turns_the_character_to_walk_that_way() {
+    let model = MotionModel::open(model_path("human_zombie_walk_fair.onnx"), Some(1)).unwrap();
+    let metadata = model.metadata().clone();
+    let fps = metadata.layout.fps;
+    let options = CharacterOptions {
+        stream: StreamOptions {
+            seed: 4,
+            block_frames: Some(60),
+            ..StreamOptions::default()
+        },
+        ..CharacterOptions::for_fps(fps)
+    };
+    let (mut app, character) = app_with(&model, options, Transform::IDENTITY);
+    let face_at = (2.0 * BEVY_FPS) as usize;
+    let frames = face_at + (10.0 * BEVY_FPS) as usize;
+    let mut roots: Vec<bevy_math::Vec3> = Vec::new();
+    let mut wanted = None;
+    let mut reach = 0;
+    for k in 0..frames {
+        if k == face_at {
+            let d = roots[k - 1] - roots[k - 1 - 2 * HEADING_HALF_WINDOW];
+            let going = f64::from(d.x).atan2(f64::from(d.z));
+            let heading = going + 120f64.to_radians();
+            wanted = Some(heading);
+            let direction = bevy_math::Vec3::new(heading.sin() as f32, 0.3, heading.cos() as f32);
+            reach = app
+                .world()
+                .get::<MotionCharacter>(character)
+                .unwrap()
+                .steering_reach();
+            app.world_mut()
+                .entity_mut(character)
+                .insert(Steering::Face { direction });
+        }
+        app.update();
+        let world = app.world();
+        let c = world.get::<MotionCharacter>(character).unwrap();
+        assert!(c.error().is_none(), "{:?}", c.error());
+        assert!(c.steering_note().is_none(), "{:?}", c.steering_note());
+        roots.push(
+            world
+                .get::<GlobalTransform>(c.joints()[0])
+                .unwrap()
+                .translation(),
+        );
+    }
+    let wanted = wanted.unwrap();
+    let settled = face_at + ((reach as f64 / fps + 1.5) * BEVY_FPS).ceil() as usize;
+    assert!(settled + 2 * BEVY_FPS as usize <= frames, "reach {reach}");
+    let mut off: Vec<f64> = travel_headings(&roots)[settled..]
+        .iter()
+        .flatten()
+        .map(|h| signed_angle(*h, wanted).abs().to_degrees())
+        .collect();
+    off.sort_by(f64::total_cmp);
+    assert!(off.len() > BEVY_FPS as usize, "it stood still");
+    let median = off[off.len() / 2];
+    eprintln!(
+        "told to face 120 degrees left; from {} Bevy frames after (reach {reach} model frames) its travel is {median:.1} degrees off at the median, {:.1} at the 90th percentile",
+        settled - face_at,
+        off[off.len() * 9 / 10]
+    );
+    assert!(
+        median < 25.0,
+        "travel {median} degrees off the facing asked"
     );
 }

@@ -433,9 +433,10 @@ static void one_case(const char *model_a, const char *work) {
          the bound, NULL arrays, either model (only model B can be steered). */
       static SinmdmSteerFrame commands[16];
       for (size_t i = 0; i < 16; i++) {
-        SinmdmSteerFrame f = {pick(4) ? (uint32_t)pick(3) : any_u32(), coin() ? 0 : any_u32(), coin() ? 12.0 : any_double(),
+        SinmdmSteerFrame f = {pick(4) ? (uint32_t)pick(5) : any_u32(), coin() ? 0 : any_u32(), coin() ? 12.0 : any_double(),
                               coin() ? 0.2 : any_double(),
-                              {coin() ? 1.0 * i : any_double(), any_double(), coin() ? -2.0 * i : any_double()}};
+                              {coin() ? 1.0 * i : any_double(), any_double(), coin() ? -2.0 * i : any_double()},
+                              {coin() ? 1.0 : any_double(), pick(3) ? 0.0 : any_double(), coin() ? 0.5 : any_double()}};
         commands[i] = f;
       }
       size_t counts[] = {0, 1, 7, 16, SINMDM_MAX_SAMPLE_FRAMES + 1, SIZE_MAX};

@@ -35,6 +35,26 @@ pub fn steer_commands(frames: usize, forward: f64, turn: f64) -> Vec<sinmdm::ste
     vec![sinmdm::steer::SteerFrame::Velocity { forward, turn }; frames]
 }
 
+/// The facing commands the steering checks give (file frame of the zombie walk, +Z up): 20
+/// frames facing (1, 0.5) on the ground, then 20 frames at positions `(0.5 i, 0.2 i)` facing
+/// +Y (a path walked with a facing of its own).
+pub fn facing_commands() -> Vec<sinmdm::steer::SteerFrame> {
+    use sinmdm::motion::math::Vec3;
+    use sinmdm::steer::SteerFrame;
+    (0..40)
+        .map(|i| {
+            if i < 20 {
+                SteerFrame::Facing(Vec3::new(1.0, 0.5, 0.0))
+            } else {
+                SteerFrame::PositionFacing {
+                    position: Vec3::new(0.5 * i as f64, 0.2 * i as f64, 0.0),
+                    facing: Vec3::new(0.0, 1.0, 0.0),
+                }
+            }
+        })
+        .collect()
+}
+
 /// The folder of the test binary's profile (`target/release`), where `libsinmdm_c.so` is,
 /// with the shared library built now: `cargo test` builds the crate's rlib for the tests, not
 /// its cdylib, which could otherwise be stale.
@@ -255,6 +275,25 @@ pub fn expected() -> BTreeMap<String, String> {
     )
     .unwrap();
     pose_lines("steer", &steered.poses(0).unwrap(), &mut out);
+    // The same with facing commands.
+    let faced = sinmdm::run(
+        &mut zombie,
+        &Request {
+            task: Task::Steer {
+                frames: 40,
+                commands: facing_commands(),
+                ramp: 5,
+            },
+            count: 1,
+            seed: 3,
+            steps: Some(4),
+            feet: Feet::Planted,
+            method: Default::default(),
+        },
+        go,
+    )
+    .unwrap();
+    pose_lines("steerfacing", &faced.poses(0).unwrap(), &mut out);
     stream_lines(
         &mut zombie,
         "steerstream",

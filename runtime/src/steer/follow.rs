@@ -1,14 +1,17 @@
 //! How well a steered motion did what it was asked: its distance from the path, how far along
-//! the path it got, and its speed and turn rate against velocity commands.
+//! the path it got, its speed and turn rate against velocity commands, and its facing against
+//! facing commands.
 
 use ndarray::ArrayView2;
 
+use crate::model_file::ModelMetadata;
 use crate::motion::FeatureLayout;
+use crate::motion::features::heading::wrap;
 use crate::motion::math::Vec3;
 use crate::motion::root_track;
 use crate::motion::up::UP;
 
-use super::SteerFrame;
+use super::{FACING_CATCH_UP_SECONDS, STEER_REACH_SECONDS, SteerFrame, facing_of_direction};
 
 /// How far from a frame's own path point its nearest point is sought, seconds.
 pub const PROGRESS_WINDOW_SECONDS: f64 = 2.0;
@@ -43,8 +46,7 @@ pub fn root_positions(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> 
     )
 }
 
-/// The root of `features` against the path of `commands` (their [`SteerFrame::Position`]s,
-/// file frame); `None` for a layout without a heading-relative root or fewer than two points.
+/// The root of `features` against the path of `commands` (their positions, file frame); `None` for a layout without a heading-relative root or fewer than two points.
 pub fn path_following(
     layout: &FeatureLayout,
     features: ArrayView2<'_, f32>,
@@ -55,13 +57,10 @@ pub fn path_following(
     let (frames_of, path): (Vec<usize>, Vec<Vec3>) = commands
         .iter()
         .enumerate()
-        .filter_map(|(f, c)| match c {
-            SteerFrame::Position(p) => {
-                let mut q = to_canonical * *p;
-                q[UP] = 0.0;
-                Some((f, q))
-            }
-            _ => None,
+        .filter_map(|(f, c)| {
+            let mut q = to_canonical * c.position()?;
+            q[UP] = 0.0;
+            Some((f, q))
         })
         .unzip();
     if path.len() < 2 {
@@ -173,4 +172,55 @@ pub fn velocity_following(
         ));
     }
     Some(out)
+}
+
+/// A motion's facing against facing commands, in degrees, over the frames that command a
+/// facing, less the first [`FACING_SETTLE_SECONDS`] of each span of them (the time it is given
+/// to turn there).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FacingFollowing {
+    /// Frames measured.
+    pub frames: usize,
+    /// Median angle between the root's facing and the commanded one.
+    pub median: f64,
+    /// The 90th percentile of that angle.
+    pub p90: f64,
+}
+
+/// How long a span of facing commands is given to turn the character before it is measured,
+/// seconds: the catch-up plus the steering low-pass's reach.
+pub const FACING_SETTLE_SECONDS: f64 = FACING_CATCH_UP_SECONDS + STEER_REACH_SECONDS;
+
+/// The root's facing of `features` (raw, `[F, N]`, of `metadata`'s heading-relative model)
+/// against the facings `commands` ask for; `None` for another layout or when no frame is
+/// measured.
+pub fn facing_following(
+    metadata: &ModelMetadata,
+    features: ArrayView2<'_, f32>,
+    commands: &[SteerFrame],
+) -> Option<FacingFollowing> {
+    let (_, headings) = root_track(&metadata.layout, features, None)?;
+    let settle = (FACING_SETTLE_SECONDS * metadata.layout.fps).round() as usize;
+    let mut since_start = 0;
+    let mut angles = Vec::new();
+    for (f, c) in commands.iter().enumerate().take(headings.len()) {
+        let Some(wanted) = c.facing().and_then(|d| facing_of_direction(metadata, d)) else {
+            since_start = 0;
+            continue;
+        };
+        since_start += 1;
+        if since_start > settle {
+            angles.push(wrap(headings[f] - wanted).abs().to_degrees());
+        }
+    }
+    if angles.is_empty() {
+        return None;
+    }
+    angles.sort_by(f64::total_cmp);
+    let at = |q: f64| angles[((angles.len() - 1) as f64 * q).round() as usize];
+    Some(FacingFollowing {
+        frames: angles.len(),
+        median: at(0.5),
+        p90: at(0.9),
+    })
 }

@@ -1,6 +1,6 @@
 //! Steering a heading-relative model (SPEC section 5, "Steering"): where the character goes is
-//! asked for frame by frame (a path on the ground, or forward speed and turn rate), and the
-//! sampler pulls the root's slow motion to it while the network makes the body to match.
+//! asked for frame by frame (a path on the ground, forward speed and turn rate, a facing, or a
+//! path with a facing of its own), and the sampler pulls the root's slow motion to it while the network makes the body to match.
 //!
 //! A command is an average over a stride, not a value per frame: a walk's hips speed up and
 //! slow down within each step, and its facing sways. So steering sets only the **slow part** of
@@ -19,6 +19,13 @@
 //!   the path, in position and in facing, fades out over [`FACING_CATCH_UP_SECONDS`]; after
 //!   that the targets are the path's own steps (open loop: each pass re-reads the facing, and
 //!   the low-pass keeps the integrated course on the path).
+//! - **Facing** commands give the direction the character faces. The turn row is pulled, as a
+//!   path's is, to a course that joins the commanded facing from the prediction's over
+//!   [`FACING_CATCH_UP_SECONDS`] and then turns as the commands turn; the travel stays the
+//!   model's. Given with a path, the facing replaces the path's direction and the travel still
+//!   follows the path, in the facing's frame: a sideways walk (strafing) or a backward one. The
+//!   travel in that frame is clamped to the clip's forward and sideways range: a clip that never
+//!   walked sideways follows a strafed path only as fast as it ever went sideways.
 //!
 //! Commands beyond what the clip showed are clamped ([`SteerLimits`]) and reported.
 
@@ -75,8 +82,19 @@ pub enum SteerFrame {
         turn: f64,
     },
     /// The root's position on the ground at this frame (file frame; the up component is
-    /// ignored).
+    /// ignored). The character faces the way the path goes.
     Position(Vec3),
+    /// The direction the character faces at this frame (file frame; the up component is
+    /// ignored, the rest must not be zero); where it goes is the model's.
+    Facing(Vec3),
+    /// The root's position on the ground and the direction the character faces, apart (file
+    /// frame, up components ignored): a path walked sideways or backwards.
+    PositionFacing {
+        /// As [`SteerFrame::Position`].
+        position: Vec3,
+        /// As [`SteerFrame::Facing`].
+        facing: Vec3,
+    },
 }
 
 impl SteerFrame {
@@ -85,9 +103,58 @@ impl SteerFrame {
         match *self {
             SteerFrame::Free => true,
             SteerFrame::Velocity { forward, turn } => forward.is_finite() && turn.is_finite(),
-            SteerFrame::Position(p) => p.is_finite(),
+            SteerFrame::Position(p) | SteerFrame::Facing(p) => p.is_finite(),
+            SteerFrame::PositionFacing { position, facing } => {
+                position.is_finite() && facing.is_finite()
+            }
         }
     }
+
+    /// The ground position the command asks for, if any (file frame).
+    pub fn position(&self) -> Option<Vec3> {
+        match *self {
+            SteerFrame::Position(p) | SteerFrame::PositionFacing { position: p, .. } => Some(p),
+            _ => None,
+        }
+    }
+
+    /// The facing direction the command asks for, if any (file frame).
+    pub fn facing(&self) -> Option<Vec3> {
+        match *self {
+            SteerFrame::Facing(d) | SteerFrame::PositionFacing { facing: d, .. } => Some(d),
+            _ => None,
+        }
+    }
+}
+
+/// The facing of a ground direction `direction` given in the file frame of `metadata`'s model:
+/// the heading about up that faces it (canonical frame, as the root's turn rows integrate);
+/// `None` when its horizontal part is (nearly) zero.
+pub fn facing_of_direction(metadata: &ModelMetadata, direction: Vec3) -> Option<f64> {
+    let mut d = metadata.layout.up.canonical_from_file() * direction;
+    d[UP] = 0.0;
+    (d.norm() > 1e-9 * direction.norm().max(1e-300)).then(|| d[0].atan2(d[2]))
+}
+
+/// Checks commands before they are used: every number finite, every facing with a horizontal
+/// part. The error names the first bad command by its index.
+pub fn check_commands(metadata: &ModelMetadata, commands: &[SteerFrame]) -> Result<(), String> {
+    for (i, c) in commands.iter().enumerate() {
+        if !c.is_finite() {
+            return Err(format!(
+                "command {i} holds a value that is not finite: {c:?}"
+            ));
+        }
+        if let Some(d) = c.facing()
+            && facing_of_direction(metadata, d).is_none()
+        {
+            return Err(format!(
+                "command {i} asks to face {:?}, which has no direction on the ground (it is zero or points along up, {})",
+                d.0, metadata.layout.up
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The range of commands a model's clip supports: its forward speed and turn rate, each as the
@@ -99,6 +166,9 @@ pub struct SteerLimits {
     pub forward: (f64, f64),
     /// Largest turn rate either way, radians per second.
     pub turn: f64,
+    /// Slowest and fastest leftward speed (negative: rightward), file units per second: how
+    /// fast a path given with a facing of its own can be walked sideways.
+    pub sideways: (f64, f64),
 }
 
 impl SteerLimits {
@@ -110,9 +180,11 @@ impl SteerLimits {
         let row = |r: usize| (f64::from(n.mean[r]) * fps, f64::from(n.std[r]) * fps);
         let (fm, fs) = row(FORWARD);
         let (tm, ts) = row(TURN);
+        let (lm, ls) = row(LEFTWARD);
         Some(SteerLimits {
             forward: (fm - 2.0 * fs, fm + 2.0 * fs),
             turn: (tm.abs() + 2.0 * ts).max(MIN_TURN_LIMIT),
+            sideways: (lm - 2.0 * ls, lm + 2.0 * ls),
         })
     }
 }
@@ -126,8 +198,29 @@ enum Goal {
         forward: f64,
         turn: f64,
     },
-    /// The root's ground position (up component 0).
-    Position(Vec3),
+    /// The root's ground position (up component 0), the facing (its own, or `None` for the
+    /// path's direction), or both.
+    Course {
+        position: Option<Vec3>,
+        facing: Option<f64>,
+    },
+}
+
+impl Goal {
+    fn position(&self) -> Option<Vec3> {
+        match *self {
+            Goal::Course { position, .. } => position,
+            _ => None,
+        }
+    }
+
+    /// Which parts a course goal has: a span of course goals is one of the same parts.
+    fn parts(&self) -> Option<(bool, bool)> {
+        match *self {
+            Goal::Course { position, facing } => Some((position.is_some(), facing.is_some())),
+            _ => None,
+        }
+    }
 }
 
 /// The steering of one sampling run: a goal per frame of its window, from a known course.
@@ -149,6 +242,10 @@ pub struct Steering {
     catch_up: f64,
     /// The fastest the root may go, per frame.
     max_step: f64,
+    /// The clip's range of forward and leftward steps, per frame (a path walked with a facing
+    /// of its own is clamped to it).
+    forward_range: (f64, f64),
+    sideways_range: (f64, f64),
 }
 
 /// A steering built from commands, and what was clamped on the way.
@@ -174,11 +271,7 @@ pub fn plan_steering(
         "steering needs a model with a heading-relative root (train it with --root-layout heading)"
             .to_string()
     })?;
-    if let Some((i, c)) = commands.iter().enumerate().find(|(_, c)| !c.is_finite()) {
-        return Err(format!(
-            "command {i} holds a value that is not finite: {c:?}"
-        ));
-    }
+    check_commands(metadata, commands)?;
     let layout = &metadata.layout;
     let fps = layout.fps;
     let to_canonical = layout.up.canonical_from_file();
@@ -212,23 +305,54 @@ pub fn plan_steering(
                     turn: t / fps,
                 }
             }
-            SteerFrame::Position(p) => {
-                let mut q = to_canonical * p;
-                q[UP] = 0.0;
-                Goal::Position(q)
+            SteerFrame::Position(_) | SteerFrame::Facing(_) | SteerFrame::PositionFacing { .. } => {
+                let position = c.position().map(|p| {
+                    let mut q = to_canonical * p;
+                    q[UP] = 0.0;
+                    q
+                });
+                let facing = c.facing().and_then(|d| facing_of_direction(metadata, d));
+                Goal::Course { position, facing }
             }
         })
         .collect();
     // A path faster than the clip ever went is followed at the clip's top speed.
     let top = limits.forward.1.max(0.0);
     for pair in goals.windows(2) {
-        if let [Goal::Position(a), Goal::Position(b)] = pair
-            && (*b - *a).norm() * fps > top * 1.0001
+        if let (Some(a), Some(b)) = (pair[0].position(), pair[1].position())
+            && (b - a).norm() * fps > top * 1.0001
         {
             warn(format!(
                 "the path goes faster than the clip's {top:.3} units/s; it is followed at that speed"
             ));
             break;
+        }
+    }
+    // A path with a facing of its own asks for travel in the facing's frame: sideways or
+    // backwards faster than the clip went is followed at the clip's pace.
+    for pair in goals.windows(2) {
+        if let (
+            Some(a),
+            Goal::Course {
+                position: Some(b),
+                facing: Some(h),
+            },
+        ) = (pair[0].position(), pair[1])
+        {
+            let local = yaw(h).transpose() * (b - a);
+            let (f, l) = (local[2] * fps, local[0] * fps);
+            let (lo, hi) = limits.sideways;
+            if l < lo * 1.0001 - 1e-12 || l > hi * 1.0001 + 1e-12 {
+                warn(format!(
+                    "the path with its facing asks for sideways speeds beyond the clip's {lo:.3} to {hi:.3} units/s; they are clamped, so the path is followed more slowly"
+                ));
+            }
+            let lo = limits.forward.0.min(0.0);
+            if f < lo * 1.0001 - 1e-12 {
+                warn(format!(
+                    "the path with its facing asks for backward speeds beyond the clip's slowest {lo:.3} units/s; they are clamped, so the path is followed more slowly"
+                ));
+            }
         }
     }
     let asked: Vec<bool> = goals
@@ -260,6 +384,8 @@ pub fn plan_steering(
             facing_reach: (FACING_REACH_SECONDS * fps).round() as usize,
             catch_up: (FACING_CATCH_UP_SECONDS * fps).max(1.0),
             max_step: top / fps,
+            forward_range: (limits.forward.0 / fps, limits.forward.1 / fps),
+            sideways_range: (limits.sideways.0 / fps, limits.sideways.1 / fps),
         }),
         warnings,
     })
@@ -304,7 +430,7 @@ impl Steering {
         // position and in facing, fades out linearly over the catch-up time, so the targets
         // are a course that joins the path (each frame's target is a step of that course, not
         // a correction of the prediction's error, which would pile up along the span).
-        let mut span: Option<(usize, Vec3, f64)> = None;
+        let mut span: Option<(usize, Vec3, f64, (bool, bool))> = None;
         let mut last_direction = 0.0;
         for i in self.anchor + 1..n {
             match self.goals[i] {
@@ -314,35 +440,53 @@ impl Steering {
                     targets[TURN][i] = Some(turn);
                     span = None;
                 }
-                Goal::Position(p) => {
-                    let before = match self.goals[i - 1] {
-                        Goal::Position(q) => q,
-                        _ => p,
-                    };
+                Goal::Course {
+                    position: goal_position,
+                    facing,
+                } => {
+                    let parts = self.goals[i].parts();
+                    // Without a position, the travel is free and the offset unused.
+                    let p = goal_position.unwrap_or(position[i - 1]);
+                    let before = self.goals[i - 1].position().unwrap_or(p);
                     let mut path_step = p - before;
                     path_step[UP] = 0.0;
-                    let (start, offset, facing_offset) = match span {
+                    if span.is_some_and(|s| Some(s.3) != parts) {
+                        span = None;
+                    }
+                    let (start, offset, facing_offset, _) = match span {
                         Some(s) => s,
                         None => {
-                            // The direction the path leaves in: its first step, or, for a span
-                            // that starts after other goals, its step to the next frame (or the
-                            // facing, standing still).
-                            let mut lead = path_step;
-                            if lead.norm() <= 1e-12
-                                && let Some(Goal::Position(next)) = self.goals.get(i + 1)
-                            {
-                                lead = *next - p;
-                                lead[UP] = 0.0;
-                            }
-                            let direction = if lead.norm() > 1e-12 {
-                                lead[0].atan2(lead[2])
-                            } else {
-                                heading[i - 1]
+                            // The direction the span leaves in: its commanded facing, or the
+                            // path's first step, or, for a span that starts after other
+                            // goals, its step to the next frame (or the facing, standing
+                            // still).
+                            let direction = match facing {
+                                Some(f) => f,
+                                None => {
+                                    let mut lead = path_step;
+                                    if lead.norm() <= 1e-12
+                                        && let Some(next) =
+                                            self.goals.get(i + 1).and_then(Goal::position)
+                                    {
+                                        lead = next - p;
+                                        lead[UP] = 0.0;
+                                    }
+                                    if lead.norm() > 1e-12 {
+                                        lead[0].atan2(lead[2])
+                                    } else {
+                                        heading[i - 1]
+                                    }
+                                }
                             };
                             last_direction = heading[i - 1] + wrap(direction - heading[i - 1]);
                             let mut offset = before - position[i - 1];
                             offset[UP] = 0.0;
-                            let s = (i, offset, heading[i - 1] - last_direction);
+                            let s = (
+                                i,
+                                offset,
+                                heading[i - 1] - last_direction,
+                                parts.unwrap_or_default(),
+                            );
                             span = Some(s);
                             s
                         }
@@ -350,22 +494,33 @@ impl Steering {
                     let fade =
                         |frame: usize| (1.0 - (frame + 1 - start) as f64 / self.catch_up).max(0.0);
                     let (now, then) = (fade(i), if i > start { fade(i - 1) } else { 1.0 });
-                    // The wanted step: the path's, less the part of the offset this frame
-                    // takes away; no faster than the clip goes.
-                    let mut want = path_step + offset * (then - now);
-                    let speed = want.norm();
-                    if speed > self.max_step && speed > 0.0 {
-                        want = want * (self.max_step / speed);
+                    if goal_position.is_some() {
+                        // The wanted step: the path's, less the part of the offset this frame
+                        // takes away; no faster than the clip goes.
+                        let mut want = path_step + offset * (then - now);
+                        let speed = want.norm();
+                        if speed > self.max_step && speed > 0.0 {
+                            want = want * (self.max_step / speed);
+                        }
+                        let local = yaw(heading[i]).transpose() * want;
+                        let (mut ahead, mut aside) = (local[2], local[0]);
+                        if facing.is_some() {
+                            // Walked in a facing of its own: no more sideways or backwards
+                            // than the clip went.
+                            ahead = ahead.max(self.forward_range.0.min(0.0));
+                            aside = aside.max(self.sideways_range.0).min(self.sideways_range.1);
+                        }
+                        targets[FORWARD][i] = Some(ahead);
+                        targets[LEFTWARD][i] = Some(aside);
                     }
-                    let local = yaw(heading[i]).transpose() * want;
-                    targets[FORWARD][i] = Some(local[2]);
-                    targets[LEFTWARD][i] = Some(local[0]);
-                    // The wanted facing: the path's direction (unwrapped along the span), plus
-                    // what is left of the start's facing offset.
-                    let direction = if path_step.norm() > 1e-12 {
-                        last_direction + wrap(path_step[0].atan2(path_step[2]) - last_direction)
-                    } else {
-                        last_direction
+                    // The wanted facing: the commanded one or the path's direction (unwrapped
+                    // along the span), plus what is left of the start's facing offset.
+                    let direction = match facing {
+                        Some(f) => last_direction + wrap(f - last_direction),
+                        None if path_step.norm() > 1e-12 => {
+                            last_direction + wrap(path_step[0].atan2(path_step[2]) - last_direction)
+                        }
+                        None => last_direction,
                     };
                     let wanted = |d: f64, f: f64| d + facing_offset * f;
                     targets[TURN][i] = Some(wanted(direction, now) - wanted(last_direction, then));
@@ -383,11 +538,16 @@ impl Steering {
                 .collect();
             // A path's facing is pulled over a longer reach than its travel: the course is
             // followed on average, and a clip's own turns away from its travel (a glide) stay.
-            let on_path = self
-                .goals
-                .iter()
-                .skip(self.anchor + 1)
-                .any(|g| matches!(g, Goal::Position(_)));
+            // A commanded facing is pulled as the travel is.
+            let on_path = self.goals.iter().skip(self.anchor + 1).any(|g| {
+                matches!(
+                    g,
+                    Goal::Course {
+                        position: Some(_),
+                        facing: None
+                    }
+                )
+            });
             let reach = if k == TURN && on_path {
                 self.facing_reach
             } else {

@@ -277,21 +277,22 @@ impl Stream {
     /// Command `i` given in all belongs to stream frame `i`, always: a block uses the commands
     /// given when it starts, so commands for frames a block has already started on are not
     /// used (give them at least [`Stream::lookahead`] frames ahead of what has been handed
-    /// out, plus whatever [`Stream::prepare`] made ahead). Needs a heading-relative model and
-    /// finite numbers. Commands beyond the clip's range are clamped when used and reported by
+    /// out, plus whatever [`Stream::prepare`] made ahead). Needs a heading-relative model,
+    /// finite numbers and facings with a direction on the ground. Commands beyond the clip's range are clamped when used and reported by
     /// [`Stream::warnings`].
     pub fn steer(&mut self, commands: &[SteerFrame]) -> Result<(), TaskError> {
-        if let Some((i, c)) = commands.iter().enumerate().find(|(_, c)| !c.is_finite()) {
-            return Err(TaskError::Steer(format!(
-                "command {i} holds a value that is not finite: {c:?}"
-            )));
-        }
         if SteerLimits::of(&self.metadata).is_none() {
             return Err(TaskError::Steer(
                 "the model has no heading-relative root (train it with --root-layout heading)"
                     .into(),
             ));
         }
+        crate::steer::check_commands(&self.metadata, commands).map_err(|e| {
+            TaskError::Steer(format!(
+                "{e} (command 0 is stream frame {})",
+                self.commands_first + self.commands.len()
+            ))
+        })?;
         self.commands.extend(commands.iter().copied());
         Ok(())
     }
