@@ -42,6 +42,32 @@ fn run(model: &mut Model, task: Task, count: usize) -> sinmdm::Generated {
     sinmdm::run(model, &request, &mut go()).unwrap()
 }
 
+/// One sample of `frames` frames steered by `commands` (ramp 10, seed 1, 20 steps), to plan.
+fn steer_request(frames: usize, commands: Vec<SteerFrame>) -> Request {
+    Request {
+        task: Task::Steer {
+            frames,
+            commands,
+            ramp: 10,
+        },
+        count: 1,
+        seed: 1,
+        steps: Some(20),
+        feet: Feet::Raw,
+        method: Default::default(),
+    }
+}
+
+/// `count` samples of `commands.len()` frames steered by `commands` (ramp 10).
+fn steer(model: &mut Model, commands: &[SteerFrame], count: usize) -> sinmdm::Generated {
+    let task = Task::Steer {
+        frames: commands.len(),
+        commands: commands.to_vec(),
+        ramp: 10,
+    };
+    run(model, task, count)
+}
+
 #[test]
 fn a_steered_circle_stays_on_its_path_and_a_free_walk_does_not() {
     let mut model = zombie();
@@ -50,15 +76,7 @@ fn a_steered_circle_stays_on_its_path_and_a_free_walk_does_not() {
     let frames = 360;
     let speed = clip_speed(&metadata).unwrap();
     let commands = path(&metadata, Shape::Circle(3.0 * height), speed, frames).unwrap();
-    let steered = run(
-        &mut model,
-        Task::Steer {
-            frames,
-            commands: commands.clone(),
-            ramp: 10,
-        },
-        2,
-    );
+    let steered = steer(&mut model, &commands, 2);
     let free = run(&mut model, Task::Generate { frames }, 2);
     for i in 0..2 {
         let raw = steered.features.index_axis(ndarray::Axis(0), i);
@@ -157,18 +175,7 @@ fn commands_beyond_the_clip_are_clamped_and_said() {
         };
         240
     ];
-    let request = Request {
-        task: Task::Steer {
-            frames: 240,
-            commands: commands.clone(),
-            ramp: 10,
-        },
-        count: 1,
-        seed: 1,
-        steps: Some(20),
-        feet: Feet::Raw,
-        method: Default::default(),
-    };
+    let request = steer_request(240, commands.clone());
     let plan = sinmdm::plan(&metadata, &request).unwrap();
     assert_eq!(plan.warnings().len(), 1, "{:?}", plan.warnings());
     assert!(
@@ -246,18 +253,7 @@ fn a_world_root_model_refuses_steering() {
     let mut hop = model("human_hop_cmu.onnx");
     let metadata = hop.metadata().clone();
     assert!(SteerLimits::of(&metadata).is_none());
-    let request = Request {
-        task: Task::Steer {
-            frames: 60,
-            commands: vec![],
-            ramp: 10,
-        },
-        count: 1,
-        seed: 0,
-        steps: Some(5),
-        feet: Feet::Raw,
-        method: Default::default(),
-    };
+    let request = steer_request(60, vec![]);
     let e = sinmdm::run(&mut hop, &request, &mut go()).unwrap_err();
     assert!(matches!(e, TaskError::Steer(_)), "{e}");
     assert!(e.to_string().contains("heading-relative"), "{e}");
@@ -279,18 +275,7 @@ fn commands_that_are_not_finite_are_refused() {
             turn: 0.0,
         },
     ];
-    let request = Request {
-        task: Task::Steer {
-            frames: 60,
-            commands: bad.clone(),
-            ramp: 10,
-        },
-        count: 1,
-        seed: 0,
-        steps: Some(5),
-        feet: Feet::Raw,
-        method: Default::default(),
-    };
+    let request = steer_request(60, bad.clone());
     let e = sinmdm::plan(&metadata, &request).unwrap_err();
     assert!(e.to_string().contains("command 1"), "{e}");
     let mut stream = Stream::new(&metadata, StreamOptions::default()).unwrap();
@@ -314,15 +299,7 @@ fn a_facing_command_turns_the_character_and_leaves_its_walk_alone() {
     let metadata = model.metadata().clone();
     let frames = 300;
     let commands = vec![SteerFrame::Facing(turned_from_start(&metadata, FRAC_PI_2)); frames];
-    let steered = run(
-        &mut model,
-        Task::Steer {
-            frames,
-            commands: commands.clone(),
-            ramp: 10,
-        },
-        2,
-    );
+    let steered = steer(&mut model, &commands, 2);
     let free = run(&mut model, Task::Generate { frames }, 2);
     for i in 0..2 {
         let raw = steered.features.index_axis(ndarray::Axis(0), i);
@@ -366,15 +343,7 @@ fn a_circle_walked_facing_one_way_is_followed_within_the_clips_range() {
             facing,
         })
         .collect();
-    let steered = run(
-        &mut walk,
-        Task::Steer {
-            frames,
-            commands: commands.clone(),
-            ramp: 10,
-        },
-        2,
-    );
+    let steered = steer(&mut walk, &commands, 2);
     for i in 0..2 {
         let raw = steered.features.index_axis(ndarray::Axis(0), i);
         let p = path_following(&metadata.layout, raw, &commands).unwrap();
@@ -409,18 +378,7 @@ fn a_circle_walked_facing_one_way_is_followed_within_the_clips_range() {
         facing,
     })
     .collect();
-    let request = Request {
-        task: Task::Steer {
-            frames: 600,
-            commands,
-            ramp: 10,
-        },
-        count: 1,
-        seed: 1,
-        steps: Some(20),
-        feet: Feet::Raw,
-        method: Default::default(),
-    };
+    let request = steer_request(600, commands);
     let plan = sinmdm::plan(&metadata, &request).unwrap();
     assert!(
         plan.warnings().iter().any(|w| w.contains("sideways")),
@@ -436,18 +394,7 @@ fn a_facing_with_no_direction_on_the_ground_is_refused() {
     // The zombie's file frame is +Z up: facing +Z is facing nowhere on the ground.
     let up = metadata.layout.up.file_from_canonical() * Vec3::new(0.0, 1.0, 0.0);
     let commands = vec![SteerFrame::Free, SteerFrame::Facing(up)];
-    let request = Request {
-        task: Task::Steer {
-            frames: 60,
-            commands: commands.clone(),
-            ramp: 10,
-        },
-        count: 1,
-        seed: 0,
-        steps: Some(5),
-        feet: Feet::Raw,
-        method: Default::default(),
-    };
+    let request = steer_request(60, commands.clone());
     let e = sinmdm::plan(&metadata, &request).unwrap_err();
     assert!(e.to_string().contains("command 1"), "{e}");
     assert!(e.to_string().contains("no direction on the ground"), "{e}");

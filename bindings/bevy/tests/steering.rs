@@ -15,6 +15,35 @@ use common::{
     BEVY_FPS, HEADING_HALF_WINDOW, app_with, model_path, signed_angle, travel_headings, unwrapped,
 };
 
+/// Runs one frame of `app` and returns the root joint's world position, checking that the
+/// character neither failed nor set its steering aside.
+fn frame_root(app: &mut bevy_app::App, character: bevy_ecs::entity::Entity) -> bevy_math::Vec3 {
+    app.update();
+    let world = app.world();
+    let c = world.get::<MotionCharacter>(character).unwrap();
+    assert!(c.error().is_none(), "{:?}", c.error());
+    assert!(c.steering_note().is_none(), "{:?}", c.steering_note());
+    world
+        .get::<GlobalTransform>(c.joints()[0])
+        .unwrap()
+        .translation()
+}
+
+/// Gives the character `steering` and returns its steering reach at that moment (model frames).
+fn steer_now(
+    app: &mut bevy_app::App,
+    character: bevy_ecs::entity::Entity,
+    steering: Steering,
+) -> usize {
+    let reach = app
+        .world()
+        .get::<MotionCharacter>(character)
+        .unwrap()
+        .steering_reach();
+    app.world_mut().entity_mut(character).insert(steering);
+    reach
+}
+
 #[test]
 fn a_steering_command_turns_the_character_left_within_its_reach() {
     let model = MotionModel::open(model_path("human_zombie_walk_fair.onnx"), Some(1)).unwrap();
@@ -53,29 +82,16 @@ fn a_steering_command_turns_the_character_left_within_its_reach() {
             if k == turn_at
                 && let Some(turn) = turn
             {
-                reach = app
-                    .world()
-                    .get::<MotionCharacter>(character)
-                    .unwrap()
-                    .steering_reach();
-                app.world_mut()
-                    .entity_mut(character)
-                    .insert(Steering::Velocity {
+                reach = steer_now(
+                    &mut app,
+                    character,
+                    Steering::Velocity {
                         forward: speed,
                         turn,
-                    });
+                    },
+                );
             }
-            app.update();
-            let world = app.world();
-            let c = world.get::<MotionCharacter>(character).unwrap();
-            assert!(c.error().is_none(), "{:?}", c.error());
-            assert!(c.steering_note().is_none(), "{:?}", c.steering_note());
-            roots.push(
-                world
-                    .get::<GlobalTransform>(c.joints()[0])
-                    .unwrap()
-                    .translation(),
-            );
+            roots.push(frame_root(&mut app, character));
         }
         (travel_headings(&roots), reach)
     };
@@ -173,26 +189,9 @@ fn a_facing_command_turns_the_character_to_walk_that_way() {
             let heading = going + 120f64.to_radians();
             wanted = Some(heading);
             let direction = bevy_math::Vec3::new(heading.sin() as f32, 0.3, heading.cos() as f32);
-            reach = app
-                .world()
-                .get::<MotionCharacter>(character)
-                .unwrap()
-                .steering_reach();
-            app.world_mut()
-                .entity_mut(character)
-                .insert(Steering::Face { direction });
+            reach = steer_now(&mut app, character, Steering::Face { direction });
         }
-        app.update();
-        let world = app.world();
-        let c = world.get::<MotionCharacter>(character).unwrap();
-        assert!(c.error().is_none(), "{:?}", c.error());
-        assert!(c.steering_note().is_none(), "{:?}", c.steering_note());
-        roots.push(
-            world
-                .get::<GlobalTransform>(c.joints()[0])
-                .unwrap()
-                .translation(),
-        );
+        roots.push(frame_root(&mut app, character));
     }
     let wanted = wanted.unwrap();
     let settled = face_at + ((reach as f64 / fps + 1.5) * BEVY_FPS).ceil() as usize;

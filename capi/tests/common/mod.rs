@@ -257,12 +257,11 @@ pub fn expected() -> BTreeMap<String, String> {
     // Steering the zombie walk: 40 frames at 12 units/s turning 0.3 rad/s, one-shot; and a
     // stream told 10 units/s turning -0.2 rad/s for 60 frames, read in chunks of 20 and 25.
     let mut zombie = Model::open(steer_model_path(), &ModelOptions { threads: Some(1) }).unwrap();
-    let steered = sinmdm::run(
-        &mut zombie,
-        &Request {
+    let mut steered = |commands: Vec<sinmdm::steer::SteerFrame>| {
+        let request = Request {
             task: Task::Steer {
                 frames: 40,
-                commands: steer_commands(40, 12.0, 0.3),
+                commands,
                 ramp: 5,
             },
             count: 1,
@@ -270,30 +269,15 @@ pub fn expected() -> BTreeMap<String, String> {
             steps: Some(4),
             feet: Feet::Planted,
             method: Default::default(),
-        },
-        go,
-    )
-    .unwrap();
-    pose_lines("steer", &steered.poses(0).unwrap(), &mut out);
+        };
+        sinmdm::run(&mut zombie, &request, go)
+            .unwrap()
+            .poses(0)
+            .unwrap()
+    };
+    pose_lines("steer", &steered(steer_commands(40, 12.0, 0.3)), &mut out);
     // The same with facing commands.
-    let faced = sinmdm::run(
-        &mut zombie,
-        &Request {
-            task: Task::Steer {
-                frames: 40,
-                commands: facing_commands(),
-                ramp: 5,
-            },
-            count: 1,
-            seed: 3,
-            steps: Some(4),
-            feet: Feet::Planted,
-            method: Default::default(),
-        },
-        go,
-    )
-    .unwrap();
-    pose_lines("steerfacing", &faced.poses(0).unwrap(), &mut out);
+    pose_lines("steerfacing", &steered(facing_commands()), &mut out);
     stream_lines(
         &mut zombie,
         "steerstream",
