@@ -51,7 +51,10 @@ namespace Sinmdm
         }
 
         [StructLayout(LayoutKind.Sequential)]
-        internal struct SteerLimits { public double ForwardMin, ForwardMax, TurnMax, SidewaysMin, SidewaysMax; }
+        internal struct SteerLimits { public double ForwardMin, ForwardMax, TurnMax; }
+
+        [StructLayout(LayoutKind.Sequential)]
+        internal struct SteerSideways { public double LeftwardMin, LeftwardMax; }
 
         [StructLayout(LayoutKind.Sequential)]
         internal struct StreamOptions
@@ -82,10 +85,11 @@ namespace Sinmdm
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_dance(ModelHandle model, ref Sampling sampling, ref PosesIn reference, ref Dance dance, out ResultHandle result);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_dance_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, ref Dance dance, out RunHandle run);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_dance_reference_beats(ModelHandle model, ref PosesIn reference, UIntPtr[] beats, UIntPtr capacity, out UIntPtr needed);
-        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_steer(ModelHandle model, ref Sampling sampling, UIntPtr frames, SteerFrame[] commands, UIntPtr commandCount, UIntPtr ramp, out ResultHandle result);
-        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_steer_begin(ModelHandle model, ref Sampling sampling, UIntPtr frames, SteerFrame[] commands, UIntPtr commandCount, UIntPtr ramp, out RunHandle run);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_steer_commands(ModelHandle model, ref Sampling sampling, UIntPtr frames, SteerFrame[] commands, UIntPtr commandCount, UIntPtr ramp, out ResultHandle result);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_steer_commands_begin(ModelHandle model, ref Sampling sampling, UIntPtr frames, SteerFrame[] commands, UIntPtr commandCount, UIntPtr ramp, out RunHandle run);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_steer_limits(ModelHandle model, out SteerLimits limits);
-        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_stream_steer(StreamHandle stream, SteerFrame[] commands, UIntPtr count);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_steer_sideways_limits(ModelHandle model, out SteerSideways sideways);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_stream_steer_commands(StreamHandle stream, SteerFrame[] commands, UIntPtr count);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_inbetween(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out ResultHandle result);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_inbetween_begin(ModelHandle model, ref Sampling sampling, ref PosesIn reference, Span[] keep, UIntPtr spanCount, UIntPtr ramp, out RunHandle run);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_expand(ModelHandle model, ref Sampling sampling, ref PosesIn reference, UIntPtr prefix, UIntPtr suffix, UIntPtr ramp, out ResultHandle result);

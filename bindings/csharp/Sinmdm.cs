@@ -77,7 +77,7 @@ namespace Sinmdm
     public enum SteerKind : uint { Free = 0, Velocity = 1, Position = 2, Facing = 3, PositionFacing = 4 }
 
     /// <summary>One frame's steering command for a heading-relative model (file frame: the
-    /// model's up axis and units); the layout of the C ABI's SinmdmSteerFrame.</summary>
+    /// model's up axis and units); the layout of the C ABI's SinmdmSteerCommand.</summary>
     [StructLayout(LayoutKind.Sequential)]
     public struct SteerFrame
     {
@@ -371,7 +371,8 @@ namespace Sinmdm
         public SteerLimits SteerLimits()
         {
             Native.Check(Native.sinmdm_steer_limits(Handle, out Native.SteerLimits l));
-            return new SteerLimits { ForwardMin = l.ForwardMin, ForwardMax = l.ForwardMax, TurnMax = l.TurnMax, SidewaysMin = l.SidewaysMin, SidewaysMax = l.SidewaysMax };
+            Native.Check(Native.sinmdm_steer_sideways_limits(Handle, out Native.SteerSideways s));
+            return new SteerLimits { ForwardMin = l.ForwardMin, ForwardMax = l.ForwardMax, TurnMax = l.TurnMax, SidewaysMin = s.LeftwardMin, SidewaysMax = s.LeftwardMax };
         }
 
         /// <summary>New motion of `frames` frames whose root goes where `commands` say (one per
@@ -380,7 +381,7 @@ namespace Sinmdm
         {
             if (commands == null) throw new ArgumentNullException(nameof(commands));
             var native = sampling.ToNative();
-            int status = Native.sinmdm_steer(Handle, ref native, Native.Size(frames, nameof(frames)), commands,
+            int status = Native.sinmdm_steer_commands(Handle, ref native, Native.Size(frames, nameof(frames)), commands,
                                              (UIntPtr)commands.Length, Native.Size(ramp, nameof(ramp)), out ResultHandle result);
             return Blocking(status, result);
         }
@@ -393,7 +394,7 @@ namespace Sinmdm
         {
             if (commands == null) throw new ArgumentNullException(nameof(commands));
             var native = sampling.ToNative();
-            int status = Native.sinmdm_steer_begin(Handle, ref native, Native.Size(frames, nameof(frames)), commands,
+            int status = Native.sinmdm_steer_commands_begin(Handle, ref native, Native.Size(frames, nameof(frames)), commands,
                                                    (UIntPtr)commands.Length, Native.Size(ramp, nameof(ramp)), out RunHandle run);
             return Begun(status, run);
         }
@@ -653,7 +654,7 @@ namespace Sinmdm
         public void Steer(SteerFrame[] commands)
         {
             if (commands == null) throw new ArgumentNullException(nameof(commands));
-            Native.Check(Native.sinmdm_stream_steer(handle, commands, (UIntPtr)commands.Length));
+            Native.Check(Native.sinmdm_stream_steer_commands(handle, commands, (UIntPtr)commands.Length));
         }
 
         /// <summary>Prepares frames ahead with at most `maxSteps` denoising steps (call it each

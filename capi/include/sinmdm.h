@@ -231,13 +231,14 @@
 #define SINMDM_STEER_POSITION 2
 
 /*
- A frame that asks for the direction the character faces (where it goes is the model's).
+ A `SinmdmSteerCommand` that asks for the direction the character faces (where it goes is
+ the model's).
  */
 #define SINMDM_STEER_FACING 3
 
 /*
- A frame that asks for the root's position on the ground and, apart, the direction the
- character faces (a path walked sideways or backwards).
+ A `SinmdmSteerCommand` that asks for the root's position on the ground and, apart, the
+ direction the character faces (a path walked sideways or backwards).
  */
 #define SINMDM_STEER_POSITION_FACING 4
 
@@ -520,20 +521,41 @@ typedef struct SinmdmSteerLimits {
    Largest turn rate either way, radians per second.
    */
   double turn_max;
-  /*
-   Fastest rightward speed (as a negative leftward one), file units per second.
-   */
-  double sideways_min;
-  /*
-   Fastest leftward speed, file units per second.
-   */
-  double sideways_max;
 } SinmdmSteerLimits;
 
 /*
  One frame's steering command (file frame: the model's up axis and units).
  */
 typedef struct SinmdmSteerFrame {
+  /*
+   `SINMDM_STEER_FREE`, `SINMDM_STEER_VELOCITY` or `SINMDM_STEER_POSITION`.
+   */
+  uint32_t kind;
+  /*
+   Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
+   included, so the struct is 48 bytes everywhere).
+   */
+  uint32_t reserved;
+  /*
+   `SINMDM_STEER_VELOCITY`: forward speed, file units per second.
+   */
+  double forward;
+  /*
+   `SINMDM_STEER_VELOCITY`: turn rate, radians per second; positive turns left
+   (counter-clockwise seen from above).
+   */
+  double turn;
+  /*
+   `SINMDM_STEER_POSITION`: the root's position, file frame (the up component is ignored).
+   */
+  double position[3];
+} SinmdmSteerFrame;
+
+/*
+ One frame's steering command with every kind, facings included (file frame: the model's up
+ axis and units): `SinmdmSteerFrame` and a facing.
+ */
+typedef struct SinmdmSteerCommand {
   /*
    `SINMDM_STEER_FREE`, `_VELOCITY`, `_POSITION`, `_FACING` or `_POSITION_FACING`.
    */
@@ -562,7 +584,22 @@ typedef struct SinmdmSteerFrame {
    frame (the up component is ignored; the rest must not be zero).
    */
   double facing[3];
-} SinmdmSteerFrame;
+} SinmdmSteerCommand;
+
+/*
+ How fast a model's clip went sideways: a path walked in a facing of its own is followed no
+ faster sideways than this.
+ */
+typedef struct SinmdmSteerSideways {
+  /*
+   Fastest rightward speed, as a negative leftward one, file units per second.
+   */
+  double leftward_min;
+  /*
+   Fastest leftward speed, file units per second.
+   */
+  double leftward_max;
+} SinmdmSteerSideways;
 
 /*
  How a stream makes its motion; zeros give the defaults.
@@ -947,6 +984,60 @@ enum SinmdmStatus sinmdm_steer(struct SinmdmModel *model,
 enum SinmdmStatus sinmdm_stream_steer(struct SinmdmStream *stream,
                                       const struct SinmdmSteerFrame *commands,
                                       size_t count);
+
+/*
+ Begins a steered run with commands of every kind, facings included (see
+ `sinmdm_steer_commands` and `sinmdm_run_step`).
+
+ # Safety
+ As `sinmdm_steer_commands`.
+ */
+enum SinmdmStatus sinmdm_steer_commands_begin(struct SinmdmModel *model,
+                                              const struct SinmdmSampling *sampling,
+                                              size_t frames,
+                                              const struct SinmdmSteerCommand *commands,
+                                              size_t command_count,
+                                              size_t ramp,
+                                              struct SinmdmRun **out);
+
+/*
+ `sinmdm_steer` with commands of every kind: a facing alone (`SINMDM_STEER_FACING`) or with
+ a position (`SINMDM_STEER_POSITION_FACING`) as well. `SINMDM_INVALID_ARGUMENT` for a facing
+ with no direction on the ground.
+
+ # Safety
+ Pointers as their types' documentation says; `commands` readable for `command_count`
+ values.
+ */
+enum SinmdmStatus sinmdm_steer_commands(struct SinmdmModel *model,
+                                        const struct SinmdmSampling *sampling,
+                                        size_t frames,
+                                        const struct SinmdmSteerCommand *commands,
+                                        size_t command_count,
+                                        size_t ramp,
+                                        struct SinmdmResult **out);
+
+/*
+ `sinmdm_stream_steer` with commands of every kind, facings included; the two add to the
+ same queue of commands.
+
+ # Safety
+ `stream` is a live handle; `commands` readable for `count` values.
+ */
+enum SinmdmStatus sinmdm_stream_steer_commands(struct SinmdmStream *stream,
+                                               const struct SinmdmSteerCommand *commands,
+                                               size_t count);
+
+/*
+ Writes how fast `model`'s clip went sideways to `out` (what a path walked in a facing of
+ its own is clamped to); `SINMDM_INVALID_ARGUMENT` for a model without a heading-relative
+ root.
+
+ # Safety
+ `model` is a live handle; `out` writable.
+ */
+enum SinmdmStatus sinmdm_steer_sideways_limits(const struct SinmdmModel *model,
+                                               struct SinmdmSteerSideways *out);
 
 /*
  Makes a stream of `model`'s motion with `options` and writes its handle to `out`.

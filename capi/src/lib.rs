@@ -108,8 +108,10 @@ pub use sampling::{
 pub use status::{SinmdmStatus, sinmdm_last_error};
 pub use steer::{
     SINMDM_STEER_FACING, SINMDM_STEER_FREE, SINMDM_STEER_POSITION, SINMDM_STEER_POSITION_FACING,
-    SINMDM_STEER_VELOCITY, SinmdmSteerFrame, SinmdmSteerLimits, sinmdm_steer, sinmdm_steer_begin,
-    sinmdm_steer_limits, sinmdm_stream_steer,
+    SINMDM_STEER_VELOCITY, SinmdmSteerCommand, SinmdmSteerFrame, SinmdmSteerLimits,
+    SinmdmSteerSideways, sinmdm_steer, sinmdm_steer_begin, sinmdm_steer_commands,
+    sinmdm_steer_commands_begin, sinmdm_steer_limits, sinmdm_steer_sideways_limits,
+    sinmdm_stream_steer, sinmdm_stream_steer_commands,
 };
 pub use stream::{
     SinmdmStream, SinmdmStreamOptions, sinmdm_stream_free, sinmdm_stream_new, sinmdm_stream_next,

@@ -1,6 +1,9 @@
 //! Steering through the C ABI: where a heading-relative model's character goes, frame by frame
 //! and ahead of time, in a one-shot run (`sinmdm_steer`) or a stream (`sinmdm_stream_steer`),
-//! and the range of commands its clip supports (`sinmdm_steer_limits`).
+//! and the range of commands its clip supports (`sinmdm_steer_limits`). Facings came later, so
+//! by the C ABI's rule (struct layouts never change) they have their own command struct,
+//! `SinmdmSteerCommand`, and functions (`sinmdm_steer_commands`, `_begin`,
+//! `sinmdm_stream_steer_commands`, `sinmdm_steer_sideways_limits`).
 
 use sinmdm::Task;
 use sinmdm::motion::math::Vec3;
@@ -22,16 +25,51 @@ pub const SINMDM_STEER_FREE: u32 = 0;
 pub const SINMDM_STEER_VELOCITY: u32 = 1;
 /// A frame that asks for the root's position on the ground (facing the way the path goes).
 pub const SINMDM_STEER_POSITION: u32 = 2;
-/// A frame that asks for the direction the character faces (where it goes is the model's).
+/// A `SinmdmSteerCommand` that asks for the direction the character faces (where it goes is
+/// the model's).
 pub const SINMDM_STEER_FACING: u32 = 3;
-/// A frame that asks for the root's position on the ground and, apart, the direction the
-/// character faces (a path walked sideways or backwards).
+/// A `SinmdmSteerCommand` that asks for the root's position on the ground and, apart, the
+/// direction the character faces (a path walked sideways or backwards).
 pub const SINMDM_STEER_POSITION_FACING: u32 = 4;
 
 /// One frame's steering command (file frame: the model's up axis and units).
 #[repr(C)]
 #[derive(Debug, Clone, Copy)]
 pub struct SinmdmSteerFrame {
+    /// `SINMDM_STEER_FREE`, `SINMDM_STEER_VELOCITY` or `SINMDM_STEER_POSITION`.
+    pub kind: u32,
+    /// Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
+    /// included, so the struct is 48 bytes everywhere).
+    pub reserved: u32,
+    /// `SINMDM_STEER_VELOCITY`: forward speed, file units per second.
+    pub forward: f64,
+    /// `SINMDM_STEER_VELOCITY`: turn rate, radians per second; positive turns left
+    /// (counter-clockwise seen from above).
+    pub turn: f64,
+    /// `SINMDM_STEER_POSITION`: the root's position, file frame (the up component is ignored).
+    pub position: [f64; 3],
+}
+
+const _: () = assert!(std::mem::size_of::<SinmdmSteerFrame>() == 48);
+const _: () = assert!(std::mem::offset_of!(SinmdmSteerFrame, forward) == 8);
+
+/// The range of commands a model's clip supports (what is beyond it is clamped).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SinmdmSteerLimits {
+    /// Slowest forward speed, file units per second.
+    pub forward_min: f64,
+    /// Fastest forward speed, file units per second.
+    pub forward_max: f64,
+    /// Largest turn rate either way, radians per second.
+    pub turn_max: f64,
+}
+
+/// One frame's steering command with every kind, facings included (file frame: the model's up
+/// axis and units): `SinmdmSteerFrame` and a facing.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct SinmdmSteerCommand {
     /// `SINMDM_STEER_FREE`, `_VELOCITY`, `_POSITION`, `_FACING` or `_POSITION_FACING`.
     pub kind: u32,
     /// Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
@@ -50,33 +88,46 @@ pub struct SinmdmSteerFrame {
     pub facing: [f64; 3],
 }
 
-const _: () = assert!(std::mem::size_of::<SinmdmSteerFrame>() == 72);
-const _: () = assert!(std::mem::offset_of!(SinmdmSteerFrame, forward) == 8);
+const _: () = assert!(std::mem::size_of::<SinmdmSteerCommand>() == 72);
+const _: () = assert!(std::mem::offset_of!(SinmdmSteerCommand, facing) == 48);
 
-/// The range of commands a model's clip supports (what is beyond it is clamped).
+/// How fast a model's clip went sideways: a path walked in a facing of its own is followed no
+/// faster sideways than this.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default)]
-pub struct SinmdmSteerLimits {
-    /// Slowest forward speed, file units per second.
-    pub forward_min: f64,
-    /// Fastest forward speed, file units per second.
-    pub forward_max: f64,
-    /// Largest turn rate either way, radians per second.
-    pub turn_max: f64,
-    /// Fastest rightward speed (as a negative leftward one), file units per second.
-    pub sideways_min: f64,
+pub struct SinmdmSteerSideways {
+    /// Fastest rightward speed, as a negative leftward one, file units per second.
+    pub leftward_min: f64,
     /// Fastest leftward speed, file units per second.
-    pub sideways_max: f64,
+    pub leftward_max: f64,
 }
 
-/// The library's commands from a caller array of at most `SINMDM_MAX_SAMPLE_FRAMES` frames.
+impl From<&SinmdmSteerFrame> for SinmdmSteerCommand {
+    fn from(f: &SinmdmSteerFrame) -> SinmdmSteerCommand {
+        SinmdmSteerCommand {
+            kind: f.kind,
+            reserved: f.reserved,
+            forward: f.forward,
+            turn: f.turn,
+            position: f.position,
+            facing: [0.0; 3],
+        }
+    }
+}
+
+/// The library's commands from a caller array of at most `SINMDM_MAX_SAMPLE_FRAMES` frames,
+/// of kinds up to `last_kind` (the frame struct's kinds, or the command struct's).
 ///
 /// # Safety
 /// `frames` is readable for `count` values (or NULL with 0).
-unsafe fn commands_arg(
-    frames: *const SinmdmSteerFrame,
+unsafe fn commands_arg<T>(
+    frames: *const T,
     count: usize,
-) -> Result<Vec<SteerFrame>, Failure> {
+    last_kind: u32,
+) -> Result<Vec<SteerFrame>, Failure>
+where
+    for<'a> &'a T: Into<SinmdmSteerCommand>,
+{
     if count > SINMDM_MAX_SAMPLE_FRAMES {
         return Err(Failure::invalid(format!(
             "commands: {count} frames; at most {SINMDM_MAX_SAMPLE_FRAMES} (one per frame of the longest sample)"
@@ -87,6 +138,7 @@ unsafe fn commands_arg(
         .iter()
         .enumerate()
         .map(|(i, f)| {
+            let f: SinmdmSteerCommand = f.into();
             let finite = |values: &[f64], what: &str| {
                 if values.iter().all(|v| v.is_finite()) {
                     Ok(())
@@ -110,11 +162,11 @@ unsafe fn commands_arg(
                     finite(&f.position, "position")?;
                     Ok(SteerFrame::Position(Vec3(f.position)))
                 }
-                SINMDM_STEER_FACING => {
+                SINMDM_STEER_FACING if last_kind >= SINMDM_STEER_FACING => {
                     finite(&f.facing, "facing")?;
                     Ok(SteerFrame::Facing(Vec3(f.facing)))
                 }
-                SINMDM_STEER_POSITION_FACING => {
+                SINMDM_STEER_POSITION_FACING if last_kind >= SINMDM_STEER_POSITION_FACING => {
                     finite(&f.position, "position")?;
                     finite(&f.facing, "facing")?;
                     Ok(SteerFrame::PositionFacing {
@@ -122,12 +174,90 @@ unsafe fn commands_arg(
                         facing: Vec3(f.facing),
                     })
                 }
+                other if last_kind == SINMDM_STEER_POSITION => Err(Failure::invalid(format!(
+                    "commands[{i}].kind must be SINMDM_STEER_FREE (0), _VELOCITY (1) or _POSITION (2), got {other} (facings take a SinmdmSteerCommand array: sinmdm_steer_commands)"
+                ))),
                 other => Err(Failure::invalid(format!(
                     "commands[{i}].kind must be SINMDM_STEER_FREE (0), _VELOCITY (1), _POSITION (2), _FACING (3) or _POSITION_FACING (4), got {other}"
                 ))),
             }
         })
         .collect()
+}
+
+/// The steering limits of a live `model`, or why it has none.
+///
+/// # Safety
+/// `model` is a live handle (or NULL, refused).
+unsafe fn limits_of(model: *const SinmdmModel) -> Result<SteerLimits, Failure> {
+    let m = unsafe { handle(model.cast_mut(), "model") }?;
+    SteerLimits::of(m.model.metadata()).ok_or_else(|| {
+        Failure::invalid(
+            "the model has no heading-relative root, so it cannot be steered (train it with --root-layout heading)",
+        )
+    })
+}
+
+/// Begins a steered run from a caller array of either command struct (kinds up to
+/// `last_kind`).
+///
+/// # Safety
+/// As `sinmdm_steer`.
+#[allow(clippy::too_many_arguments)]
+unsafe fn steer_begin<T>(
+    model: *mut SinmdmModel,
+    sampling: *const SinmdmSampling,
+    frames: usize,
+    commands: *const T,
+    command_count: usize,
+    last_kind: u32,
+    ramp: usize,
+    out: *mut *mut SinmdmRun,
+) -> SinmdmStatus
+where
+    for<'a> &'a T: Into<SinmdmSteerCommand>,
+{
+    unsafe {
+        begin(model, out, |_| {
+            let sampling = sampling_arg(sampling)?;
+            let commands = commands_arg(commands, command_count, last_kind)?;
+            request(
+                &sampling,
+                Task::Steer {
+                    frames,
+                    commands,
+                    ramp,
+                },
+            )
+        })
+    }
+}
+
+/// Queues a stream's steering commands from a caller array of either command struct.
+///
+/// # Safety
+/// As `sinmdm_stream_steer`.
+unsafe fn stream_steer<T>(
+    stream: *mut SinmdmStream,
+    commands: *const T,
+    count: usize,
+    last_kind: u32,
+) -> SinmdmStatus
+where
+    for<'a> &'a T: Into<SinmdmSteerCommand>,
+{
+    guard(|| {
+        let stream = unsafe { handle(stream, "stream") }?;
+        let commands = unsafe { commands_arg(commands, count, last_kind) }?;
+        stream.stream.steer(&commands)?;
+        Ok(())
+    })
+}
+
+impl From<&SinmdmSteerCommand> for SinmdmSteerCommand {
+    fn from(c: &SinmdmSteerCommand) -> SinmdmSteerCommand {
+        *c
+    }
 }
 
 /// Writes the range of commands `model`'s clip supports to `out`; `SINMDM_INVALID_ARGUMENT`
@@ -141,19 +271,12 @@ pub unsafe extern "C" fn sinmdm_steer_limits(
     out: *mut SinmdmSteerLimits,
 ) -> SinmdmStatus {
     guard(|| {
-        let m = unsafe { handle(model.cast_mut(), "model") }?;
+        let limits = unsafe { limits_of(model) }?;
         let out = unsafe { handle(out, "out") }?;
-        let limits = SteerLimits::of(m.model.metadata()).ok_or_else(|| {
-            Failure::invalid(
-                "the model has no heading-relative root, so it cannot be steered (train it with --root-layout heading)",
-            )
-        })?;
         *out = SinmdmSteerLimits {
             forward_min: limits.forward.0,
             forward_max: limits.forward.1,
             turn_max: limits.turn,
-            sideways_min: limits.sideways.0,
-            sideways_max: limits.sideways.1,
         };
         Ok(())
     })
@@ -174,18 +297,16 @@ pub unsafe extern "C" fn sinmdm_steer_begin(
     out: *mut *mut SinmdmRun,
 ) -> SinmdmStatus {
     unsafe {
-        begin(model, out, |_| {
-            let sampling = sampling_arg(sampling)?;
-            let commands = commands_arg(commands, command_count)?;
-            request(
-                &sampling,
-                Task::Steer {
-                    frames,
-                    commands,
-                    ramp,
-                },
-            )
-        })
+        steer_begin(
+            model,
+            sampling,
+            frames,
+            commands,
+            command_count,
+            SINMDM_STEER_POSITION,
+            ramp,
+            out,
+        )
     }
 }
 
@@ -230,10 +351,94 @@ pub unsafe extern "C" fn sinmdm_stream_steer(
     commands: *const SinmdmSteerFrame,
     count: usize,
 ) -> SinmdmStatus {
+    unsafe { stream_steer(stream, commands, count, SINMDM_STEER_POSITION) }
+}
+
+/// Begins a steered run with commands of every kind, facings included (see
+/// `sinmdm_steer_commands` and `sinmdm_run_step`).
+///
+/// # Safety
+/// As `sinmdm_steer_commands`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_steer_commands_begin(
+    model: *mut SinmdmModel,
+    sampling: *const SinmdmSampling,
+    frames: usize,
+    commands: *const SinmdmSteerCommand,
+    command_count: usize,
+    ramp: usize,
+    out: *mut *mut SinmdmRun,
+) -> SinmdmStatus {
+    unsafe {
+        steer_begin(
+            model,
+            sampling,
+            frames,
+            commands,
+            command_count,
+            SINMDM_STEER_POSITION_FACING,
+            ramp,
+            out,
+        )
+    }
+}
+
+/// `sinmdm_steer` with commands of every kind: a facing alone (`SINMDM_STEER_FACING`) or with
+/// a position (`SINMDM_STEER_POSITION_FACING`) as well. `SINMDM_INVALID_ARGUMENT` for a facing
+/// with no direction on the ground.
+///
+/// # Safety
+/// Pointers as their types' documentation says; `commands` readable for `command_count`
+/// values.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_steer_commands(
+    model: *mut SinmdmModel,
+    sampling: *const SinmdmSampling,
+    frames: usize,
+    commands: *const SinmdmSteerCommand,
+    command_count: usize,
+    ramp: usize,
+    out: *mut *mut SinmdmResult,
+) -> SinmdmStatus {
+    unsafe {
+        blocking(model, out, |run| {
+            sinmdm_steer_commands_begin(model, sampling, frames, commands, command_count, ramp, run)
+        })
+    }
+}
+
+/// `sinmdm_stream_steer` with commands of every kind, facings included; the two add to the
+/// same queue of commands.
+///
+/// # Safety
+/// `stream` is a live handle; `commands` readable for `count` values.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_stream_steer_commands(
+    stream: *mut SinmdmStream,
+    commands: *const SinmdmSteerCommand,
+    count: usize,
+) -> SinmdmStatus {
+    unsafe { stream_steer(stream, commands, count, SINMDM_STEER_POSITION_FACING) }
+}
+
+/// Writes how fast `model`'s clip went sideways to `out` (what a path walked in a facing of
+/// its own is clamped to); `SINMDM_INVALID_ARGUMENT` for a model without a heading-relative
+/// root.
+///
+/// # Safety
+/// `model` is a live handle; `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_steer_sideways_limits(
+    model: *const SinmdmModel,
+    out: *mut SinmdmSteerSideways,
+) -> SinmdmStatus {
     guard(|| {
-        let stream = unsafe { handle(stream, "stream") }?;
-        let commands = unsafe { commands_arg(commands, count) }?;
-        stream.stream.steer(&commands)?;
+        let limits = unsafe { limits_of(model) }?;
+        let out = unsafe { handle(out, "out") }?;
+        *out = SinmdmSteerSideways {
+            leftward_min: limits.sideways.0,
+            leftward_max: limits.sideways.1,
+        };
         Ok(())
     })
 }

@@ -137,6 +137,11 @@ impl CourseArgs {
                 metadata.layout.up
             );
         }
+        if commands.iter().any(|c| c.facing().is_some()) {
+            bail!(
+                "--face with a path that gives its own facings (six numbers a line): give one or the other"
+            );
+        }
         Ok(commands
             .into_iter()
             .map(|c| match c.position() {

@@ -409,7 +409,11 @@ fn steer_takes_facings_and_names_what_it_refuses() {
     assert!(stdout.contains("path distance"), "{stdout}");
     std::fs::remove_file(&out).unwrap();
     // Refusals name the flag or the line, and write nothing.
-    let refusals: [(&[&str], &str); 4] = [
+    let refusals: [(&[&str], &str); 5] = [
+        (
+            &["--path", path_text, "--face", "1,0,0"],
+            "give one or the other",
+        ),
         (&["--face", "0,0,1"], "no part on the ground"),
         (&["--face", "1,0"], "--face takes three"),
         (&["--face", "1,0,0", "--velocity", path_text], "--velocity"),

@@ -106,7 +106,12 @@ def main(argv=None):
             elif args.path:
                 commands = steer.read_path(args.path)
             if args.face:
-                facing = tuple(float(x) for x in args.face.replace(";", ",").split(","))
+                if args.velocity:
+                    raise ValueError("--face cannot go with --velocity (a velocity's turn sets the facing)")
+                fields = [x for x in args.face.replace(";", ",").replace(" ", ",").split(",") if x.strip()]
+                facing = tuple(float(x) for x in fields)
+                if len(facing) != 3:
+                    raise ValueError(f"--face takes three numbers x,y,z, got '{args.face}'")
                 commands = steer.with_facing(commands, facing, args.frames)
             feats = stream_features(model, schedule, args.seed, args.frames, block=args.block, method=method,
                                     commands=commands)

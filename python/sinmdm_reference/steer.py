@@ -101,9 +101,15 @@ def to_canonical(model):
 
 def facing_of_direction(model, direction):
     """facing_of_direction: the canonical heading facing a file-frame ground direction, or None."""
-    d = mat_vec(to_canonical(model), direction)
+    largest = 0.0
+    for v in direction:
+        largest = max(largest, abs(v))
+    if not (math.isfinite(largest) and largest > 0.0):
+        return None
+    scale = 1.0 / largest
+    d = mat_vec(to_canonical(model), [v * scale for v in direction])
     d[UP] = 0.0
-    if not norm(d) > 1e-9 * max(norm(direction), 1e-300):
+    if not norm(d) > 1e-9:
         return None
     return math.atan2(d[0], d[2])
 
@@ -148,7 +154,7 @@ class Steering:
         self.max_step = max(hi, 0.0) / fps
         self.backward_floor = min(lo / fps, 0.0)
         side_lo, side_hi = sideways_limits(model)
-        self.sideways_range = (side_lo / fps, side_hi / fps)
+        self.sideways_range = (min(side_lo, 0.0) / fps, max(side_hi, 0.0) / fps)
 
     def apply(self, x0):
         """x0 [F, N] float32, normalised; changed in place."""
@@ -315,12 +321,22 @@ def read_velocities(path, fps, frames):
 
 def read_path(path):
     """x,y,z per line, or x,y,z,fx,fy,fz: a position and the direction to face there."""
-    return [("position", (v[0], v[1], v[2])) if len(v) == 3 else
-            ("position_facing", (v[0], v[1], v[2]), (v[3], v[4], v[5])) for v in _triples(path)]
+    out = []
+    for v in _triples(path):
+        if len(v) == 3:
+            out.append(("position", (v[0], v[1], v[2])))
+        elif len(v) == 6:
+            out.append(("position_facing", (v[0], v[1], v[2]), (v[3], v[4], v[5])))
+        else:
+            raise ValueError(f"{path}: a row of {len(v)} numbers; expected x,y,z or x,y,z,fx,fy,fz")
+    return out
 
 
 def with_facing(commands, facing, frames):
-    """--face: the path's positions walked in `facing`, or, without a path, `frames` frames of it."""
+    """--face: the path's positions walked in `facing`, or, without a path, `frames` frames of it.
+    A path that brings its own facings is refused, as the command line refuses it."""
     if commands is None:
         return [("facing", facing)] * frames
-    return [("position_facing", c[1], facing) if c is not None and c[0] == "position" else c for c in commands]
+    if any(c is not None and c[0] != "position" for c in commands):
+        raise ValueError("--face with a path that gives its own facings (six numbers a line): give one or the other")
+    return [("position_facing", c[1], facing) for c in commands]

@@ -240,7 +240,7 @@ static void check_stepping(SinmdmModel *model, size_t joints, const SinmdmPoses 
 
 static void steer_velocity(SinmdmSteerFrame *frames, size_t count, double forward, double turn) {
   for (size_t i = 0; i < count; i++) {
-    SinmdmSteerFrame f = {SINMDM_STEER_VELOCITY, 0, forward, turn, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+    SinmdmSteerFrame f = {SINMDM_STEER_VELOCITY, 0, forward, turn, {0.0, 0.0, 0.0}};
     frames[i] = f;
   }
 }
@@ -268,26 +268,33 @@ static void check_steering(const char *path, const char *world_path) {
   CHECK_OK(sinmdm_result_poses(steered, 0, &bs));
   print_poses("steer", &steer_poses);
   sinmdm_result_free(steered);
-  /* Facing commands: 20 frames facing (1, 0.5) on the ground (+Z is up), then 20 at positions
-     (0.5 i, 0.2 i) facing +Y. */
+  /* Facing commands (SinmdmSteerCommand): 20 frames facing (1, 0.5) on the ground (+Z is
+     up), then 20 at positions (0.5 i, 0.2 i) facing +Y. */
+  SinmdmSteerCommand faced[40];
   for (size_t i = 0; i < 40; i++) {
-    SinmdmSteerFrame facing = {SINMDM_STEER_FACING, 0, 0.0, 0.0, {0.0, 0.0, 0.0}, {1.0, 0.5, 0.0}};
-    SinmdmSteerFrame both = {SINMDM_STEER_POSITION_FACING, 0, 0.0, 0.0,
-                             {0.5 * (double)i, 0.2 * (double)i, 0.0}, {0.0, 1.0, 0.0}};
-    commands[i] = i < 20 ? facing : both;
+    SinmdmSteerCommand facing = {SINMDM_STEER_FACING, 0, 0.0, 0.0, {0.0, 0.0, 0.0}, {1.0, 0.5, 0.0}};
+    SinmdmSteerCommand both = {SINMDM_STEER_POSITION_FACING, 0, 0.0, 0.0,
+                               {0.5 * (double)i, 0.2 * (double)i, 0.0}, {0.0, 1.0, 0.0}};
+    faced[i] = i < 20 ? facing : both;
   }
-  CHECK_OK(sinmdm_steer(zombie, &once, 40, commands, 40, 5, &steered));
+  expect_true(sizeof(SinmdmSteerCommand) == 72 && sizeof(SinmdmSteerFrame) == 48,
+              "steering structs are 72 and 48 bytes");
+  CHECK_OK(sinmdm_steer_commands(zombie, &once, 40, faced, 40, 5, &steered));
   CHECK_OK(sinmdm_result_poses(steered, 0, &bs));
   print_poses("steerfacing", &steer_poses);
   sinmdm_result_free(steered);
-  /* A facing straight up has no direction on the ground. */
+  SinmdmSteerSideways sideways;
+  CHECK_OK(sinmdm_steer_sideways_limits(zombie, &sideways));
+  expect_true(sideways.leftward_min < sideways.leftward_max, "sideways limits are a range");
+  /* A facing straight up has no direction on the ground; the frame struct takes no facings. */
   SinmdmResult *refused = NULL;
-  commands[0].kind = SINMDM_STEER_FACING;
-  commands[0].facing[0] = 0.0;
-  commands[0].facing[1] = 0.0;
-  commands[0].facing[2] = 2.0;
-  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_steer(zombie, &once, 40, commands, 40, 5, &refused));
+  faced[0].facing[0] = 0.0;
+  faced[0].facing[1] = 0.0;
+  faced[0].facing[2] = 2.0;
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_steer_commands(zombie, &once, 40, faced, 40, 5, &refused));
   expect_true(refused == NULL, "a refused steer writes no result");
+  SinmdmSteerFrame old_kind[1] = {{SINMDM_STEER_FACING, 0, 0.0, 0.0, {1.0, 0.0, 0.0}}};
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_steer(zombie, &once, 40, old_kind, 1, 5, &refused));
   poses_free(&steer_poses);
 
   SinmdmStreamOptions options = {11, 3, 30, SINMDM_FEET_PLANTED, NULL, 0, 0, SINMDM_METHOD_ANCESTRAL, 0.0};

@@ -432,23 +432,42 @@ static void one_case(const char *model_a, const char *work) {
       /* Steering: commands of any kind and value (NaN, infinities, unknown kinds), counts past
          the bound, NULL arrays, either model (only model B can be steered). */
       static SinmdmSteerFrame commands[16];
+      static SinmdmSteerCommand full[16];
       for (size_t i = 0; i < 16; i++) {
         SinmdmSteerFrame f = {pick(4) ? (uint32_t)pick(5) : any_u32(), coin() ? 0 : any_u32(), coin() ? 12.0 : any_double(),
                               coin() ? 0.2 : any_double(),
-                              {coin() ? 1.0 * i : any_double(), any_double(), coin() ? -2.0 * i : any_double()},
-                              {coin() ? 1.0 : any_double(), pick(3) ? 0.0 : any_double(), coin() ? 0.5 : any_double()}};
+                              {coin() ? 1.0 * i : any_double(), any_double(), coin() ? -2.0 * i : any_double()}};
         commands[i] = f;
+        SinmdmSteerCommand c = {f.kind, f.reserved, f.forward, f.turn,
+                                {f.position[0], f.position[1], f.position[2]},
+                                {coin() ? 1.0 : any_double(), pick(3) ? 0.0 : any_double(), coin() ? 0.5 : any_double()}};
+        full[i] = c;
       }
       size_t counts[] = {0, 1, 7, 16, SINMDM_MAX_SAMPLE_FRAMES + 1, SIZE_MAX};
       size_t count = counts[pick(6)];
       const SinmdmSteerFrame *commands_ptr = (count <= 16 || coin()) && pick(6) ? commands : NULL;
       if (count > 16 && commands_ptr != NULL) commands_ptr = NULL;
+      const SinmdmSteerCommand *full_ptr = commands_ptr != NULL ? full : NULL;
+      SinmdmSteerSideways sideways;
       size_t frames = coin() ? 30 + pick(20) : any_size(SINMDM_MAX_SAMPLE_FRAMES);
       size_t ramp = coin() ? pick(12) : any_size(SINMDM_MAX_RAMP_FRAMES);
       SinmdmSteerLimits limits;
-      switch (pick(4)) {
+      switch (pick(8)) {
         case 0:
           CALL("steer", sinmdm_steer(model, sampling_ptr, frames, commands_ptr, count, ramp, result_out));
+          break;
+        case 4:
+          CALL("steer_commands", sinmdm_steer_commands(model, sampling_ptr, frames, full_ptr, count, ramp, result_out));
+          break;
+        case 5:
+          CALL("steer_commands_begin",
+               sinmdm_steer_commands_begin(model, sampling_ptr, frames, full_ptr, count, ramp, run_out));
+          break;
+        case 6:
+          CALL("steer_sideways_limits", sinmdm_steer_sideways_limits(model, coin() ? &sideways : NULL));
+          break;
+        case 7:
+          CALL("stream_steer_commands", sinmdm_stream_steer_commands(ANY_OF(streams), full_ptr, count));
           break;
         case 1:
           CALL("steer_begin", sinmdm_steer_begin(model, sampling_ptr, frames, commands_ptr, count, ramp, run_out));

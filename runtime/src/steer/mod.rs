@@ -23,9 +23,10 @@
 //!   path's is, to a course that joins the commanded facing from the prediction's over
 //!   [`FACING_CATCH_UP_SECONDS`] and then turns as the commands turn; the travel stays the
 //!   model's. Given with a path, the facing replaces the path's direction and the travel still
-//!   follows the path, in the facing's frame: a sideways walk (strafing) or a backward one. The
-//!   travel in that frame is clamped to the clip's forward and sideways range: a clip that never
-//!   walked sideways follows a strafed path only as fast as it ever went sideways.
+//!   follows the path: a sideways walk (strafing) or a backward one. The travel, in the
+//!   character's frame, is clamped to the clip's sideways range and its slowest forward speed
+//!   (each taking in 0): a clip that never walked sideways follows a strafed path only as fast
+//!   as it ever went sideways.
 //!
 //! Commands beyond what the clip showed are clamped ([`SteerLimits`]) and reported.
 
@@ -131,9 +132,14 @@ impl SteerFrame {
 /// the heading about up that faces it (canonical frame, as the root's turn rows integrate);
 /// `None` when its horizontal part is (nearly) zero.
 pub fn facing_of_direction(metadata: &ModelMetadata, direction: Vec3) -> Option<f64> {
-    let mut d = metadata.layout.up.canonical_from_file() * direction;
+    // Scaled by its largest component first, so a direction of any finite size is read alike.
+    let largest = direction.0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !(largest.is_finite() && largest > 0.0) {
+        return None;
+    }
+    let mut d = metadata.layout.up.canonical_from_file() * (direction * (1.0 / largest));
     d[UP] = 0.0;
-    (d.norm() > 1e-9 * direction.norm().max(1e-300)).then(|| d[0].atan2(d[2]))
+    (d.norm() > 1e-9).then(|| d[0].atan2(d[2]))
 }
 
 /// Checks commands before they are used: every number finite, every facing with a horizontal
@@ -242,8 +248,8 @@ pub struct Steering {
     catch_up: f64,
     /// The fastest the root may go, per frame.
     max_step: f64,
-    /// The clip's range of forward and leftward steps, per frame (a path walked with a facing
-    /// of its own is clamped to it).
+    /// The clip's range of forward and leftward steps, per frame, each widened to take in 0 (a
+    /// path walked with a facing of its own is clamped to it).
     forward_range: (f64, f64),
     sideways_range: (f64, f64),
 }
@@ -341,14 +347,15 @@ pub fn plan_steering(
         {
             let local = yaw(h).transpose() * (b - a);
             let (f, l) = (local[2] * fps, local[0] * fps);
-            let (lo, hi) = limits.sideways;
-            if l < lo * 1.0001 - 1e-12 || l > hi * 1.0001 + 1e-12 {
+            let (lo, hi) = (limits.sideways.0.min(0.0), limits.sideways.1.max(0.0));
+            let beyond = |v: f64, bound: f64| (v - bound).abs() > 1e-4 * bound.abs() + 1e-12;
+            if (l < lo && beyond(l, lo)) || (l > hi && beyond(l, hi)) {
                 warn(format!(
                     "the path with its facing asks for sideways speeds beyond the clip's {lo:.3} to {hi:.3} units/s; they are clamped, so the path is followed more slowly"
                 ));
             }
             let lo = limits.forward.0.min(0.0);
-            if f < lo * 1.0001 - 1e-12 {
+            if f < lo && beyond(f, lo) {
                 warn(format!(
                     "the path with its facing asks for backward speeds beyond the clip's slowest {lo:.3} units/s; they are clamped, so the path is followed more slowly"
                 ));
@@ -385,7 +392,10 @@ pub fn plan_steering(
             catch_up: (FACING_CATCH_UP_SECONDS * fps).max(1.0),
             max_step: top / fps,
             forward_range: (limits.forward.0 / fps, limits.forward.1 / fps),
-            sideways_range: (limits.sideways.0 / fps, limits.sideways.1 / fps),
+            sideways_range: (
+                limits.sideways.0.min(0.0) / fps,
+                limits.sideways.1.max(0.0) / fps,
+            ),
         }),
         warnings,
     })
