@@ -148,11 +148,14 @@ class Steering:
         self.mean = [float(model.mean[r]) for r in (FORWARD, LEFTWARD, TURN)]
         self.std = [float(model.std[r]) for r in (FORWARD, LEFTWARD, TURN)]
         self.reach = int(round_half_away(STEER_REACH_SECONDS * fps))
-        self.facing_reach = int(round_half_away(FACING_REACH_SECONDS * fps))
+        # A path's facing is pulled over a longer reach (Rust: plan_steering's turn_reach).
+        on_path = any(g is not None and g[0] == "course" and g[1] is not None and g[2] is None
+                      for g in goals[anchor + 1:])
+        self.turn_reach = int(round_half_away(FACING_REACH_SECONDS * fps)) if on_path else self.reach
         self.catch_up = max(FACING_CATCH_UP_SECONDS * fps, 1.0)
         lo, hi, _ = limits(model)
         self.max_step = max(hi, 0.0) / fps
-        self.backward_floor = min(lo / fps, 0.0)
+        self.backward_floor = min(lo, 0.0) / fps
         side_lo, side_hi = sideways_limits(model)
         self.sideways_range = (min(side_lo, 0.0) / fps, max(side_hi, 0.0) / fps)
 
@@ -246,9 +249,7 @@ class Steering:
             current = raw[k]
             pull = [0.0 if targets[k][i] is None else self.weights[i] * (targets[k][i] - current[i])
                     for i in range(n)]
-            on_path = any(g is not None and g[0] == "course" and g[1] is not None and g[2] is None
-                          for g in self.goals[self.anchor + 1:])
-            slow = triangular(pull, self.facing_reach if k == TURN and on_path else self.reach)
+            slow = triangular(pull, self.turn_reach if k == TURN else self.reach)
             x0[k] = np.array([np.float32(float(v) + d / self.std[k]) for v, d in zip(x0[k], slow)],
                              dtype=np.float32)
 

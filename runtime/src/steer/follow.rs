@@ -46,7 +46,8 @@ pub fn root_positions(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> 
     )
 }
 
-/// The root of `features` against the path of `commands` (their positions, file frame); `None` for a layout without a heading-relative root or fewer than two points.
+/// The root of `features` against the path of `commands` (their positions, file frame);
+/// `None` for a layout without a heading-relative root or fewer than two points.
 pub fn path_following(
     layout: &FeatureLayout,
     features: ArrayView2<'_, f32>,

@@ -1,6 +1,7 @@
 //! Steering a heading-relative model (SPEC section 5, "Steering"): where the character goes is
 //! asked for frame by frame (a path on the ground, forward speed and turn rate, a facing, or a
-//! path with a facing of its own), and the sampler pulls the root's slow motion to it while the network makes the body to match.
+//! path with a facing of its own), and the sampler pulls the root's slow motion to it while the
+//! network makes the body to match.
 //!
 //! A command is an average over a stride, not a value per frame: a walk's hips speed up and
 //! slow down within each step, and its facing sways. So steering sets only the **slow part** of
@@ -219,14 +220,6 @@ impl Goal {
             _ => None,
         }
     }
-
-    /// Which parts a course goal has: a span of course goals is one of the same parts.
-    fn parts(&self) -> Option<(bool, bool)> {
-        match *self {
-            Goal::Course { position, facing } => Some((position.is_some(), facing.is_some())),
-            _ => None,
-        }
-    }
 }
 
 /// The steering of one sampling run: a goal per frame of its window, from a known course.
@@ -242,15 +235,15 @@ pub struct Steering {
     /// Mean and standard deviation of the forward, leftward and turn rows.
     mean: [f64; 3],
     std: [f64; 3],
-    /// Low-pass half-width (the facing's, for a path), and catch-up time, frames.
+    /// Low-pass half-width of the travel rows and of the turn row, and catch-up time, frames.
     reach: usize,
-    facing_reach: usize,
+    turn_reach: usize,
     catch_up: f64,
     /// The fastest the root may go, per frame.
     max_step: f64,
-    /// The clip's range of forward and leftward steps, per frame, each widened to take in 0 (a
-    /// path walked with a facing of its own is clamped to it).
-    forward_range: (f64, f64),
+    /// The clip's slowest forward step and its range of leftward steps, per frame, each widened
+    /// to take in 0 (a path walked with a facing of its own is clamped to them).
+    backward_floor: f64,
     sideways_range: (f64, f64),
 }
 
@@ -336,6 +329,8 @@ pub fn plan_steering(
     }
     // A path with a facing of its own asks for travel in the facing's frame: sideways or
     // backwards faster than the clip went is followed at the clip's pace.
+    let sideways = (limits.sideways.0.min(0.0), limits.sideways.1.max(0.0));
+    let slowest = limits.forward.0.min(0.0);
     for pair in goals.windows(2) {
         if let (
             Some(a),
@@ -347,17 +342,16 @@ pub fn plan_steering(
         {
             let local = yaw(h).transpose() * (b - a);
             let (f, l) = (local[2] * fps, local[0] * fps);
-            let (lo, hi) = (limits.sideways.0.min(0.0), limits.sideways.1.max(0.0));
+            let (lo, hi) = sideways;
             let beyond = |v: f64, bound: f64| (v - bound).abs() > 1e-4 * bound.abs() + 1e-12;
             if (l < lo && beyond(l, lo)) || (l > hi && beyond(l, hi)) {
                 warn(format!(
                     "the path with its facing asks for sideways speeds beyond the clip's {lo:.3} to {hi:.3} units/s; they are clamped, so the path is followed more slowly"
                 ));
             }
-            let lo = limits.forward.0.min(0.0);
-            if f < lo && beyond(f, lo) {
+            if f < slowest && beyond(f, slowest) {
                 warn(format!(
-                    "the path with its facing asks for backward speeds beyond the clip's slowest {lo:.3} units/s; they are clamped, so the path is followed more slowly"
+                    "the path with its facing asks for backward speeds beyond the clip's slowest {slowest:.3} units/s; they are clamped, so the path is followed more slowly"
                 ));
             }
         }
@@ -374,6 +368,24 @@ pub fn plan_steering(
         });
     }
     let weights = soft_mask(&asked, ramp).into_iter().map(f64::from).collect();
+    // A path's facing is pulled over a longer reach than its travel: the course is followed on
+    // average, and a clip's own turns away from its travel (a glide) stay. A commanded facing
+    // is pulled as the travel is.
+    let reach = (STEER_REACH_SECONDS * fps).round() as usize;
+    let on_path = goals.iter().skip(anchor + 1).any(|g| {
+        matches!(
+            g,
+            Goal::Course {
+                position: Some(_),
+                facing: None
+            }
+        )
+    });
+    let turn_reach = if on_path {
+        (FACING_REACH_SECONDS * fps).round() as usize
+    } else {
+        reach
+    };
     let n = &metadata.normalizer;
     let rows = [FORWARD, LEFTWARD, TURN];
     Ok(SteeringPlan {
@@ -387,15 +399,12 @@ pub fn plan_steering(
             },
             mean: rows.map(|r| f64::from(n.mean[r])),
             std: rows.map(|r| f64::from(n.std[r])),
-            reach: (STEER_REACH_SECONDS * fps).round() as usize,
-            facing_reach: (FACING_REACH_SECONDS * fps).round() as usize,
+            reach,
+            turn_reach,
             catch_up: (FACING_CATCH_UP_SECONDS * fps).max(1.0),
             max_step: top / fps,
-            forward_range: (limits.forward.0 / fps, limits.forward.1 / fps),
-            sideways_range: (
-                limits.sideways.0.min(0.0) / fps,
-                limits.sideways.1.max(0.0) / fps,
-            ),
+            backward_floor: slowest / fps,
+            sideways_range: (sideways.0 / fps, sideways.1 / fps),
         }),
         warnings,
     })
@@ -454,13 +463,13 @@ impl Steering {
                     position: goal_position,
                     facing,
                 } => {
-                    let parts = self.goals[i].parts();
+                    let parts = (goal_position.is_some(), facing.is_some());
                     // Without a position, the travel is free and the offset unused.
                     let p = goal_position.unwrap_or(position[i - 1]);
                     let before = self.goals[i - 1].position().unwrap_or(p);
                     let mut path_step = p - before;
                     path_step[UP] = 0.0;
-                    if span.is_some_and(|s| Some(s.3) != parts) {
+                    if span.is_some_and(|s| s.3 != parts) {
                         span = None;
                     }
                     let (start, offset, facing_offset, _) = match span {
@@ -491,12 +500,7 @@ impl Steering {
                             last_direction = heading[i - 1] + wrap(direction - heading[i - 1]);
                             let mut offset = before - position[i - 1];
                             offset[UP] = 0.0;
-                            let s = (
-                                i,
-                                offset,
-                                heading[i - 1] - last_direction,
-                                parts.unwrap_or_default(),
-                            );
+                            let s = (i, offset, heading[i - 1] - last_direction, parts);
                             span = Some(s);
                             s
                         }
@@ -517,7 +521,7 @@ impl Steering {
                         if facing.is_some() {
                             // Walked in a facing of its own: no more sideways or backwards
                             // than the clip went.
-                            ahead = ahead.max(self.forward_range.0.min(0.0));
+                            ahead = ahead.max(self.backward_floor);
                             aside = aside.max(self.sideways_range.0).min(self.sideways_range.1);
                         }
                         targets[FORWARD][i] = Some(ahead);
@@ -546,20 +550,8 @@ impl Steering {
             let pull: Vec<f64> = (0..n)
                 .map(|i| targets[k][i].map_or(0.0, |t| self.weights[i] * (t - current[i])))
                 .collect();
-            // A path's facing is pulled over a longer reach than its travel: the course is
-            // followed on average, and a clip's own turns away from its travel (a glide) stay.
-            // A commanded facing is pulled as the travel is.
-            let on_path = self.goals.iter().skip(self.anchor + 1).any(|g| {
-                matches!(
-                    g,
-                    Goal::Course {
-                        position: Some(_),
-                        facing: None
-                    }
-                )
-            });
-            let reach = if k == TURN && on_path {
-                self.facing_reach
+            let reach = if k == TURN {
+                self.turn_reach
             } else {
                 self.reach
             };

@@ -278,8 +278,8 @@ impl Stream {
     /// given when it starts, so commands for frames a block has already started on are not
     /// used (give them at least [`Stream::lookahead`] frames ahead of what has been handed
     /// out, plus whatever [`Stream::prepare`] made ahead). Needs a heading-relative model,
-    /// finite numbers and facings with a direction on the ground. Commands beyond the clip's range are clamped when used and reported by
-    /// [`Stream::warnings`].
+    /// finite numbers and facings with a direction on the ground. Commands beyond the clip's
+    /// range are clamped when used and reported by [`Stream::warnings`].
     pub fn steer(&mut self, commands: &[SteerFrame]) -> Result<(), TaskError> {
         if SteerLimits::of(&self.metadata).is_none() {
             return Err(TaskError::Steer(
