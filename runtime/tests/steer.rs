@@ -249,12 +249,12 @@ fn a_heading_streams_blocks_continue_the_course() {
 
 #[test]
 fn a_world_root_model_refuses_steering() {
-    // The shipped hop keeps the world root it was trained with.
-    let mut hop = model("human_hop_cmu.onnx");
-    let metadata = hop.metadata().clone();
+    // The shipped fox does not travel, so the default gave it the world root.
+    let mut fox = model("fox_survey_khronos.onnx");
+    let metadata = fox.metadata().clone();
     assert!(SteerLimits::of(&metadata).is_none());
     let request = steer_request(60, vec![]);
-    let e = sinmdm::run(&mut hop, &request, &mut go()).unwrap_err();
+    let e = sinmdm::run(&mut fox, &request, &mut go()).unwrap_err();
     assert!(matches!(e, TaskError::Steer(_)), "{e}");
     assert!(e.to_string().contains("heading-relative"), "{e}");
     let mut stream = Stream::new(&metadata, StreamOptions::default()).unwrap();

@@ -107,7 +107,8 @@ def main() -> None:
         f"the default (`configs/default.yaml`: C {m['channels']}, {m['heads']} heads, window "
         f"{m['window']}, dropout {m['dropout']}, cosine learning rate "
         f"from {t['learning_rate']:g} after {t['warmup_steps']} warm-up steps, weight average "
-        f"{t.get('ema_decay')}, {frames_seen(t, state)}, {fps}, seed {t['seed']})"
+        f"{t.get('ema_decay')}, {frames_seen(t, state)}, {fps}, seed {t['seed']}; the step count, "
+        "window and dropout as the default's `from_clip` rule chose them from the clip)"
     )
     if d.get("root_layout", "world") != "world":
         config_row += f", with the {d['root_layout']} root layout"
@@ -122,7 +123,7 @@ def main() -> None:
         (
             "training time",
             f"{state['elapsed_seconds']:.0f} s ({state['elapsed_seconds'] / 60:.1f} min) on a "
-            "2-core AMD EPYC virtual machine, nothing else running",
+            "2-core AMD EPYC virtual machine, no other training running",
         ),
         ("loss", f"last step {state['loss']:.4f}, mean of the last 100 steps {state['recent_loss']:.4f}"),
         (

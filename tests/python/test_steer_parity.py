@@ -72,7 +72,8 @@ COURSES = {
     "velocity": lambda d: ["--velocity", write_schedule(d / "velocity.csv")],
     "path": lambda d: ["--path", write_circle(d / "path.csv")],
     "strafe": lambda d: ["--path", write_circle(d / "path.csv"), "--face", "1,0.25,0"],
-    "face": lambda d: ["--face=-0.5,1,0"],
+    # Away from where the free walk heads, so that the facing must turn the character.
+    "face": lambda d: ["--face=0.5,-1,0"],
     "mixed": lambda d: ["--path", write_mixed(d / "mixed.csv")],
 }
 

@@ -6,6 +6,7 @@
 
 pub mod checkpoint;
 pub mod clip_data;
+pub mod clip_rule;
 pub mod clock;
 pub mod config;
 pub mod data;

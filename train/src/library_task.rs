@@ -83,6 +83,7 @@ fn entry_config(manifest: &Manifest, entry: &ClipEntry) -> Result<TrainConfig, L
     if let Some(window) = entry.window {
         config.model.window = window;
         config.model.window_follows_fps = false;
+        config.from_clip.window = false;
     }
     config.validate().map_err(setting)?;
     Ok(config)

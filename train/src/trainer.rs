@@ -55,6 +55,8 @@ pub struct Trainer {
     last_checkpoint: Option<PathBuf>,
     /// Steps (1-based) whose gradients tests turn into NaN, once each.
     injected_faults: BTreeSet<u64>,
+    /// What the rule that reads the clip chose for a new run, a line per setting.
+    rule: Option<Vec<String>>,
 }
 
 /// A new network, its weight average and optimiser for `config`, drawn from the run's seed.
@@ -132,6 +134,7 @@ impl Trainer {
             session_start: Instant::now(),
             last_checkpoint,
             injected_faults: BTreeSet::new(),
+            rule: None,
         }
     }
 
@@ -150,8 +153,11 @@ impl Trainer {
             });
         }
         let data = ClipData::load(clip, &config.data, &config.model)?;
-        // The run saves the shape it trains: a window that follows the frame rate and a root
-        // layout chosen from the clip, resolved.
+        // The run saves the numbers it trains: what the rule that reads the clip chose, a
+        // window that follows the frame rate and a root layout chosen from the clip, resolved.
+        let rule = (!config.from_clip.is_off())
+            .then(|| crate::clip_rule::choose(&config, crate::clip_rule::ClipReading::of(&data)));
+        let config = rule.as_ref().map_or(config, |r| r.config.clone());
         let mut config = config.at_fps(data.facts.layout.fps);
         config.data.root_layout = data.facts.root_layout();
         std::fs::create_dir_all(run).map_err(io("create the output folder", run))?;
@@ -179,9 +185,9 @@ impl Trainer {
             config: config.clone(),
         };
         let parts = (model, average, optimizer);
-        Ok(Trainer::assemble(
-            run, device, parts, data, state, log, None,
-        ))
+        let mut trainer = Trainer::assemble(run, device, parts, data, state, log, None);
+        trainer.rule = rule.map(|r| r.lines);
+        Ok(trainer)
     }
 
     /// Continues the run in `run` from its newest checkpoint. A `config`, when given, must
@@ -199,6 +205,22 @@ impl Trainer {
         })?;
         let mut state = checkpoint::load_state(&dir)?;
         if let Some(asked) = &config {
+            let mut asked = asked.clone();
+            // What the rule that reads the clip chose when the run started stands.
+            let rule = asked.from_clip;
+            let saved = &state.config;
+            if rule.steps {
+                asked.training.steps = saved.training.steps;
+                asked.training.warmup_steps = saved.training.warmup_steps;
+            }
+            if rule.window {
+                asked.model.window = saved.model.window;
+                asked.model.window_follows_fps = false;
+            }
+            if rule.dropout {
+                asked.model.dropout = saved.model.dropout;
+            }
+            asked.from_clip = crate::config::FromClip::default();
             let mut asked = asked.at_fps(state.clip.layout.fps);
             // `auto` chose from this clip when the run started: the choice stands.
             if asked.data.root_layout == sinmdm::motion::RootLayout::Auto {
@@ -275,6 +297,12 @@ impl Trainer {
         let fps = self.clip.facts.layout.fps;
         let frames = crate::motion_span::decorrelation_frames(self.clip.features.view(), fps)?;
         crate::motion_span::wider_window_hint(frames, fps, &self.state.config.model)
+    }
+
+    /// What the rule that reads the clip chose for this run, a line per setting, when it was
+    /// started here with a configuration that asks for the rule ([`crate::clip_rule`]).
+    pub fn rule_lines(&self) -> Option<&[String]> {
+        self.rule.as_deref()
     }
 
     /// Whether all configured steps are done.
@@ -517,6 +545,7 @@ pub fn seconds_per_step(
     let mut probe_config = config.clone();
     probe_config.training.steps = steps + 2;
     probe_config.training.warmup_steps = 0;
+    probe_config.from_clip.steps = false;
     let measured = (|| {
         let mut trainer = Trainer::start(clip, probe_config, &folder, device)?;
         let mut times = Vec::new();

@@ -412,6 +412,11 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
     // F = 191 for this skeleton: 5,262,546 + 17 * (2 * 3 * 256 + 1).
     assert!(text.contains("parameters      5288675"), "{text}");
     assert!(text.contains("receptive field 23 frames"), "{text}");
+    // A configuration of one's own trains its numbers as written.
+    assert!(
+        text.contains("from_clip       off: the configuration's numbers train as written"),
+        "{text}"
+    );
 
     // Without --config, the built-in default; --fps replaces its frame rate.
     let default = TrainConfig::load(&root().join("configs/default.yaml")).unwrap();
@@ -429,7 +434,11 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
                 default.training.steps
             ))
             && text.contains("(249 frames at 30 fps)")
-            && text.contains("receptive field 23 frames (QnA window 3)")
+            // The rule that reads the clip finds the walk varied (its own intra diversity
+            // 0.837) and widens its window to 5 (29 frames) with dropout 0.5.
+            && text.contains("clip            varied: its own intra diversity 0.837")
+            && text.contains("receptive field 29 frames (QnA window 5)")
+            && text.contains("dropout         0.5:")
             // The default gives a walk the heading-relative root, and says so.
             && text.contains("root            heading-relative: facing across LeftHip and RightHip")
             && text.contains("chosen from the clip (data.root_layout auto)"),
@@ -442,10 +451,10 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("(994 frames at 120"), "{text}");
-    // The default's QnA window follows the frame rate: 3 at 30 fps (23 frames, 0.77 s), 25 at
-    // 120 (89 frames, 0.74 s).
+    // The default's QnA window follows the frame rate: the rule's 5 at 30 fps (29 frames,
+    // 0.97 s) is 33 at 120 (113 frames, 0.94 s).
     assert!(
-        text.contains("receptive field 89 frames (QnA window 25)"),
+        text.contains("receptive field 113 frames (QnA window 33)"),
         "{text}"
     );
     let out = Command::new(bin)

@@ -19,9 +19,9 @@ pub fn model_path() -> PathBuf {
     repo().join("onnx-models/human_walk_cmu.onnx")
 }
 
-/// A shipped world-root model (the hop), which refuses steering.
+/// A shipped world-root model (the fox, which does not travel), which refuses steering.
 pub fn world_root_model_path() -> PathBuf {
-    repo().join("onnx-models/human_hop_cmu.onnx")
+    repo().join("onnx-models/fox_survey_khronos.onnx")
 }
 
 /// The shipped heading-relative model the steering checks run on.

@@ -12,16 +12,17 @@ use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use sinmdm_train::clip_data::ClipData;
+use sinmdm_train::clip_rule;
 use sinmdm_train::motion_span;
 use sinmdm_train::{QnaUnet, RunEnd, TrainConfig, Trainer};
 
 /// Fit the single-motion QnA-UNet denoiser on one clip (BVH, glTF .glb/.gltf, or FBX).
 ///
 /// Examples:
-///   sinmdm-train tests/data/bvh/human_walk_cmu_131_01.bvh --out runs/walk   (the default, ~6 min)
+///   sinmdm-train tests/data/bvh/human_walk_cmu_131_01.bvh --out runs/walk   (the default, ~9 min)
 ///   sinmdm-train CLIP.bvh --minutes 5 --out runs/quick   (as many steps as fit in 5 minutes)
 ///   sinmdm-train --resume --out runs/walk            (continue after Ctrl-C or a crash)
-///   sinmdm-train CLIP.bvh --config configs/paper.yaml --dry-run   (sizes only)
+///   sinmdm-train CLIP.bvh --dry-run   (sizes, and what the default chose from the clip)
 ///   sinmdm-train character.glb --clip-anim Walk --out runs/walk   (one animation of a glTF file)
 ///   sinmdm-train mixamo_walk.fbx --out runs/walk                  (an FBX clip, e.g. from Mixamo)
 ///   sinmdm-train --manifest library.yaml --index 3     (clip 3 of a library: one array task;
@@ -68,7 +69,8 @@ struct Args {
     /// and random stream). A --config may raise training.steps.
     #[arg(long)]
     resume: bool,
-    /// Print the clip's size, the parameter count and the receptive field, then stop.
+    /// Print the clip's size, the parameter count, the receptive field and what the rule that
+    /// reads the clip chose (and why), then stop.
     #[arg(long)]
     dry_run: bool,
     /// CPU threads (default: all cores). Each step's batch is split into this many shards that
@@ -183,6 +185,7 @@ fn new_run_config(args: &Args) -> Result<TrainConfig> {
     if let Some(window) = args.window {
         config.model.window = window;
         config.model.window_follows_fps = false;
+        config.from_clip.window = false;
         config
             .validate()
             .map_err(|e| anyhow::anyhow!("--window {window}: {e}"))?;
@@ -216,6 +219,7 @@ fn fit_to_budget(
     if steps < 1.0 {
         bail!("--minutes {minutes} leaves no time to train: one step takes {per_step:.3} s here");
     }
+    config.from_clip.steps = false;
     let training = &mut config.training;
     training.steps = steps as u64;
     training.warmup_steps = training.warmup_steps.min(training.steps / 10);
@@ -232,6 +236,9 @@ fn dry_run(args: &Args) -> Result<()> {
     };
     let config = new_run_config(args)?;
     let data = ClipData::load(clip, &config.data, &config.model)?;
+    let rule = (!config.from_clip.is_off())
+        .then(|| clip_rule::choose(&config, clip_rule::ClipReading::of(&data)));
+    let config = rule.as_ref().map_or(config, |r| r.config.clone());
     let config = config.at_fps(data.facts.layout.fps);
     let features = data.features.nrows();
     let model = QnaUnet::new(features, &config.model, &Device::flex());
@@ -274,6 +281,17 @@ fn dry_run(args: &Args) -> Result<()> {
             }
         }
         None => println!("motion span     longer than half the clip or 10 s"),
+    }
+    match &rule {
+        Some(rule) => {
+            println!(
+                "the rule that reads the clip (from_clip; --config, --window and --minutes override it):"
+            );
+            for line in &rule.lines {
+                println!("  {line}");
+            }
+        }
+        None => println!("from_clip       off: the configuration's numbers train as written"),
     }
     let shape = config.training.batch_shape(data.features.ncols());
     let window = match shape.window {
@@ -378,6 +396,12 @@ fn main() -> Result<()> {
     }
     if state.clip.in_place {
         eprintln!("in-place cycle: contacts measured against the treadmill");
+    }
+    if let Some(lines) = trainer.rule_lines() {
+        eprintln!("the rule that reads the clip chose (--dry-run says more):");
+        for line in lines {
+            eprintln!("  {line}");
+        }
     }
     if state.step == 0
         && let Some(hint) = trainer.wider_window_hint()

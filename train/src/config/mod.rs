@@ -21,6 +21,10 @@ pub struct TrainConfig {
     pub training: TrainingConfig,
     /// How the clip becomes features.
     pub data: DataConfig,
+    /// Which settings the rule that reads the clip chooses ([`crate::clip_rule`]); absent:
+    /// none, every number trains as written. A run saves the numbers chosen, with this off.
+    #[serde(default, skip_serializing_if = "FromClip::is_off")]
+    pub from_clip: FromClip,
 }
 
 /// The QnA-UNet's shape (SPEC §3).
@@ -204,6 +208,29 @@ pub struct DataConfig {
 
 fn is_world(layout: &sinmdm::motion::RootLayout) -> bool {
     *layout == sinmdm::motion::RootLayout::World
+}
+
+/// Which settings the rule that reads the clip ([`crate::clip_rule`]) may choose: the
+/// configuration's `from_clip` section. A part left false trains the configuration's own number.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FromClip {
+    /// `training.steps` and `training.warmup_steps`.
+    #[serde(default)]
+    pub steps: bool,
+    /// `model.window`.
+    #[serde(default)]
+    pub window: bool,
+    /// `model.dropout`.
+    #[serde(default)]
+    pub dropout: bool,
+}
+
+impl FromClip {
+    /// Whether the rule chooses nothing.
+    pub fn is_off(&self) -> bool {
+        !(self.steps || self.window || self.dropout)
+    }
 }
 
 impl TrainConfig {

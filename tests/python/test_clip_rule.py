@@ -1,0 +1,60 @@
+"""The rule that reads the clip (train/src/clip_rule.rs): the clip's own intra diversity the
+trainer reads before training, against the benchmark's measure computed with numpy from the
+features `sinmdm encode` writes, and the choice the default makes from it."""
+
+import json
+import re
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import TRAIN, clips, tiny_config
+
+# The benchmark's window for the intra diversity, and the rule's numbers (clip_rule.rs).
+LOCAL_WINDOW = 15
+CALM_INTRA_BELOW = 0.7
+CALM_STEPS = 300
+VARIED_WINDOW = 5
+VARIED_DROPOUT = 0.5
+
+
+def numpy_intra_diversity(raw, columns):
+    """Mean over every ordered pair of 15-frame windows of the clip's joint rotations and contact
+    labels of their Frobenius distance divided by 15 (sinmdm_eval::intra_diversity)."""
+    keep = [i for i, c in enumerate(columns) if ".rot6d[" in c or c.endswith(".contact")]
+    x = np.asarray(raw, dtype=np.float64)[keep].T  # frames x metric columns
+    starts = x.shape[0] - LOCAL_WINDOW + 1
+    windows = np.stack([x[s:s + LOCAL_WINDOW].ravel() for s in range(starts)])
+    sq = (windows ** 2).sum(axis=1)
+    d2 = np.maximum(sq[:, None] + sq[None, :] - 2 * windows @ windows.T, 0.0)
+    return float(np.sqrt(d2).mean() / LOCAL_WINDOW)
+
+
+@pytest.mark.parametrize("clip", clips(), ids=lambda p: p.stem)
+def test_the_default_reads_the_clip_as_numpy_does(clip, tmp_path, sinmdm):
+    config = tmp_path / "one_step.yaml"
+    # The default's root layout, so that the root joint's rotation is read as the default reads it.
+    config.write_text(tiny_config(1) + "\n  root_layout: auto\n")
+    model = tmp_path / "layout.onnx"
+    subprocess.run([str(TRAIN), str(clip), "--config", str(config), "--out", str(tmp_path / "run"),
+                    "--export", str(model)], check=True, capture_output=True)
+    features = tmp_path / "features.json"
+    sinmdm("encode", clip, "-m", model, "-o", features)
+    doc = json.loads(features.read_text())
+    expected = numpy_intra_diversity(doc["samples"][0], doc["columns"])
+
+    out = subprocess.run([str(TRAIN), str(clip), "--dry-run"], check=True, capture_output=True,
+                         text=True).stdout
+    found = re.search(r"clip +(calm|varied): its own intra diversity ([0-9.]+)", out)
+    assert found, out
+    assert abs(float(found.group(2)) - expected) < 0.0006, (found.group(2), expected)
+    calm = expected < CALM_INTRA_BELOW
+    assert found.group(1) == ("calm" if calm else "varied"), out
+    window = re.search(r"receptive field \d+ frames \(QnA window (\d+)\)", out)
+    steps = re.search(r"^steps +(\d+) \(batch", out, re.M)
+    if calm:
+        assert int(steps.group(1)) == CALM_STEPS and window.group(1) == "3", out
+    else:
+        assert int(steps.group(1)) == 17000 and window.group(1) == str(VARIED_WINDOW), out
+        assert f"dropout         {VARIED_DROPOUT}" in out, out

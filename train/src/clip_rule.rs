@@ -1,0 +1,272 @@
+//! The default that reads the clip: before training, what the clip's own motion says sets the
+//! settings that no single value serves on every clip.
+//!
+//! One measure, taken before the first step, splits clips into two kinds that want opposite
+//! things (docs/TRAINING_EXPERIMENTS.md, "A default that reads the clip"):
+//! - a **calm** clip (its own intra diversity under [`CALM_INTRA_BELOW`]: a walk in one mood, a
+//!   kick, a dance phrase, an idle) is covered within a few hundred steps, and the longer it
+//!   trains the longer its samples replay it verbatim. It trains [`CALM_STEPS`] steps.
+//! - a **varied** clip (at or over it: a walk that turns and stops, a hop, a dog's run) covers
+//!   more the longer it trains, and its samples shake more than the clip. It keeps the
+//!   configuration's steps and trains with a wider QnA window ([`VARIED_WINDOW`]) that smooths
+//!   the samples and more dropout ([`VARIED_DROPOUT`]) that keeps them varied.
+//!
+//! The measure is the benchmark's intra diversity ([`sinmdm_eval::intra_diversity`]): the mean
+//! distance, per frame, between two 15-frame windows of the clip's joint rotations and contact
+//! labels. The rule names no clip; its three numbers were chosen on the project's clips and
+//! judged on the ones each was not chosen on (`scripts/lab/leave_one_out.py`).
+//!
+//! A configuration asks for the rule with its `from_clip` section; each part it names may be
+//! replaced by the rule, and a run saves the numbers it trained with, the section off.
+
+use crate::clip_data::ClipData;
+use crate::config::{FromClip, TrainConfig};
+
+/// The clip's own intra diversity under which a clip is calm.
+pub const CALM_INTRA_BELOW: f64 = 0.7;
+/// Optimiser steps of a calm clip.
+pub const CALM_STEPS: u64 = 300;
+/// Warm-up steps of a calm clip's cosine schedule.
+pub const CALM_WARMUP_STEPS: u64 = 100;
+/// QnA window of a varied clip, meant at 30 fps (it follows the frame rate when the
+/// configuration's window does).
+pub const VARIED_WINDOW: usize = 5;
+/// Dropout of a varied clip.
+pub const VARIED_DROPOUT: f64 = 0.5;
+
+/// What the rule reads from a clip before training.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClipReading {
+    /// Frames, at the rate the clip trains at.
+    pub frames: usize,
+    /// That rate.
+    pub fps: f64,
+    /// The clip's own intra diversity ([`sinmdm_eval::intra_diversity`] over
+    /// [`sinmdm_eval::LOCAL_WINDOW`]-frame windows of its metric features).
+    pub intra_diversity: f64,
+}
+
+impl ClipReading {
+    /// Reads a loaded clip (its normalised features are returned to file units first).
+    pub fn of(data: &ClipData) -> ClipReading {
+        let layout = &data.facts.layout;
+        let raw = data.facts.normalizer.denormalize(data.features.view());
+        let rows = sinmdm_eval::metric_features(layout, raw.view());
+        ClipReading {
+            frames: data.facts.frames,
+            fps: layout.fps,
+            intra_diversity: sinmdm_eval::intra_diversity(rows.view(), sinmdm_eval::LOCAL_WINDOW),
+        }
+    }
+
+    /// Whether the clip is calm ([`CALM_INTRA_BELOW`]).
+    pub fn is_calm(&self) -> bool {
+        self.intra_diversity < CALM_INTRA_BELOW
+    }
+}
+
+/// What the rule chose for one clip, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RuleChoice {
+    /// The reading it chose from.
+    pub reading: ClipReading,
+    /// The configuration as the rule leaves it (`from_clip` off).
+    pub config: TrainConfig,
+    /// One line per setting, saying what it is and why (also for a setting the configuration
+    /// kept because the rule was not asked to choose it).
+    pub lines: Vec<String>,
+}
+
+/// Applies the rule of `config.from_clip` to `config` for the clip `reading` describes. The
+/// settings the rule is not asked for are kept; the result has `from_clip` off.
+pub fn choose(config: &TrainConfig, reading: ClipReading) -> RuleChoice {
+    let asked = config.from_clip;
+    let mut out = config.clone();
+    out.from_clip = FromClip::default();
+    let mut lines = Vec::new();
+    let calm = reading.is_calm();
+    let kind = if calm {
+        format!(
+            "calm: its own intra diversity {:.3} is under {CALM_INTRA_BELOW}",
+            reading.intra_diversity
+        )
+    } else {
+        format!(
+            "varied: its own intra diversity {:.3} is at least {CALM_INTRA_BELOW}",
+            reading.intra_diversity
+        )
+    };
+    lines.push(format!("clip            {kind}"));
+    let kept = "the configuration's; from_clip does not ask for it";
+    lines.push(match (asked.steps, calm) {
+        (false, _) => format!("steps           {} ({kept})", config.training.steps),
+        (true, true) => {
+            out.training.steps = CALM_STEPS;
+            out.training.warmup_steps = CALM_WARMUP_STEPS;
+            format!(
+                "steps           {CALM_STEPS} (warm-up {CALM_WARMUP_STEPS}): a calm clip is covered within a few hundred steps, and replays the longer it trains"
+            )
+        }
+        (true, false) => format!(
+            "steps           {} (the configuration's): a varied clip covers more the longer it trains",
+            config.training.steps
+        ),
+    });
+    lines.push(match (asked.window, calm) {
+        (false, _) => format!("window          {} ({kept})", config.model.window),
+        (true, true) => format!(
+            "window          {} (the configuration's): the rule widens only a varied clip's",
+            config.model.window
+        ),
+        (true, false) => {
+            let mut wider = config.model.clone();
+            wider.window = wider.window.max(VARIED_WINDOW);
+            let field = wider.at_fps(reading.fps).receptive_field();
+            if field <= reading.frames {
+                out.model.window = wider.window;
+                format!(
+                    "window          {}{}: a wider field smooths a varied clip's samples",
+                    wider.window,
+                    if config.model.window_follows_fps {
+                        " at 30 fps"
+                    } else {
+                        ""
+                    }
+                )
+            } else {
+                format!(
+                    "window          {} (the configuration's): the clip's {} frames are fewer than the {field} a wider window sees",
+                    config.model.window, reading.frames
+                )
+            }
+        }
+    });
+    lines.push(match (asked.dropout, calm) {
+        (false, _) => format!("dropout         {} ({kept})", config.model.dropout),
+        (true, true) => format!(
+            "dropout         {} (the configuration's): the rule raises only a varied clip's",
+            config.model.dropout
+        ),
+        (true, false) => {
+            out.model.dropout = VARIED_DROPOUT;
+            format!(
+                "dropout         {VARIED_DROPOUT}: keeps a varied clip's samples varied at the wider window"
+            )
+        }
+    });
+    RuleChoice {
+        reading,
+        config: out,
+        lines,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DEFAULT: &str = include_str!("../../configs/default.yaml");
+    const TINY: &str = include_str!("../../configs/tiny.yaml");
+
+    fn reading(intra_diversity: f64) -> ClipReading {
+        ClipReading {
+            frames: 300,
+            fps: 30.0,
+            intra_diversity,
+        }
+    }
+
+    #[test]
+    fn the_default_asks_the_rule_for_steps_window_and_dropout() {
+        let config = TrainConfig::parse(DEFAULT).unwrap();
+        let all = FromClip {
+            steps: true,
+            window: true,
+            dropout: true,
+        };
+        assert_eq!(config.from_clip, all);
+        // A configuration without the section trains its numbers as written.
+        assert!(TrainConfig::parse(TINY).unwrap().from_clip.is_off());
+    }
+
+    #[test]
+    fn a_calm_clip_trains_few_steps_and_keeps_the_shape() {
+        let config = TrainConfig::parse(DEFAULT).unwrap();
+        let choice = choose(&config, reading(0.5));
+        let out = &choice.config;
+        assert_eq!(out.training.steps, CALM_STEPS);
+        assert_eq!(out.training.warmup_steps, CALM_WARMUP_STEPS);
+        assert_eq!(out.model.window, config.model.window);
+        assert_eq!(out.model.dropout, config.model.dropout);
+        assert!(out.from_clip.is_off());
+        assert!(choice.lines[0].contains("calm: its own intra diversity 0.500 is under 0.7"));
+        out.validate().unwrap();
+    }
+
+    #[test]
+    fn a_varied_clip_keeps_the_steps_and_widens_the_window() {
+        let config = TrainConfig::parse(DEFAULT).unwrap();
+        // The threshold itself counts as varied.
+        for intra in [CALM_INTRA_BELOW, 0.9] {
+            let choice = choose(&config, reading(intra));
+            let out = &choice.config;
+            assert_eq!(out.training.steps, config.training.steps);
+            assert_eq!(out.training.warmup_steps, config.training.warmup_steps);
+            assert_eq!(out.model.window, VARIED_WINDOW);
+            assert_eq!(out.model.dropout, VARIED_DROPOUT);
+            assert!(
+                out.model.window_follows_fps,
+                "the window still follows the frame rate"
+            );
+            assert!(choice.lines[0].contains("varied"), "{:?}", choice.lines);
+            out.validate().unwrap();
+        }
+        // A wider window of the configuration's own is never narrowed.
+        let mut wide = config.clone();
+        wide.model.window = 7;
+        assert_eq!(choose(&wide, reading(0.9)).config.model.window, 7);
+    }
+
+    #[test]
+    fn the_parts_not_asked_for_keep_the_configuration_numbers() {
+        let mut config = TrainConfig::parse(DEFAULT).unwrap();
+        config.from_clip.window = false;
+        config.from_clip.dropout = false;
+        let varied = choose(&config, reading(0.9));
+        assert_eq!(varied.config.model.window, config.model.window);
+        assert_eq!(varied.config.model.dropout, config.model.dropout);
+        assert!(
+            varied
+                .lines
+                .iter()
+                .any(|l| l.starts_with("window") && l.contains("from_clip does not ask for it")),
+            "{:?}",
+            varied.lines
+        );
+        config.from_clip.steps = false;
+        let calm = choose(&config, reading(0.2));
+        assert_eq!(calm.config.training.steps, config.training.steps);
+    }
+
+    #[test]
+    fn a_clip_shorter_than_the_wider_field_keeps_its_window() {
+        let config = TrainConfig::parse(DEFAULT).unwrap();
+        // Window 5 sees 29 frames at 30 fps.
+        let short = ClipReading {
+            frames: 28,
+            ..reading(0.9)
+        };
+        let choice = choose(&config, short);
+        assert_eq!(choice.config.model.window, config.model.window);
+        assert!(
+            choice.lines.iter().any(|l| l.contains("fewer than the 29")),
+            "{:?}",
+            choice.lines
+        );
+        let just = ClipReading {
+            frames: 29,
+            ..reading(0.9)
+        };
+        assert_eq!(choose(&config, just).config.model.window, VARIED_WINDOW);
+    }
+}
