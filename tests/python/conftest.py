@@ -1,5 +1,6 @@
 """Shared fixtures: the project root, the release binaries (built fresh) and the clips to check."""
 
+import json
 import pathlib
 import subprocess
 
@@ -21,6 +22,20 @@ def tiny_config(steps):
     text = (ROOT / "configs" / "tiny.yaml").read_text()
     assert "steps: 300" in text, "configs/tiny.yaml no longer trains 300 steps; update the tests"
     return text.replace("steps: 300", f"steps: {steps}")
+
+
+def encoded_clip(clip, tmp_path, run_sinmdm, data_extra=""):
+    """The clip's features as `sinmdm encode` writes them (JSON: fps, columns, samples), in the
+    layout of a one-step model of configs/tiny.yaml trained on it (only its layout is used);
+    `data_extra` adds lines to the config's `data` section."""
+    config = tmp_path / "one_step.yaml"
+    config.write_text(tiny_config(1) + data_extra)
+    model = tmp_path / "layout.onnx"
+    subprocess.run([str(TRAIN), str(clip), "--config", str(config), "--out", str(tmp_path / "run"),
+                    "--export", str(model)], check=True, capture_output=True)
+    features = tmp_path / "features.json"
+    run_sinmdm("encode", clip, "-m", model, "-o", features)
+    return json.loads(features.read_text())
 
 
 def clips():

@@ -2,14 +2,13 @@
 trainer reads before training, against the benchmark's measure computed with numpy from the
 features `sinmdm encode` writes, and the choice the default makes from it."""
 
-import json
 import re
 import subprocess
 
 import numpy as np
 import pytest
 
-from conftest import TRAIN, clips, tiny_config
+from conftest import TRAIN, clips, encoded_clip
 
 # The benchmark's window for the intra diversity, and the rule's numbers (clip_rule.rs).
 LOCAL_WINDOW = 15
@@ -33,15 +32,8 @@ def numpy_intra_diversity(raw, columns):
 
 @pytest.mark.parametrize("clip", clips(), ids=lambda p: p.stem)
 def test_the_default_reads_the_clip_as_numpy_does(clip, tmp_path, sinmdm):
-    config = tmp_path / "one_step.yaml"
     # The default's root layout, so that the root joint's rotation is read as the default reads it.
-    config.write_text(tiny_config(1) + "\n  root_layout: auto\n")
-    model = tmp_path / "layout.onnx"
-    subprocess.run([str(TRAIN), str(clip), "--config", str(config), "--out", str(tmp_path / "run"),
-                    "--export", str(model)], check=True, capture_output=True)
-    features = tmp_path / "features.json"
-    sinmdm("encode", clip, "-m", model, "-o", features)
-    doc = json.loads(features.read_text())
+    doc = encoded_clip(clip, tmp_path, sinmdm, "\n  root_layout: auto\n")
     expected = numpy_intra_diversity(doc["samples"][0], doc["columns"])
 
     out = subprocess.run([str(TRAIN), str(clip), "--dry-run"], check=True, capture_output=True,

@@ -1,7 +1,6 @@
 """The trainer's motion span (how long a clip's features stay correlated) and its wider-window hint,
 against the same measure computed with numpy from the features `sinmdm encode` writes."""
 
-import json
 import math
 import re
 import subprocess
@@ -9,7 +8,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import TRAIN, clips, tiny_config
+from conftest import TRAIN, clips, encoded_clip
 
 # SPEC section 3: the input and output convolutions (k 3) and the two k3 convolutions of each of
 # the three residual blocks reach 8 frames each side; each of the three QnA blocks (k - 1) / 2.
@@ -42,14 +41,7 @@ def numpy_span(raw, fps):
 @pytest.mark.parametrize("clip", clips(), ids=lambda p: p.stem)
 def test_motion_span_and_hint_match_numpy(clip, tmp_path, sinmdm):
     config = tmp_path / "one_step.yaml"
-    config.write_text(tiny_config(1))
-    model = tmp_path / "layout.onnx"
-    # A one-step model: only its feature layout is used, to encode the clip.
-    subprocess.run([str(TRAIN), str(clip), "--config", str(config), "--out", str(tmp_path / "run"),
-                    "--export", str(model)], check=True, capture_output=True)
-    features = tmp_path / "features.json"
-    sinmdm("encode", clip, "-m", model, "-o", features)
-    doc = json.loads(features.read_text())
+    doc = encoded_clip(clip, tmp_path, sinmdm)
     raw = np.asarray(doc["samples"][0], dtype=np.float64)
     assert raw.shape[0] == len(doc["columns"])
     fps = doc["fps"]
