@@ -77,6 +77,17 @@ pub struct RuleChoice {
     pub lines: Vec<String>,
 }
 
+/// The configuration a new run on `data` trains: `config` with what its `from_clip` section asks
+/// the rule for chosen from the clip, and the rule's lines; `config` unchanged, and no lines,
+/// when the section is off.
+pub fn apply(config: TrainConfig, data: &ClipData) -> (TrainConfig, Option<Vec<String>>) {
+    if config.from_clip.is_off() {
+        return (config, None);
+    }
+    let choice = choose(&config, ClipReading::of(data));
+    (choice.config, Some(choice.lines))
+}
+
 /// Applies the rule of `config.from_clip` to `config` for the clip `reading` describes. The
 /// settings the rule is not asked for are kept; the result has `from_clip` off.
 pub fn choose(config: &TrainConfig, reading: ClipReading) -> RuleChoice {

@@ -155,9 +155,7 @@ impl Trainer {
         let data = ClipData::load(clip, &config.data, &config.model)?;
         // The run saves the numbers it trains: what the rule that reads the clip chose, a
         // window that follows the frame rate and a root layout chosen from the clip, resolved.
-        let rule = (!config.from_clip.is_off())
-            .then(|| crate::clip_rule::choose(&config, crate::clip_rule::ClipReading::of(&data)));
-        let config = rule.as_ref().map_or(config, |r| r.config.clone());
+        let (config, rule) = crate::clip_rule::apply(config, &data);
         let mut config = config.at_fps(data.facts.layout.fps);
         config.data.root_layout = data.facts.root_layout();
         std::fs::create_dir_all(run).map_err(io("create the output folder", run))?;
@@ -186,7 +184,7 @@ impl Trainer {
         };
         let parts = (model, average, optimizer);
         let mut trainer = Trainer::assemble(run, device, parts, data, state, log, None);
-        trainer.rule = rule.map(|r| r.lines);
+        trainer.rule = rule;
         Ok(trainer)
     }
 

@@ -236,9 +236,7 @@ fn dry_run(args: &Args) -> Result<()> {
     };
     let config = new_run_config(args)?;
     let data = ClipData::load(clip, &config.data, &config.model)?;
-    let rule = (!config.from_clip.is_off())
-        .then(|| clip_rule::choose(&config, clip_rule::ClipReading::of(&data)));
-    let config = rule.as_ref().map_or(config, |r| r.config.clone());
+    let (config, rule) = clip_rule::apply(config, &data);
     let config = config.at_fps(data.facts.layout.fps);
     let features = data.features.nrows();
     let model = QnaUnet::new(features, &config.model, &Device::flex());
@@ -283,11 +281,11 @@ fn dry_run(args: &Args) -> Result<()> {
         None => println!("motion span     longer than half the clip or 10 s"),
     }
     match &rule {
-        Some(rule) => {
+        Some(lines) => {
             println!(
                 "the rule that reads the clip (from_clip; --config, --window and --minutes override it):"
             );
-            for line in &rule.lines {
+            for line in lines {
                 println!("  {line}");
             }
         }
