@@ -402,3 +402,76 @@ fn a_facing_with_no_direction_on_the_ground_is_refused() {
     let e = stream.steer(&commands).unwrap_err();
     assert!(e.to_string().contains("no direction on the ground"), "{e}");
 }
+
+/// The root's mean ground speed over each two seconds of `motion` (file frame), in file units
+/// per second (the chord of a two-second arc at 0.3 rad/s is within 1.5 % of its length).
+fn ground_speed_per_two_seconds(
+    metadata: &sinmdm::model_file::ModelMetadata,
+    motion: &sinmdm::motion::clip::LocalMotion,
+) -> Vec<f64> {
+    let layout = &metadata.layout;
+    let joints = layout.skeleton.len();
+    let root = layout.root.as_ref().unwrap().joint;
+    let to_canonical = layout.up.file_from_canonical().transpose();
+    let ground = |f: usize| {
+        let mut p = to_canonical * motion.translations[f * joints + root];
+        p[sinmdm::motion::up::UP] = 0.0;
+        p
+    };
+    let window = (2.0 * layout.fps).round() as usize;
+    (0..motion.translations.len() / joints / window)
+        .map(|w| {
+            let (a, b) = (w * window, (w + 1) * window - 1);
+            (ground(b) - ground(a)).norm() * layout.fps / (b - a) as f64
+        })
+        .collect()
+}
+
+/// A velocity command sets where the root goes, and foot planting (the default output) leaves
+/// it there: carried along with the feet instead, the root would walk at the pace of the
+/// model's strides, which can be half the commanded one. Each two seconds cover the commanded
+/// speed within 12 %, in a batch run and in a stream of short blocks.
+#[test]
+fn planted_feet_keep_the_commanded_speed() {
+    let mut model = zombie();
+    let metadata = model.metadata().clone();
+    let fps = metadata.layout.fps;
+    let speed = clip_speed(&metadata).unwrap();
+    let frames = (6.0 * fps) as usize;
+    let commands = vec![
+        SteerFrame::Velocity {
+            forward: speed,
+            turn: 0.3,
+        };
+        frames
+    ];
+    let check = |what: &str, motion: &sinmdm::motion::clip::LocalMotion| {
+        let speeds = ground_speed_per_two_seconds(&metadata, motion);
+        println!("{what}: {speeds:.2?} against {speed:.2}");
+        assert_eq!(speeds.len(), 3);
+        for (w, got) in speeds.iter().enumerate() {
+            assert!(
+                (got - speed).abs() <= 0.12 * speed,
+                "{what}, seconds {}-{}: {got:.2} against the commanded {speed:.2}",
+                2 * w,
+                2 * w + 2
+            );
+        }
+    };
+    let request = Request {
+        feet: Feet::Planted,
+        ..steer_request(frames, commands.clone())
+    };
+    let batch = sinmdm::run(&mut model, &request, &mut go()).unwrap();
+    check("batch", &batch.motion(0).unwrap());
+    let options = StreamOptions {
+        seed: 3,
+        block_frames: Some(60),
+        feet: Feet::Planted,
+        ..StreamOptions::default()
+    };
+    let mut stream = Stream::new(&metadata, options).unwrap();
+    stream.steer(&commands).unwrap();
+    let chunk = stream.next(&mut model, frames).unwrap();
+    check("stream", &chunk.motion);
+}

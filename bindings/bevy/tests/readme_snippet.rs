@@ -18,6 +18,7 @@ use bevy_app::{App, Startup, TaskPoolPlugin};
 use bevy_time::{TimePlugin, TimeUpdateStrategy};
 use bevy_transform::TransformPlugin;
 use bevy_transform::components::GlobalTransform;
+use sinmdm::steer::SteerLimits;
 use sinmdm_bevy::MotionCharacter;
 
 #[test]
@@ -36,6 +37,7 @@ fn the_readme_snippet_spawns_a_walking_zombie() {
     )))
     .add_systems(Startup, spawn_zombie);
     let mut roots = Vec::new();
+    let mut frame = None;
     for _ in 0..240 {
         app.update();
         let world = app.world_mut();
@@ -43,8 +45,24 @@ fn the_readme_snippet_spawns_a_walking_zombie() {
         let character = query.single(world).expect("one character");
         assert_eq!(character.joints().len(), 27);
         assert!(character.steering_note().is_none());
+        frame = Some(character.frame());
         let root = character.joints()[0];
         roots.push(world.get::<GlobalTransform>(root).unwrap().translation());
+    }
+    // Each second it walks at the clip's mean forward speed, as `Turn` asks (the ground
+    // distance of a second's travel on a 0.3 rad/s arc is within half a percent of its length;
+    // the stream's feet planting leaves a commanded root where the steering put it).
+    let model =
+        sinmdm_bevy::MotionModel::open("onnx-models/human_zombie_walk_fair.onnx", Some(1)).unwrap();
+    let limits = SteerLimits::of(model.metadata()).expect("a heading-relative model");
+    let speed = f64::from(sinmdm_bevy::Steering::clip_speed(&frame.unwrap(), &limits));
+    for second in 0..4 {
+        let moved =
+            f64::from((roots[second * 60 + 59] - roots[second * 60]).length()) * 60.0 / 59.0;
+        assert!(
+            (moved - speed).abs() < 0.15 * speed,
+            "second {second}: moved {moved:.3} m against the clip's {speed:.3} m/s"
+        );
     }
     // The direction of travel over the first second and over the fourth: turned left (a left
     // turn about +Y takes +Z toward +X) by about the commanded 0.3 rad/s over 3 s.

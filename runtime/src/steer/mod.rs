@@ -416,6 +416,28 @@ impl Steering {
         self.goals.len()
     }
 
+    /// Per frame of the window, whether a command sets where the root goes (a velocity, or a
+    /// position on a path), as opposed to nothing or a facing alone. Foot planting leaves the
+    /// root of those frames where the steering put it: carried along with the feet instead, it
+    /// would go at the pace of the model's strides rather than the commanded one.
+    pub fn travel_commanded(&self) -> Vec<bool> {
+        self.goals
+            .iter()
+            .enumerate()
+            .map(|(i, goal)| {
+                i > self.anchor
+                    && matches!(
+                        goal,
+                        Goal::Velocity { .. }
+                            | Goal::Course {
+                                position: Some(_),
+                                ..
+                            }
+                    )
+            })
+            .collect()
+    }
+
     /// Pulls the slow part of the root rows of one normalised prediction `[F, N]` to the goals,
     /// [`STEER_PASSES`] times: a path's targets follow the prediction's course, which each pass
     /// changes.

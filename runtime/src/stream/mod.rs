@@ -127,6 +127,9 @@ struct Frame {
 struct PendingBlock {
     window: blocks::Window,
     sampler: Sampler,
+    /// Per window frame, whether steering commands the root's travel there (planting leaves
+    /// those roots where the steering put them).
+    travel_commanded: Vec<bool>,
 }
 
 /// Endless motion from one model; see the [module documentation](self).
@@ -515,15 +518,28 @@ impl Stream {
             harmonization: None,
             steering,
         };
+        let travel_commanded = guidance
+            .steering
+            .as_ref()
+            .map(|s| s.travel_commanded())
+            .unwrap_or_default();
         let seed = block_seed(self.seed, self.blocks as u64);
         let sampler =
             Sampler::new(&self.schedule, &guidance, 1, f, n, seed)?.with_method(self.method)?;
-        Ok(PendingBlock { window, sampler })
+        Ok(PendingBlock {
+            window,
+            sampler,
+            travel_commanded,
+        })
     }
 
     /// Decodes a finished block and queues its final frames.
     fn complete_block(&mut self, pending: PendingBlock) -> Result<(), TaskError> {
-        let PendingBlock { window, sampler } = pending;
+        let PendingBlock {
+            window,
+            sampler,
+            travel_commanded,
+        } = pending;
         let sizes = self.sizes;
         let n = window.frames;
         let normalized = sampler.into_sample().index_axis_move(Axis(0), 0);
@@ -596,7 +612,11 @@ impl Stream {
                 joints: (0..done.end)
                     .map(|frame| vec![frame < done.start; joints])
                     .collect(),
-                root: (0..done.end).map(|frame| frame < done.start).collect(),
+                root: (0..done.end)
+                    .map(|frame| {
+                        frame < done.start || travel_commanded.get(frame).copied() == Some(true)
+                    })
+                    .collect(),
             };
             let options = PlantOptions {
                 anchor: Anchor::Landing,

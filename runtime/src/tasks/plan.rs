@@ -96,16 +96,34 @@ impl Plan {
         )
     }
 
-    /// Per frame, whether the task keeps the root's position from the reference (every root
-    /// position column fully masked); `None` for tasks without a reference mask.
+    /// Per frame, whether the task sets the root's position: from the reference (every root
+    /// position column fully masked), or by a steering command of its travel
+    /// ([`crate::steer::Steering::travel_commanded`]); `None` for tasks with neither.
     pub fn kept_root(&self) -> Option<Vec<bool>> {
-        let inpaint = self.guidance.inpainting.as_ref()?;
-        let axes = self.metadata.layout.root.as_ref().map_or(0, |r| r.width());
-        Some(
+        let masked = self.guidance.inpainting.as_ref().map(|inpaint| {
+            let axes = self.metadata.layout.root.as_ref().map_or(0, |r| r.width());
             (0..self.frames)
                 .map(|frame| axes > 0 && (0..axes).all(|c| inpaint.mask[[c, frame]] >= 1.0))
-                .collect(),
-        )
+                .collect::<Vec<bool>>()
+        });
+        let steered = self
+            .guidance
+            .steering
+            .as_ref()
+            .map(|s| s.travel_commanded());
+        match (masked, steered) {
+            (None, None) => None,
+            (a, b) => Some(
+                (0..self.frames)
+                    .map(|frame| {
+                        let at = |v: &Option<Vec<bool>>| {
+                            v.as_ref().and_then(|v| v.get(frame)).copied() == Some(true)
+                        };
+                        at(&a) || at(&b)
+                    })
+                    .collect(),
+            ),
+        }
     }
 
     /// What the batch's motion and poses do to the feet.
