@@ -17,6 +17,10 @@ Settings and where their `sinmdm eval` JSON (20 samples, seed 0) lies, per clip 
                              out/variants/NAME.SETTING.json (scripts/lab/variant_runs.sh;
                              sNNN: NNN steps with 100 warm-up; wK: window K and dNN: dropout
                              0.NN with the default otherwise)
+  p1, p2, p3, p3r65          out/variants/NAME.SETTING.json (steps that fall with the clip's calm:
+                             round(300 * min(1, intra / R) ** P), at least 50:
+                             scripts/lab/calm_steps_runs.sh), else s300's where the clip is at
+                             or over R
   s300, s1000, s3000         out/short_runs/NAME.STEPS.json
   d17k (window 3, dropout 0.2, 17 000 steps: the default before the rule)
                              out/checkpoint_sweep/NAME.17000.json, else out/heading/NAME.json
@@ -31,7 +35,12 @@ out = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "out")
 CLIPS = ["dog_run_mann", "dog_walk_mann", "dog_walk_mann_60fps", "fox_survey_khronos",
          "human_dance_rokoko", "human_hop_cmu", "human_kick_bandai", "human_walk_cmu",
          "human_walk_happy_bandai", "human_walk_sad_bandai", "human_zombie_walk_fair"]
-SETTINGS = ["s150", "s300", "s300d45", "s1000", "s3000", "d17k", "w3d45", "w5d45", "w5d50"]
+SETTINGS = ["s150", "s300", "s300d45", "s1000", "s3000", "d17k", "w3d45", "w5d45", "w5d50",
+            "p1", "p2", "p3", "p3r65"]
+# Steps that fall with the clip's calm: round(300 * min(1, intra / R) ** P), at least 50, warm-up
+# a third of them, R 0.7 unless the name says (p3r65: R 0.65). A clip at or over R trains the
+# 300 steps of s300.
+POWERS = {"p1": (1, 0.7), "p2": (2, 0.7), "p3": (3, 0.7), "p3r65": (3, 0.65)}
 
 
 def candidates(name, setting):
@@ -39,6 +48,9 @@ def candidates(name, setting):
     v, s = out / "variants", out / "short_runs"
     if setting in ("s150", "s300", "s300d45", "w3d45", "w5d45", "w5d50"):
         yield v / f"{name}.{setting}.json", v / f"{name}.{setting}"
+    if setting in POWERS:
+        yield v / f"{name}.{setting}.json", v / f"{name}.{setting}"
+        yield from candidates(name, "s300")
     if setting in ("s300", "s1000", "s3000"):
         steps = setting[1:]
         yield s / f"{name}.{steps}.json", s / f"{name}.{steps}"

@@ -125,7 +125,7 @@ def main() -> None:
             f"{state['elapsed_seconds']:.0f} s ({state['elapsed_seconds'] / 60:.1f} min) on a "
             "2-core AMD EPYC virtual machine, no other training running",
         ),
-        ("loss", f"last step {state['loss']:.4f}, mean of the last 100 steps {state['recent_loss']:.4f}"),
+        ("loss", f"last step {state['loss']:.4f}, mean of the last {min(100, state['step'])} steps {state['recent_loss']:.4f}"),
         (
             "size",
             f"{size_mb:.1f} MB, {grouped(state['parameters'])} parameters, F {state['features']} "

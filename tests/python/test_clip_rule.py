@@ -14,8 +14,18 @@ from conftest import TRAIN, clips, encoded_clip
 LOCAL_WINDOW = 15
 CALM_INTRA_BELOW = 0.7
 CALM_STEPS = 300
+CALM_FULL_STEPS_FROM = 0.65
+CALM_STEPS_POWER = 3
+CALM_MIN_STEPS = 50
 VARIED_WINDOW = 5
 VARIED_DROPOUT = 0.5
+
+
+def calm_steps(intra):
+    """A calm clip's steps, written from the rule's description: all of them from the reference
+    up, falling with the cube of the intra diversity below it, never under the floor."""
+    share = min(1.0, intra / CALM_FULL_STEPS_FROM)
+    return max(CALM_MIN_STEPS, int(np.floor(CALM_STEPS * share ** CALM_STEPS_POWER + 0.5)))
 
 
 def numpy_intra_diversity(raw, columns):
@@ -46,7 +56,10 @@ def test_the_default_reads_the_clip_as_numpy_does(clip, tmp_path, sinmdm):
     window = re.search(r"receptive field \d+ frames \(QnA window (\d+)\)", out)
     steps = re.search(r"^steps +(\d+) \(batch", out, re.M)
     if calm:
-        assert int(steps.group(1)) == CALM_STEPS and window.group(1) == "3", out
+        # The numpy reading may differ from the trainer's in the fourth decimal: one step either
+        # way where the count falls.
+        assert abs(int(steps.group(1)) - calm_steps(expected)) <= 1, (out, calm_steps(expected))
+        assert window.group(1) == "3", out
     else:
         assert int(steps.group(1)) == 17000 and window.group(1) == str(VARIED_WINDOW), out
         assert f"dropout         {VARIED_DROPOUT}" in out, out

@@ -5,7 +5,9 @@
 //! things (docs/TRAINING_EXPERIMENTS.md, "A default that reads the clip"):
 //! - a **calm** clip (its own intra diversity under [`CALM_INTRA_BELOW`]: a walk in one mood, a
 //!   kick, a dance phrase, an idle) is covered within a few hundred steps, and the longer it
-//!   trains the longer its samples replay it verbatim. It trains [`CALM_STEPS`] steps.
+//!   trains the longer its samples replay it verbatim; the calmer it is, the sooner. It trains
+//!   [`calm_steps`]: [`CALM_STEPS`] from [`CALM_FULL_STEPS_FROM`] up, falling with the cube of
+//!   its intra diversity below that, to no fewer than [`CALM_MIN_STEPS`].
 //! - a **varied** clip (at or over it: a walk that turns and stops, a hop, a dog's run) covers
 //!   more the longer it trains, and its samples shake more than the clip. It keeps the
 //!   configuration's steps and trains with a wider QnA window ([`VARIED_WINDOW`]) that smooths
@@ -24,10 +26,32 @@ use crate::config::{FromClip, TrainConfig};
 
 /// The clip's own intra diversity under which a clip is calm.
 pub const CALM_INTRA_BELOW: f64 = 0.7;
-/// Optimiser steps of a calm clip.
+/// Optimiser steps of a calm clip at or over [`CALM_FULL_STEPS_FROM`] (the most a calm clip
+/// trains).
 pub const CALM_STEPS: u64 = 300;
-/// Warm-up steps of a calm clip's cosine schedule.
-pub const CALM_WARMUP_STEPS: u64 = 100;
+/// The intra diversity from which a calm clip trains all of [`CALM_STEPS`]; a calmer one
+/// trains fewer ([`calm_steps`]).
+pub const CALM_FULL_STEPS_FROM: f64 = 0.65;
+/// The power of the intra diversity that a calm clip's steps fall with below
+/// [`CALM_FULL_STEPS_FROM`].
+pub const CALM_STEPS_POWER: i32 = 3;
+/// The fewest steps a calm clip trains, however calm.
+pub const CALM_MIN_STEPS: u64 = 50;
+
+/// Optimiser steps of a calm clip of this intra diversity: `CALM_STEPS * min(1, intra /
+/// CALM_FULL_STEPS_FROM)^CALM_STEPS_POWER`, rounded, at least [`CALM_MIN_STEPS`] (a walk of
+/// intra diversity 0.34, which repeats one stride, replays its clip after 150 steps and not
+/// after 50; a kick of 0.64 is covered only from about 260).
+pub fn calm_steps(intra_diversity: f64) -> u64 {
+    let share = (intra_diversity / CALM_FULL_STEPS_FROM).clamp(0.0, 1.0);
+    let steps = (CALM_STEPS as f64 * share.powi(CALM_STEPS_POWER)).round() as u64;
+    steps.max(CALM_MIN_STEPS)
+}
+
+/// Warm-up steps of a calm clip's cosine schedule: a third of its steps.
+pub fn calm_warmup_steps(steps: u64) -> u64 {
+    (steps as f64 / 3.0).round() as u64
+}
 /// QnA window of a varied clip, meant at 30 fps (it follows the frame rate when the
 /// configuration's window does).
 pub const VARIED_WINDOW: usize = 5;
@@ -112,10 +136,13 @@ pub fn choose(config: &TrainConfig, reading: ClipReading) -> RuleChoice {
     lines.push(match (asked.steps, calm) {
         (false, _) => format!("steps           {} ({kept})", config.training.steps),
         (true, true) => {
-            out.training.steps = CALM_STEPS;
-            out.training.warmup_steps = CALM_WARMUP_STEPS;
+            let steps = calm_steps(reading.intra_diversity);
+            let warmup = calm_warmup_steps(steps);
+            out.training.steps = steps;
+            out.training.warmup_steps = warmup;
             format!(
-                "steps           {CALM_STEPS} (warm-up {CALM_WARMUP_STEPS}): a calm clip is covered within a few hundred steps, and replays the longer it trains"
+                "steps           {steps} (warm-up {warmup}): a calm clip is covered within a few hundred steps, and replays the longer it trains, the calmer the sooner ({CALM_STEPS} x min(1, {:.3} / {CALM_FULL_STEPS_FROM})^{CALM_STEPS_POWER}, at least {CALM_MIN_STEPS})",
+                reading.intra_diversity
             )
         }
         (true, false) => format!(
@@ -205,13 +232,31 @@ mod tests {
         let config = TrainConfig::parse(DEFAULT).unwrap();
         let choice = choose(&config, reading(0.5));
         let out = &choice.config;
-        assert_eq!(out.training.steps, CALM_STEPS);
-        assert_eq!(out.training.warmup_steps, CALM_WARMUP_STEPS);
+        // 300 x (0.5 / 0.65)^3 = 136.5.
+        assert_eq!(out.training.steps, 137);
+        assert_eq!(out.training.warmup_steps, 46);
         assert_eq!(out.model.window, config.model.window);
         assert_eq!(out.model.dropout, config.model.dropout);
         assert!(out.from_clip.is_off());
         assert!(choice.lines[0].contains("calm: its own intra diversity 0.500 is under 0.7"));
         out.validate().unwrap();
+    }
+
+    #[test]
+    fn the_calmer_the_clip_the_fewer_its_steps() {
+        // The full count from the reference up to the calm threshold.
+        for intra in [CALM_FULL_STEPS_FROM, 0.69] {
+            assert_eq!(calm_steps(intra), CALM_STEPS, "{intra}");
+        }
+        // Cubes: half the reference trains an eighth of the steps (37.5, rounded up).
+        assert_eq!(calm_steps(CALM_FULL_STEPS_FROM / 2.0), CALM_MIN_STEPS);
+        assert_eq!(calm_steps(0.6), 236); // 300 x (0.6 / 0.65)^3 = 235.96
+        assert_eq!(calm_steps(0.4), 70); // 69.9
+        // Never fewer than the floor, even for a still clip.
+        assert_eq!(calm_steps(0.0), CALM_MIN_STEPS);
+        assert_eq!(calm_warmup_steps(236), 79);
+        let steps: Vec<u64> = (0..=14).map(|i| calm_steps(f64::from(i) * 0.05)).collect();
+        assert!(steps.windows(2).all(|w| w[0] <= w[1]), "{steps:?}");
     }
 
     #[test]
