@@ -54,23 +54,26 @@ def main() -> None:
     model, clip = sys.argv[1], sys.argv[2]
     speed = clip_speed(model)
     schedule = pathlib.Path("scripts/lab/velocity_schedule.csv").read_text().split()
-    with tempfile.NamedTemporaryFile("w", suffix=".csv", delete=False) as f:
+    with tempfile.TemporaryDirectory() as scratch:
+        # The schedule's speeds, given as multiples of the clip's, in file units per second.
+        velocity = pathlib.Path(scratch) / "velocity.csv"
+        lines = []
         for line in schedule:
             t, factor, turn = line.split(",")
-            f.write(f"{t},{float(factor) * speed:.4f},{turn}\n")
-        velocity = f.name
-    courses = [
-        ("free (no course)", ["--frames", "600"]),
-        ("`--circle 3`", ["--frames", "600", "--circle", "3"]),
-        ("`--figure8 3`, 120 s (`--frames 3600`)", ["--frames", "3600", "--figure8", "3"]),
-        ("`--velocity` (scripts/lab/velocity_schedule.csv), `--stream`",
-         ["--frames", "600", "--velocity", velocity, "--stream"]),
-    ]
-    print("| course | root to path, mean / worst (heights) | facing against travel, median / share "
-          "over 45 degrees | coverage | jitter x clip (planted) | skating (planted) |")
-    print("|---|---|---|---|---|---|")
-    for name, extra in courses:
-        print(row(name, evaluate(model, clip, extra)), flush=True)
+            lines.append(f"{t},{float(factor) * speed:.4f},{turn}\n")
+        velocity.write_text("".join(lines))
+        courses = [
+            ("free (no course)", ["--frames", "600"]),
+            ("`--circle 3`", ["--frames", "600", "--circle", "3"]),
+            ("`--figure8 3`, 120 s (`--frames 3600`)", ["--frames", "3600", "--figure8", "3"]),
+            ("`--velocity` (scripts/lab/velocity_schedule.csv), `--stream`",
+             ["--frames", "600", "--velocity", str(velocity), "--stream"]),
+        ]
+        print("| course | root to path, mean / worst (heights) | facing against travel, median / "
+              "share over 45 degrees | coverage | jitter x clip (planted) | skating (planted) |")
+        print("|---|---|---|---|---|---|")
+        for name, extra in courses:
+            print(row(name, evaluate(model, clip, extra)), flush=True)
 
 
 if __name__ == "__main__":

@@ -111,19 +111,17 @@ impl Plan {
             .steering
             .as_ref()
             .map(|s| s.travel_commanded());
-        match (masked, steered) {
-            (None, None) => None,
-            (a, b) => Some(
-                (0..self.frames)
-                    .map(|frame| {
-                        let at = |v: &Option<Vec<bool>>| {
-                            v.as_ref().and_then(|v| v.get(frame)).copied() == Some(true)
-                        };
-                        at(&a) || at(&b)
-                    })
-                    .collect(),
-            ),
+        if masked.is_none() && steered.is_none() {
+            return None;
         }
+        let set = |by: &Option<Vec<bool>>, frame: usize| {
+            by.as_ref().is_some_and(|v| v.get(frame) == Some(&true))
+        };
+        Some(
+            (0..self.frames)
+                .map(|frame| set(&masked, frame) || set(&steered, frame))
+                .collect(),
+        )
     }
 
     /// What the batch's motion and poses do to the feet.
