@@ -51,7 +51,9 @@ pub use feet::{
     FeetReference, FeetReport, FeetScores, GROUND_BAND, PENETRATION_TOLERANCE, SKATING_SPEED,
     SPEED_WINDOW, SampleFeet, mean_scores,
 };
-pub use model_eval::{ModelEvalError, ModelEvaluation, evaluate_generated, evaluate_model};
+pub use model_eval::{
+    GoalScores, ModelEvalError, ModelEvaluation, evaluate_generated, evaluate_model, goal_scores,
+};
 pub use patched_nn::patched_nearest_neighbour;
 pub use replay::{REPLAY_TOLERANCE, ReplayReport, longest_replay, rotation_rows};
 pub use window_match::DiagonalSums;

@@ -78,6 +78,59 @@ where
     evaluate_generated(generated, clip, threads, started.elapsed().as_secs_f64())
 }
 
+/// The benchmark's scores of the samples as the network made them, against the clip's metric
+/// features.
+fn network_report(
+    generated: &Generated,
+    clip_metric: ArrayView2<'_, f64>,
+    threads: usize,
+) -> Result<Report, EvalError> {
+    let layout = generated.layout();
+    let samples: Vec<Array2<f64>> = generated
+        .features
+        .outer_iter()
+        .map(|sample| metric_features(layout, sample))
+        .collect();
+    evaluate(clip_metric, &samples, threads.max(1))
+}
+
+/// The figures a model's goals are set on, and only those: a quarter of
+/// [`evaluate_generated`]'s work (one benchmark report instead of four, no planting).
+#[derive(Debug)]
+pub struct GoalScores {
+    /// The benchmark's scores of the samples as the network made them (coverage, global
+    /// diversity...), as [`ModelEvaluation::report`].
+    pub report: Report,
+    /// How long the samples copy the clip verbatim, as [`ModelEvaluation::replay`].
+    pub replay: ReplayReport,
+    /// The raw samples' jitter as a multiple of the clip's, as
+    /// `ModelEvaluation::feet.raw.jitter_ratio`.
+    pub raw_jitter_ratio: f64,
+}
+
+/// Scores `generated` against `clip` (raw features `[F, N]` in the samples' layout) for the
+/// figures of [`GoalScores`], each equal to the one [`evaluate_generated`] gives.
+pub fn goal_scores(
+    generated: &Generated,
+    clip: ArrayView2<'_, f32>,
+    threads: usize,
+) -> Result<GoalScores, ModelEvalError> {
+    check_sample_length(generated.frames())?;
+    let layout = generated.layout();
+    let report = network_report(generated, metric_features(layout, clip).view(), threads)?;
+    let replay =
+        ReplayReport::of_features(layout, clip, generated.features.view(), REPLAY_TOLERANCE);
+    let raw = (0..generated.count())
+        .map(|i| generated.raw_motion(i))
+        .collect::<Result<Vec<_>, _>>()?;
+    let feet = FeetReport::new(layout, &decode(layout, clip)?, &raw, &raw);
+    Ok(GoalScores {
+        report,
+        replay,
+        raw_jitter_ratio: feet.raw.jitter_ratio,
+    })
+}
+
 /// Samples shorter than the coverage window cannot be scored; said before any work.
 fn check_sample_length(frames: usize) -> Result<(), EvalError> {
     if frames < COVERAGE_WINDOW {
@@ -103,12 +156,7 @@ pub fn evaluate_generated(
     let started = Instant::now();
     let layout = generated.layout();
     let clip_metric = metric_features(layout, clip);
-    let samples: Vec<Array2<f64>> = generated
-        .features
-        .outer_iter()
-        .map(|sample| metric_features(layout, sample))
-        .collect();
-    let report = evaluate(clip_metric.view(), &samples, threads.max(1))?;
+    let report = network_report(&generated, clip_metric.view(), threads)?;
     let body_samples: Vec<Array2<f64>> = generated
         .features
         .outer_iter()

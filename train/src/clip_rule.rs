@@ -5,9 +5,10 @@
 //! things (docs/TRAINING_EXPERIMENTS.md, "A default that reads the clip"):
 //! - a **calm** clip (its own intra diversity under [`CALM_INTRA_BELOW`]: a walk in one mood, a
 //!   kick, a dance phrase, an idle) is covered within a few hundred steps, and the longer it
-//!   trains the longer its samples replay it verbatim; the calmer it is, the sooner. It trains
-//!   [`calm_steps`]: [`CALM_STEPS`] from [`CALM_FULL_STEPS_FROM`] up, falling with the cube of
-//!   its intra diversity below that, to no fewer than [`CALM_MIN_STEPS`].
+//!   trains the longer its samples replay it verbatim; how soon differs from clip to clip. Its
+//!   steps are left to the step ladder ([`crate::step_ladder`]), which trains short runs and
+//!   keeps the one whose own samples meet the goals best; a calm clip that no short run covers
+//!   trains as a varied one ([`not_calm_after_all`]).
 //! - a **varied** clip (at or over it: a walk that turns and stops, a hop, a dog's run) covers
 //!   more the longer it trains, and its samples shake more than the clip. It keeps the
 //!   configuration's steps and trains with a wider QnA window ([`VARIED_WINDOW`]) that smooths
@@ -15,8 +16,8 @@
 //!
 //! The measure is the benchmark's intra diversity ([`sinmdm_eval::intra_diversity`]): the mean
 //! distance, per frame, between two 15-frame windows of the clip's joint rotations and contact
-//! labels. The rule names no clip; its three numbers were chosen on the project's clips and
-//! judged on the ones each was not chosen on (`scripts/lab/leave_one_out.py`).
+//! labels. The rule names no clip; its threshold and the varied clip's setting were chosen on the
+//! project's clips and judged on the ones each was not chosen on (`scripts/lab/leave_one_out.py`).
 //!
 //! A configuration asks for the rule with its `from_clip` section; each part it names may be
 //! replaced by the rule, and a run saves the numbers it trained with, the section off.
@@ -26,31 +27,15 @@ use crate::config::{FromClip, TrainConfig};
 
 /// The clip's own intra diversity under which a clip is calm.
 pub const CALM_INTRA_BELOW: f64 = 0.7;
-/// Optimiser steps of a calm clip at or over [`CALM_FULL_STEPS_FROM`] (the most a calm clip
-/// trains).
-pub const CALM_STEPS: u64 = 300;
-/// The intra diversity from which a calm clip trains all of [`CALM_STEPS`]; a calmer one
-/// trains fewer ([`calm_steps`]).
-pub const CALM_FULL_STEPS_FROM: f64 = 0.65;
-/// The power of the intra diversity that a calm clip's steps fall with below
-/// [`CALM_FULL_STEPS_FROM`].
-pub const CALM_STEPS_POWER: i32 = 3;
-/// The fewest steps a calm clip trains, however calm.
-pub const CALM_MIN_STEPS: u64 = 50;
-
-/// Optimiser steps of a calm clip of this intra diversity: `CALM_STEPS * min(1, intra /
-/// CALM_FULL_STEPS_FROM)^CALM_STEPS_POWER`, rounded, at least [`CALM_MIN_STEPS`] (a walk of
-/// intra diversity 0.34, which repeats one stride, replays its clip after 150 steps and not
-/// after 50; a kick of 0.64 is covered only from about 260).
-pub fn calm_steps(intra_diversity: f64) -> u64 {
-    let share = (intra_diversity / CALM_FULL_STEPS_FROM).clamp(0.0, 1.0);
-    let steps = (CALM_STEPS as f64 * share.powi(CALM_STEPS_POWER)).round() as u64;
-    steps.max(CALM_MIN_STEPS)
-}
 
 /// Warm-up steps of a calm clip's cosine schedule: a third of its steps.
 pub fn calm_warmup_steps(steps: u64) -> u64 {
     (steps as f64 / 3.0).round() as u64
+}
+
+/// The most steps a calm clip trains: the step ladder's top rung.
+pub fn calm_most_steps() -> u64 {
+    crate::step_ladder::LADDER_STEPS[crate::step_ladder::LADDER_STEPS.len() - 1]
 }
 /// QnA window of a varied clip, meant at 30 fps (it follows the frame rate when the
 /// configuration's window does).
@@ -99,26 +84,23 @@ pub struct RuleChoice {
     /// One line per setting, saying what it is and why (also for a setting the configuration
     /// kept because the rule was not asked to choose it).
     pub lines: Vec<String>,
+    /// Whether the steps are left to the step ladder ([`crate::step_ladder`]): a calm clip whose
+    /// steps the rule was asked for. `config` then holds the ladder's most steps.
+    pub climb_ladder: bool,
 }
 
-/// The configuration a new run on `data` trains: `config` with what its `from_clip` section asks
-/// the rule for chosen from the clip, and the rule's lines; `config` unchanged, and no lines,
-/// when the section is off.
-pub fn apply(config: TrainConfig, data: &ClipData) -> (TrainConfig, Option<Vec<String>>) {
+/// What the rule chooses for a new run on `data` with `config`; `None` when its `from_clip`
+/// section is off (the configuration trains as written).
+pub fn apply(config: &TrainConfig, data: &ClipData) -> Option<RuleChoice> {
     if config.from_clip.is_off() {
-        return (config, None);
+        return None;
     }
-    let choice = choose(&config, ClipReading::of(data));
-    (choice.config, Some(choice.lines))
+    Some(choose(config, ClipReading::of(data)))
 }
 
 /// Applies the rule of `config.from_clip` to `config` for the clip `reading` describes. The
 /// settings the rule is not asked for are kept; the result has `from_clip` off.
 pub fn choose(config: &TrainConfig, reading: ClipReading) -> RuleChoice {
-    let asked = config.from_clip;
-    let mut out = config.clone();
-    out.from_clip = FromClip::default();
-    let mut lines = Vec::new();
     let calm = reading.is_calm();
     let kind = if calm {
         format!(
@@ -131,18 +113,39 @@ pub fn choose(config: &TrainConfig, reading: ClipReading) -> RuleChoice {
             reading.intra_diversity
         )
     };
+    choose_kind(config, reading, calm, kind)
+}
+
+/// The rule's choice for a calm clip that no rung of the step ladder covered: it trains as a
+/// varied clip. `ladder` says how far the ladder got.
+pub fn not_calm_after_all(config: &TrainConfig, reading: ClipReading, ladder: &str) -> RuleChoice {
+    let kind = format!(
+        "varied: its own intra diversity {:.3} is under {CALM_INTRA_BELOW}, but {ladder}",
+        reading.intra_diversity
+    );
+    choose_kind(config, reading, false, kind)
+}
+
+fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: String) -> RuleChoice {
+    let asked = config.from_clip;
+    let mut out = config.clone();
+    out.from_clip = FromClip::default();
+    let mut lines = Vec::new();
     lines.push(format!("clip            {kind}"));
     let kept = "the configuration's; from_clip does not ask for it";
     lines.push(match (asked.steps, calm) {
         (false, _) => format!("steps           {} ({kept})", config.training.steps),
         (true, true) => {
-            let steps = calm_steps(reading.intra_diversity);
-            let warmup = calm_warmup_steps(steps);
+            let steps = calm_most_steps();
             out.training.steps = steps;
-            out.training.warmup_steps = warmup;
+            out.training.warmup_steps = calm_warmup_steps(steps);
             format!(
-                "steps           {steps} (warm-up {warmup}): a calm clip is covered within a few hundred steps, and replays the longer it trains, the calmer the sooner ({CALM_STEPS} x min(1, {:.3} / {CALM_FULL_STEPS_FROM})^{CALM_STEPS_POWER}, at least {CALM_MIN_STEPS})",
-                reading.intra_diversity
+                "steps           chosen by the step ladder when training starts: short runs of {} steps (warm-up a third), each sampled {} times and scored, and the one that meets coverage >= {}, replay <= {} s and jitter within {}x of the clip's either way with the widest margin trains the model (a calm clip is covered within a few hundred steps, and replays the longer it trains)",
+                ladder_list(),
+                crate::step_ladder::CHECK_SAMPLES,
+                crate::step_ladder::goals::COVERAGE,
+                crate::step_ladder::goals::REPLAY_SECONDS,
+                crate::step_ladder::goals::JITTER_RATIO,
             )
         }
         (true, false) => format!(
@@ -196,7 +199,18 @@ pub fn choose(config: &TrainConfig, reading: ClipReading) -> RuleChoice {
         reading,
         config: out,
         lines,
+        climb_ladder: calm && asked.steps,
     }
+}
+
+/// The ladder's rungs as words: "50, 75, ... and 300".
+fn ladder_list() -> String {
+    let steps: Vec<String> = crate::step_ladder::LADDER_STEPS
+        .iter()
+        .map(u64::to_string)
+        .collect();
+    let (last, rest) = steps.split_last().expect("the ladder has rungs");
+    format!("{} and {last}", rest.join(", "))
 }
 
 #[cfg(test)]
@@ -228,35 +242,45 @@ mod tests {
     }
 
     #[test]
-    fn a_calm_clip_trains_few_steps_and_keeps_the_shape() {
+    fn a_calm_clip_leaves_its_steps_to_the_ladder_and_keeps_the_shape() {
         let config = TrainConfig::parse(DEFAULT).unwrap();
         let choice = choose(&config, reading(0.5));
         let out = &choice.config;
-        // 300 x (0.5 / 0.65)^3 = 136.5.
-        assert_eq!(out.training.steps, 137);
-        assert_eq!(out.training.warmup_steps, 46);
+        assert!(choice.climb_ladder);
+        // Until the ladder chooses, the most it may train.
+        assert_eq!(out.training.steps, 1000);
+        assert_eq!(out.training.warmup_steps, 333);
         assert_eq!(out.model.window, config.model.window);
         assert_eq!(out.model.dropout, config.model.dropout);
         assert!(out.from_clip.is_off());
         assert!(choice.lines[0].contains("calm: its own intra diversity 0.500 is under 0.7"));
+        assert!(
+            choice.lines[1]
+                .contains("short runs of 50, 75, 100, 150, 200, 250, 300, 400, 600 and 1000 steps"),
+            "{:?}",
+            choice.lines
+        );
         out.validate().unwrap();
+        // Not asked for the steps, the rule leaves them as written and climbs nothing.
+        let mut fixed = config.clone();
+        fixed.from_clip.steps = false;
+        assert!(!choose(&fixed, reading(0.5)).climb_ladder);
+        assert_eq!(calm_warmup_steps(75), 25);
     }
 
     #[test]
-    fn the_calmer_the_clip_the_fewer_its_steps() {
-        // The full count from the reference up to the calm threshold.
-        for intra in [CALM_FULL_STEPS_FROM, 0.69] {
-            assert_eq!(calm_steps(intra), CALM_STEPS, "{intra}");
-        }
-        // Cubes: half the reference trains an eighth of the steps (37.5, rounded up).
-        assert_eq!(calm_steps(CALM_FULL_STEPS_FROM / 2.0), CALM_MIN_STEPS);
-        assert_eq!(calm_steps(0.6), 236); // 300 x (0.6 / 0.65)^3 = 235.96
-        assert_eq!(calm_steps(0.4), 70); // 69.9
-        // Never fewer than the floor, even for a still clip.
-        assert_eq!(calm_steps(0.0), CALM_MIN_STEPS);
-        assert_eq!(calm_warmup_steps(236), 79);
-        let steps: Vec<u64> = (0..=14).map(|i| calm_steps(f64::from(i) * 0.05)).collect();
-        assert!(steps.windows(2).all(|w| w[0] <= w[1]), "{steps:?}");
+    fn a_calm_clip_no_rung_covers_trains_as_a_varied_one() {
+        let config = TrainConfig::parse(DEFAULT).unwrap();
+        let choice = not_calm_after_all(&config, reading(0.6), "no rung covered it");
+        assert!(!choice.climb_ladder);
+        assert_eq!(choice.config.training.steps, config.training.steps);
+        assert_eq!(choice.config.model.window, VARIED_WINDOW);
+        assert_eq!(choice.config.model.dropout, VARIED_DROPOUT);
+        assert!(
+            choice.lines[0].contains("varied") && choice.lines[0].contains("no rung covered it"),
+            "{:?}",
+            choice.lines
+        );
     }
 
     #[test]
@@ -275,6 +299,7 @@ mod tests {
                 "the window still follows the frame rate"
             );
             assert!(choice.lines[0].contains("varied"), "{:?}", choice.lines);
+            assert!(!choice.climb_ladder);
             out.validate().unwrap();
         }
         // A wider window of the configuration's own is never narrowed.

@@ -60,6 +60,14 @@ pub enum TrainError {
         /// What does not fit.
         message: String,
     },
+    /// A rung of the step ladder could not be sampled or scored ([`crate::step_ladder`]).
+    #[error("could not check the samples of '{}' (a rung of the step ladder that chooses a calm clip's steps): {message}", model.display())]
+    Check {
+        /// The rung's model file.
+        model: PathBuf,
+        /// Why.
+        message: String,
+    },
     /// The model could not be exported.
     #[error("export failed: {0}")]
     Export(String),

@@ -24,6 +24,7 @@ pub mod recovery;
 pub mod run_folder;
 mod shards;
 pub mod step;
+pub mod step_ladder;
 pub mod trainer;
 pub mod weight_average;
 

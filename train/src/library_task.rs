@@ -293,7 +293,19 @@ fn train_export_evaluate(
     let mut trainer = if resumed {
         Trainer::resume(&run, Some(&entry.clip), None, device)?
     } else {
-        Trainer::start(&entry.clip, config, &run, device)?
+        let started = crate::step_ladder::start_run(
+            &entry.clip,
+            config,
+            &run,
+            device,
+            &crate::step_ladder::Ladder::default(),
+            stop,
+            &mut |_| {},
+        )?;
+        match started {
+            Some(trainer) => trainer,
+            None => return Ok(TaskEnd::Interrupted),
+        }
     };
     let dir = match trainer.run(stop, on_step)? {
         RunEnd::Finished(dir) => dir,

@@ -138,6 +138,17 @@ impl Trainer {
         }
     }
 
+    /// An error when the folder `run` already holds a training run.
+    pub fn check_new_run(run: &Path) -> Result<(), TrainError> {
+        if checkpoint::latest(run)?.is_some() || run.join(LOSS_LOG).exists() {
+            return Err(TrainError::Checkpoint {
+                path: run.to_path_buf(),
+                message: "already holds a training run; pass --resume to continue it, or choose another --out".into(),
+            });
+        }
+        Ok(())
+    }
+
     /// Starts a new run of `config` on `clip` in the folder `run` (created if needed; it must
     /// not already hold a run).
     pub fn start(
@@ -146,16 +157,16 @@ impl Trainer {
         run: &Path,
         device: Device,
     ) -> Result<Trainer, TrainError> {
-        if checkpoint::latest(run)?.is_some() || run.join(LOSS_LOG).exists() {
-            return Err(TrainError::Checkpoint {
-                path: run.to_path_buf(),
-                message: "already holds a training run; pass --resume to continue it, or choose another --out".into(),
-            });
-        }
+        Trainer::check_new_run(run)?;
         let data = ClipData::load(clip, &config.data, &config.model)?;
         // The run saves the numbers it trains: what the rule that reads the clip chose, a
         // window that follows the frame rate and a root layout chosen from the clip, resolved.
-        let (config, rule) = crate::clip_rule::apply(config, &data);
+        // (The steps of a calm clip are left to the step ladder, which `step_ladder::start_run`
+        // climbs before it calls this; called directly, a calm clip trains the ladder's most.)
+        let (config, rule) = match crate::clip_rule::apply(&config, &data) {
+            Some(choice) => (choice.config, Some(choice.lines)),
+            None => (config, None),
+        };
         let mut config = config.at_fps(data.facts.layout.fps);
         config.data.root_layout = data.facts.root_layout();
         std::fs::create_dir_all(run).map_err(io("create the output folder", run))?;
@@ -301,6 +312,11 @@ impl Trainer {
     /// started here with a configuration that asks for the rule ([`crate::clip_rule`]).
     pub fn rule_lines(&self) -> Option<&[String]> {
         self.rule.as_deref()
+    }
+
+    /// Replaces the rule's lines (the step ladder's choice, made before this run started).
+    pub(crate) fn set_rule_lines(&mut self, lines: Vec<String>) {
+        self.rule = Some(lines);
     }
 
     /// Whether all configured steps are done.

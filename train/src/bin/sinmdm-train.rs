@@ -236,7 +236,10 @@ fn dry_run(args: &Args) -> Result<()> {
     };
     let config = new_run_config(args)?;
     let data = ClipData::load(clip, &config.data, &config.model)?;
-    let (config, rule) = clip_rule::apply(config, &data);
+    let (config, rule, ladder) = match clip_rule::apply(&config, &data) {
+        Some(choice) => (choice.config, Some(choice.lines), choice.climb_ladder),
+        None => (config, None, false),
+    };
     let config = config.at_fps(data.facts.layout.fps);
     let features = data.features.nrows();
     let model = QnaUnet::new(features, &config.model, &Device::flex());
@@ -297,8 +300,10 @@ fn dry_run(args: &Args) -> Result<()> {
         _ => "the whole clip".into(),
     };
     println!(
-        "steps           {} (batch {} x {window})",
-        config.training.steps, shape.items
+        "steps           {}{} (batch {} x {window})",
+        if ladder { "up to " } else { "" },
+        config.training.steps,
+        shape.items
     );
     Ok(())
 }
@@ -344,6 +349,12 @@ fn main() -> Result<()> {
             "--minutes sets the steps of a new run; a resumed run keeps its own (raise them with a --config)"
         );
     }
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst))
+            .context("installing the Ctrl-C handler")?;
+    }
     let mut trainer = if args.resume {
         if args.fps.is_some() {
             bail!("--fps sets the frame rate of a new run; a resumed run keeps its own");
@@ -367,15 +378,28 @@ fn main() -> Result<()> {
         if let Some(minutes) = args.minutes {
             fit_to_budget(clip, &mut config, &device, minutes)?;
         }
-        Trainer::start(clip, config, out, device)?
+        let mut on_rung = |rung: &sinmdm_train::step_ladder::RungCheck| {
+            eprintln!("step ladder: {}", rung.line());
+        };
+        match sinmdm_train::step_ladder::start_run(
+            clip,
+            config,
+            out,
+            device,
+            &sinmdm_train::step_ladder::Ladder::default(),
+            &stop,
+            &mut on_rung,
+        )? {
+            Some(trainer) => trainer,
+            None => {
+                eprintln!(
+                    "interrupted while the step ladder chose the steps; the same command starts again and keeps the rungs finished (in {})",
+                    sinmdm_train::step_ladder::folder(out).display()
+                );
+                std::process::exit(130);
+            }
+        }
     };
-
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst))
-            .context("installing the Ctrl-C handler")?;
-    }
 
     let state = trainer.state().clone();
     eprintln!(

@@ -1,0 +1,273 @@
+//! The step ladder on a real calm clip: each rung is trained, exported and scored as `sinmdm
+//! eval` scores it, a rung already scored is not trained again, the main run trains the rung the
+//! ladder chose (or the varied setting when no rung covers the clip), and a stopped climb keeps
+//! the rungs it finished.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Mutex;
+use std::sync::atomic::AtomicBool;
+
+use burn::tensor::Device;
+use sinmdm_train::TrainConfig;
+use sinmdm_train::step_ladder::{Ladder, RungCheck, choose, folder, start_run};
+
+mod common;
+use common::root;
+
+/// burn's CPU RNG is process-wide: runs in this file take turns.
+static RNG: Mutex<()> = Mutex::new(());
+
+fn fox() -> PathBuf {
+    root().join("tests/data/bvh/fox_survey_khronos.bvh")
+}
+
+/// The tiny model, with the rule asked for the steps only (so the shape stays the tiny one).
+fn tiny_asking_for_steps() -> TrainConfig {
+    let mut config = TrainConfig::load(&root().join("configs/tiny.yaml")).unwrap();
+    config.from_clip.steps = true;
+    config
+}
+
+fn device() -> Device {
+    Device::flex().autodiff()
+}
+
+/// The `sinmdm` command line built beside this test (the workspace's test run builds it).
+fn sinmdm_command() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let profile = exe.parent().and_then(Path::parent).unwrap();
+    let cli = profile.join(format!("sinmdm{}", std::env::consts::EXE_SUFFIX));
+    assert!(
+        cli.is_file(),
+        "{} is not built; run the workspace's tests (cargo test --workspace)",
+        cli.display()
+    );
+    cli
+}
+
+fn json_number(value: &serde_json::Value, path: &[&str]) -> f64 {
+    path.iter()
+        .fold(value, |v, key| &v[key])
+        .as_f64()
+        .unwrap_or_else(|| panic!("{path:?} in {value}"))
+}
+
+#[test]
+fn each_rung_is_scored_as_sinmdm_eval_scores_it_and_the_chosen_one_trains() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let run = common::scratch("ladder", "climb");
+    let ladder = Ladder {
+        steps: vec![3, 6],
+        samples: 2,
+        seed: 1,
+    };
+    let mut heard: Vec<RungCheck> = Vec::new();
+    let stop = AtomicBool::new(false);
+    let trainer = start_run(
+        &fox(),
+        tiny_asking_for_steps(),
+        &run,
+        device(),
+        &ladder,
+        &stop,
+        &mut |r| heard.push(r.clone()),
+    )
+    .unwrap()
+    .expect("not stopped");
+    // The most-trained rung first, and the other only when it covers the clip.
+    assert_eq!(heard[0].steps, 6);
+    let climbed: Vec<u64> = heard.iter().map(|r| r.steps).collect();
+    assert_eq!(
+        climbed,
+        if heard[0].covers() {
+            vec![6, 3]
+        } else {
+            vec![6]
+        }
+    );
+
+    // Each rung's scores are those `sinmdm eval` gives its model for the same samples.
+    for rung in &heard {
+        let dir = folder(&run).join(format!("steps-{}", rung.steps));
+        let json = dir.join("eval.json");
+        let status = Command::new(sinmdm_command())
+            .args(["eval", "-m"])
+            .arg(dir.join("model.onnx"))
+            .arg("--clip")
+            .arg(fox())
+            .args(["--samples", "2", "--seed", "1", "--quiet", "--json"])
+            .arg(&json)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let eval: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let close = |ours: f64, theirs: f64, what: &str| {
+            assert!(
+                (ours - theirs).abs() <= 1e-6 * theirs.abs().max(1.0),
+                "rung {}: {what} {ours} against sinmdm eval's {theirs}",
+                rung.steps
+            );
+        };
+        close(
+            rung.coverage,
+            json_number(&eval, &["report", "coverage", "mean"]),
+            "coverage",
+        );
+        close(
+            rung.global_diversity,
+            json_number(&eval, &["report", "global_diversity", "mean"]),
+            "global diversity",
+        );
+        close(
+            rung.replay_seconds,
+            json_number(&eval, &["replay", "mean_seconds"]),
+            "replay",
+        );
+        close(
+            rung.jitter_ratio,
+            json_number(&eval, &["feet", "raw", "jitter_ratio"]),
+            "jitter",
+        );
+    }
+
+    // The main run trains what the ladder chose, and its lines list the rungs.
+    let config = &trainer.state().config;
+    match choose(&heard) {
+        Some(best) => assert_eq!(config.training.steps, best.steps),
+        None => assert_eq!(
+            config.training.steps, 300,
+            "the configuration's, as a varied clip"
+        ),
+    }
+    let lines = trainer.rule_lines().unwrap().join("\n");
+    assert!(lines.contains("   6 steps: coverage"), "{lines}");
+    let _ = std::fs::remove_dir_all(&run);
+}
+
+/// Scores as a finished rung leaves them.
+fn scored(steps: u64, coverage: f64, replay_seconds: f64, jitter_ratio: f64) -> RungCheck {
+    RungCheck {
+        steps,
+        coverage,
+        global_diversity: 0.5,
+        replay_seconds,
+        jitter_ratio,
+        train_seconds: 1.0,
+        check_seconds: 1.0,
+    }
+}
+
+/// Writes `rungs` into the ladder folder of `run`, as a climb stopped after them leaves them.
+fn leave_scored(run: &Path, rungs: &[RungCheck]) {
+    for rung in rungs {
+        let dir = folder(run).join(format!("steps-{}", rung.steps));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("check.json"), serde_json::to_string(rung).unwrap()).unwrap();
+    }
+}
+
+#[test]
+fn scored_rungs_are_kept_and_the_widest_margin_trains() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let run = common::scratch("ladder", "chosen");
+    let ladder = Ladder {
+        steps: vec![4, 8, 12],
+        samples: 2,
+        seed: 1,
+    };
+    // Rungs 4 and 12 scored already: only 8 is trained. Rung 4 has the widest margin any rung
+    // can have (1: full coverage, no replay, the clip's jitter), so 8 can at best tie with it,
+    // and a tie goes to fewer steps.
+    let (fewest, most) = (scored(4, 100.0, 0.0, 1.0), scored(12, 99.0, 0.5, 1.0));
+    leave_scored(&run, &[fewest.clone(), most.clone()]);
+    let mut heard: Vec<RungCheck> = Vec::new();
+    let trainer = start_run(
+        &fox(),
+        tiny_asking_for_steps(),
+        &run,
+        device(),
+        &ladder,
+        &AtomicBool::new(false),
+        &mut |r| heard.push(r.clone()),
+    )
+    .unwrap()
+    .unwrap();
+    // The most-trained first (it covers the clip), then the others, fewest steps first.
+    assert_eq!(
+        heard.iter().map(|r| r.steps).collect::<Vec<_>>(),
+        [12, 4, 8]
+    );
+    assert_eq!((&heard[0], &heard[1]), (&most, &fewest));
+    assert!(folder(&run).join("steps-8/model.onnx").is_file());
+    assert!(!folder(&run).join("steps-4/model.onnx").exists());
+    let config = &trainer.state().config;
+    assert_eq!(config.training.steps, 4);
+    assert_eq!(config.training.warmup_steps, 1);
+    let lines = trainer.rule_lines().unwrap().join("\n");
+    assert!(
+        lines.contains(
+            "steps           4 (warm-up 1): the rung of the step ladder that meets every goal"
+        ),
+        "{lines}"
+    );
+    let _ = std::fs::remove_dir_all(&run);
+}
+
+#[test]
+fn a_clip_the_most_steps_do_not_cover_trains_as_a_varied_one() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let run = common::scratch("ladder", "varied");
+    let ladder = Ladder {
+        steps: vec![4, 8, 12],
+        samples: 2,
+        seed: 1,
+    };
+    leave_scored(&run, &[scored(12, 90.0, 0.5, 1.0)]);
+    let mut config = tiny_asking_for_steps();
+    config.from_clip.window = true;
+    let trainer = start_run(
+        &fox(),
+        config,
+        &run,
+        device(),
+        &ladder,
+        &AtomicBool::new(false),
+        &mut |_| {},
+    )
+    .unwrap()
+    .unwrap();
+    // Nothing under the most-trained rung is climbed.
+    assert!(!folder(&run).join("steps-4").exists() && !folder(&run).join("steps-8").exists());
+    let trained = &trainer.state().config;
+    assert_eq!(trained.training.steps, 300, "the configuration's");
+    assert_eq!(trained.model.window, sinmdm_train::clip_rule::VARIED_WINDOW);
+    let lines = trainer.rule_lines().unwrap().join("\n");
+    assert!(
+        lines.contains("varied: its own intra diversity")
+            && lines
+                .contains("no short run of the step ladder covered it (at most 90.0 at 12 steps)"),
+        "{lines}"
+    );
+    let _ = std::fs::remove_dir_all(&run);
+}
+
+#[test]
+fn a_climb_stopped_before_its_first_rung_starts_no_run() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let run = common::scratch("ladder", "stopped");
+    let stopped = start_run(
+        &fox(),
+        tiny_asking_for_steps(),
+        &run,
+        device(),
+        &Ladder::default(),
+        &AtomicBool::new(true),
+        &mut |_| {},
+    )
+    .unwrap();
+    assert!(stopped.is_none());
+    assert!(!run.join("config.yaml").exists());
+    let _ = std::fs::remove_dir_all(&run);
+}
