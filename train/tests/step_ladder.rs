@@ -53,6 +53,35 @@ fn json_number(value: &serde_json::Value, path: &[&str]) -> f64 {
         .unwrap_or_else(|| panic!("{path:?} in {value}"))
 }
 
+/// Starts a run on the fox with `config` and `ladder`, telling `on_rung` each rung's scores.
+fn start_fox(
+    run: &Path,
+    config: TrainConfig,
+    ladder: &Ladder,
+    stop: bool,
+    on_rung: &mut dyn FnMut(&RungCheck),
+) -> Option<sinmdm_train::Trainer> {
+    start_run(
+        &fox(),
+        config,
+        run,
+        device(),
+        ladder,
+        &AtomicBool::new(stop),
+        on_rung,
+    )
+    .unwrap()
+}
+
+/// A ladder of three short rungs, scored on two samples.
+fn three_rungs() -> Ladder {
+    Ladder {
+        steps: vec![4, 8, 12],
+        samples: 2,
+        seed: 1,
+    }
+}
+
 #[test]
 fn each_rung_is_scored_as_sinmdm_eval_scores_it_and_the_chosen_one_trains() {
     let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
@@ -63,17 +92,9 @@ fn each_rung_is_scored_as_sinmdm_eval_scores_it_and_the_chosen_one_trains() {
         seed: 1,
     };
     let mut heard: Vec<RungCheck> = Vec::new();
-    let stop = AtomicBool::new(false);
-    let trainer = start_run(
-        &fox(),
-        tiny_asking_for_steps(),
-        &run,
-        device(),
-        &ladder,
-        &stop,
-        &mut |r| heard.push(r.clone()),
-    )
-    .unwrap()
+    let trainer = start_fox(&run, tiny_asking_for_steps(), &ladder, false, &mut |r| {
+        heard.push(r.clone())
+    })
     .expect("not stopped");
     // The most-trained rung first, and the other only when it covers the clip.
     assert_eq!(heard[0].steps, 6);
@@ -172,27 +193,19 @@ fn leave_scored(run: &Path, rungs: &[RungCheck]) {
 fn scored_rungs_are_kept_and_the_widest_margin_trains() {
     let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
     let run = common::scratch("ladder", "chosen");
-    let ladder = Ladder {
-        steps: vec![4, 8, 12],
-        samples: 2,
-        seed: 1,
-    };
     // Rungs 4 and 12 scored already: only 8 is trained. Rung 4 has the widest margin any rung
     // can have (1: full coverage, no replay, the clip's jitter), so 8 can at best tie with it,
     // and a tie goes to fewer steps.
     let (fewest, most) = (scored(4, 100.0, 0.0, 1.0), scored(12, 99.0, 0.5, 1.0));
     leave_scored(&run, &[fewest.clone(), most.clone()]);
     let mut heard: Vec<RungCheck> = Vec::new();
-    let trainer = start_run(
-        &fox(),
-        tiny_asking_for_steps(),
+    let trainer = start_fox(
         &run,
-        device(),
-        &ladder,
-        &AtomicBool::new(false),
+        tiny_asking_for_steps(),
+        &three_rungs(),
+        false,
         &mut |r| heard.push(r.clone()),
     )
-    .unwrap()
     .unwrap();
     // The most-trained first (it covers the clip), then the others, fewest steps first.
     assert_eq!(
@@ -219,25 +232,10 @@ fn scored_rungs_are_kept_and_the_widest_margin_trains() {
 fn a_clip_the_most_steps_do_not_cover_trains_as_a_varied_one() {
     let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
     let run = common::scratch("ladder", "varied");
-    let ladder = Ladder {
-        steps: vec![4, 8, 12],
-        samples: 2,
-        seed: 1,
-    };
     leave_scored(&run, &[scored(12, 90.0, 0.5, 1.0)]);
     let mut config = tiny_asking_for_steps();
     config.from_clip.window = true;
-    let trainer = start_run(
-        &fox(),
-        config,
-        &run,
-        device(),
-        &ladder,
-        &AtomicBool::new(false),
-        &mut |_| {},
-    )
-    .unwrap()
-    .unwrap();
+    let trainer = start_fox(&run, config, &three_rungs(), false, &mut |_| {}).unwrap();
     // Nothing under the most-trained rung is climbed.
     assert!(!folder(&run).join("steps-4").exists() && !folder(&run).join("steps-8").exists());
     let trained = &trainer.state().config;
@@ -257,16 +255,13 @@ fn a_clip_the_most_steps_do_not_cover_trains_as_a_varied_one() {
 fn a_climb_stopped_before_its_first_rung_starts_no_run() {
     let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
     let run = common::scratch("ladder", "stopped");
-    let stopped = start_run(
-        &fox(),
-        tiny_asking_for_steps(),
+    let stopped = start_fox(
         &run,
-        device(),
+        tiny_asking_for_steps(),
         &Ladder::default(),
-        &AtomicBool::new(true),
+        true,
         &mut |_| {},
-    )
-    .unwrap();
+    );
     assert!(stopped.is_none());
     assert!(!run.join("config.yaml").exists());
     let _ = std::fs::remove_dir_all(&run);
