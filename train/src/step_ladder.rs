@@ -6,10 +6,11 @@
 //! ways one number read before training did not predict on clips it was not chosen on
 //! (docs/TRAINING_EXPERIMENTS.md, "The step ladder"). So the trainer measures instead: it trains
 //! short runs of [`LADDER_STEPS`] steps (each its own run, warm-up a third; the most-trained
-//! first, and the rest only when it covers the clip), samples each as the benchmark does ([`CHECK_SAMPLES`] samples of twice the clip, seed [`CHECK_SEED`], through
-//! onnxruntime as a user would), scores the samples against the goals and trains the
-//! main run with the rung that meets them with the widest margin ([`choose`]). When no rung
-//! covers the clip, the clip is not calm after all and trains as a varied one.
+//! first, and the rest only when it covers the clip), samples each as the benchmark does
+//! ([`CHECK_SAMPLES`] samples of twice the clip, seed [`CHECK_SEED`], through onnxruntime as a
+//! user would), scores the samples against the [`goals`] and trains the main run with the rung
+//! that meets them with the widest margin ([`choose`]). When no rung covers the clip, the clip
+//! is not calm after all and trains as a varied one.
 //!
 //! The rungs live in the run folder's [`LADDER_FOLDER`], one folder each with its model and its
 //! scores (`check.json`); a start that was interrupted keeps the rungs it finished.
