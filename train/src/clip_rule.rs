@@ -35,7 +35,7 @@ pub fn calm_warmup_steps(steps: u64) -> u64 {
 
 /// The most steps a calm clip trains: the step ladder's top rung.
 pub fn calm_most_steps() -> u64 {
-    crate::step_ladder::LADDER_STEPS[crate::step_ladder::LADDER_STEPS.len() - 1]
+    crate::ladder_settings::LADDER_STEPS[crate::ladder_settings::LADDER_STEPS.len() - 1]
 }
 /// QnA window of a varied clip, meant at 30 fps (it follows the frame rate when the
 /// configuration's window does).
@@ -142,10 +142,10 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
             format!(
                 "steps           chosen by the step ladder when training starts: short runs of {} steps (warm-up a third), each sampled {} times and scored, and the one that meets coverage >= {}, replay <= {} s and jitter within {}x of the clip's either way with the widest margin trains the model (a calm clip is covered within a few hundred steps, and replays the longer it trains)",
                 ladder_list(),
-                crate::step_ladder::CHECK_SAMPLES,
-                crate::step_ladder::goals::COVERAGE,
-                crate::step_ladder::goals::REPLAY_SECONDS,
-                crate::step_ladder::goals::JITTER_RATIO,
+                crate::ladder_settings::CHECK_SAMPLES,
+                crate::ladder_settings::goals::COVERAGE,
+                crate::ladder_settings::goals::REPLAY_SECONDS,
+                crate::ladder_settings::goals::JITTER_RATIO,
             )
         }
         (true, false) => format!(
@@ -205,7 +205,7 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
 
 /// The ladder's rungs as words: "50, 75, ... and 300".
 fn ladder_list() -> String {
-    let steps: Vec<String> = crate::step_ladder::LADDER_STEPS
+    let steps: Vec<String> = crate::ladder_settings::LADDER_STEPS
         .iter()
         .map(u64::to_string)
         .collect();

@@ -12,6 +12,7 @@ pub mod config;
 pub mod data;
 pub mod error;
 pub mod export;
+pub mod ladder_settings;
 pub mod library_task;
 pub mod loss;
 pub mod loss_log;

@@ -26,47 +26,17 @@ use serde::{Deserialize, Serialize};
 use sinmdm::motion::encode_for_model;
 use sinmdm_formats::{AnimationChoice, ReadOptions, read_clip};
 
+pub use crate::ladder_settings::{CHECK_SAMPLES, CHECK_SEED, LADDER_STEPS, goals};
+
 use crate::clip_data::ClipData;
 use crate::config::TrainConfig;
 use crate::error::TrainError;
 use crate::trainer::{RunEnd, Trainer};
 
-/// The steps of each rung, fewest first.
-pub const LADDER_STEPS: [u64; 10] = [50, 75, 100, 150, 200, 250, 300, 400, 600, 1000];
-/// Samples a rung is scored on (the benchmark's count).
-pub const CHECK_SAMPLES: usize = 20;
-/// Seed of a rung's samples (the benchmark's tables use seed 0, so the check and the tables
-/// score different samples).
-pub const CHECK_SEED: u64 = 1;
 /// The folder, inside the run folder, that holds the rungs.
 pub const LADDER_FOLDER: &str = "step_ladder";
 /// The scores file of a finished rung.
 const CHECK_FILE: &str = "check.json";
-
-/// The goals a calm clip's samples are held to: the adaptive default's (coverage, replay, jitter
-/// at most 1.5x the clip's), and one it does not set, jitter at least the clip's divided by 1.5.
-/// Without that mirror bound the ladder would choose the least-trained rung whenever every rung
-/// covers the clip, and those samples are smoother than the clip (a happy walk after 50 steps:
-/// 0.26x its jitter; docs/TRAINING_EXPERIMENTS.md, "The step ladder").
-pub mod goals {
-    /// Least coverage, in percent of the clip's windows.
-    pub const COVERAGE: f64 = 95.0;
-    /// Longest mean verbatim run, in seconds.
-    pub const REPLAY_SECONDS: f64 = 1.0;
-    /// Most jitter, as a multiple of the clip's own.
-    pub const JITTER_RATIO: f64 = 1.5;
-    /// Least jitter, as a multiple of the clip's own: the mirror of [`JITTER_RATIO`].
-    pub const LEAST_JITTER_RATIO: f64 = 1.0 / JITTER_RATIO;
-    /// Coverage points that count as one goal's worth of margin.
-    pub const COVERAGE_UNIT: f64 = 5.0;
-    /// Replay seconds that count as one goal's worth of margin.
-    pub const REPLAY_UNIT: f64 = 0.5;
-    /// Jitter (times the clip's) over [`JITTER_RATIO`] that counts as one goal's worth of margin.
-    pub const JITTER_UNIT: f64 = 0.5;
-    /// Jitter (times the clip's) under [`LEAST_JITTER_RATIO`] that counts as one goal's worth of
-    /// margin: the mirror of [`JITTER_UNIT`], from 1 / 1.5 down to 1 / (1.5 + 0.5).
-    pub const LEAST_JITTER_UNIT: f64 = LEAST_JITTER_RATIO - 1.0 / (JITTER_RATIO + JITTER_UNIT);
-}
 
 /// How a rung's samples scored.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
