@@ -4,7 +4,9 @@
 //! <out>/<name>/
 //!   fingerprint    what the model in this folder was made from (see crate::fingerprint)
 //!   status.json    the task's state (see crate::status)
-//!   run/           the training run: checkpoints, loss.csv (resumed from after a kill)
+//!   run/           the training run: checkpoints, loss.csv (resumed from after a kill), and
+//!                  a calm clip's step_ladder/ (kept when a task killed before its first
+//!                  checkpoint starts again)
 //!   model.onnx     the model, written under a temporary name and renamed when whole
 //!   eval.json      the model's evaluation (`sinmdm eval --json`)
 //!   card.md        the model's card: clip, settings, training, evaluation table
@@ -88,11 +90,15 @@ impl TaskFolder {
     }
 
     /// Decides what the task does, and makes the folder ready for it: a stale folder (another
-    /// fingerprint) loses its run and model first; the fingerprint is then recorded.
+    /// fingerprint) loses its run and model first; the fingerprint is then recorded. A run of
+    /// the same fingerprint killed before its first checkpoint starts again, but keeps the
+    /// entries of its folder named in `kept_by_a_restart` (work a start does before its first
+    /// checkpoint and can reuse, such as the trainer's step ladder).
     pub fn prepare(
         &self,
         fingerprint: &str,
         has_checkpoint: impl Fn(&Path) -> bool,
+        kept_by_a_restart: &[&str],
     ) -> Result<Plan, LibraryError> {
         if self.is_current(fingerprint) {
             return Ok(Plan::UpToDate);
@@ -102,9 +108,25 @@ impl TaskFolder {
         if same && has_checkpoint(&self.run()) {
             return Ok(Plan::Resume);
         }
-        // Stale, or never started, or killed before its first checkpoint: start clean.
+        // Stale, or never started, or killed before its first checkpoint: start clean (but for
+        // what a restart of the same fingerprint keeps).
         let run = self.run();
-        if run.exists() {
+        if same && run.is_dir() {
+            let entries = std::fs::read_dir(&run).map_err(|e| LibraryError::io(&run, e))?;
+            for entry in entries {
+                let entry = entry.map_err(|e| LibraryError::io(&run, e))?;
+                if kept_by_a_restart.iter().any(|k| entry.file_name() == *k) {
+                    continue;
+                }
+                let path = entry.path();
+                let removed = if path.is_dir() {
+                    std::fs::remove_dir_all(&path)
+                } else {
+                    std::fs::remove_file(&path)
+                };
+                removed.map_err(|e| LibraryError::io(&path, e))?;
+            }
+        } else if run.exists() {
             std::fs::remove_dir_all(&run).map_err(|e| LibraryError::io(&run, e))?;
         }
         for file in [self.model(), self.eval(), self.card(), self.sample()] {
@@ -131,12 +153,24 @@ mod tests {
         let folder = TaskFolder::new(&dir);
         let never = |_: &Path| false;
         let always = |_: &Path| true;
-        assert_eq!(folder.prepare("a", never).unwrap(), Plan::Fresh);
+        let kept = ["ladder"];
+        assert_eq!(folder.prepare("a", never, &kept).unwrap(), Plan::Fresh);
         std::fs::create_dir_all(folder.run()).unwrap();
-        assert_eq!(folder.prepare("a", always).unwrap(), Plan::Resume);
+        assert_eq!(folder.prepare("a", always, &kept).unwrap(), Plan::Resume);
+        // Killed before its first checkpoint: a start again keeps what a restart keeps.
+        std::fs::create_dir_all(folder.run().join("ladder/rung")).unwrap();
+        std::fs::create_dir_all(folder.run().join("checkpoints")).unwrap();
+        std::fs::write(folder.run().join("loss.csv"), b"step,loss").unwrap();
+        assert_eq!(folder.prepare("a", never, &kept).unwrap(), Plan::Fresh);
+        let left: Vec<_> = std::fs::read_dir(folder.run())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(left, ["ladder"]);
+        assert!(folder.run().join("ladder/rung").is_dir());
         std::fs::write(folder.model(), b"model").unwrap();
         // A model without a done status (killed before its card) is not finished: resume.
-        assert_eq!(folder.prepare("a", always).unwrap(), Plan::Resume);
+        assert_eq!(folder.prepare("a", always, &kept).unwrap(), Plan::Resume);
         let status = crate::status::TaskStatus {
             state: crate::status::State::Done,
             name: "x".into(),
@@ -151,8 +185,9 @@ mod tests {
             pid: None,
         };
         status.write(&folder.status()).unwrap();
-        assert_eq!(folder.prepare("a", always).unwrap(), Plan::UpToDate);
-        assert_eq!(folder.prepare("b", always).unwrap(), Plan::Fresh);
+        assert_eq!(folder.prepare("a", always, &kept).unwrap(), Plan::UpToDate);
+        // Another fingerprint: nothing of the run is kept.
+        assert_eq!(folder.prepare("b", always, &kept).unwrap(), Plan::Fresh);
         assert!(!folder.model().exists() && !folder.run().exists());
         assert_eq!(folder.recorded_fingerprint().as_deref(), Some("b"));
         std::fs::remove_dir_all(dir).unwrap();

@@ -82,3 +82,37 @@ def test_tasks_are_idempotent_resumable_and_reported(tmp_path):
     assert all(0 <= r["coverage"] <= 100 for r in rows[:2])
     assert (tmp_path / "report" / "contact_sheet.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert os.path.getsize(tmp_path / "report" / "contact_sheet.png") > 1000
+
+
+def test_a_task_killed_during_its_step_ladder_keeps_the_rungs_it_finished(tmp_path):
+    # The fox is calm: with the rule asked for its steps, its task climbs the step ladder (the
+    # tiny model's rungs train in seconds) before its run has any checkpoint.
+    shutil.copy(ROOT / "tests/data/bvh/fox_survey_khronos.bvh", tmp_path / "fox.bvh")
+    (tmp_path / "ladder.yaml").write_text(tiny_config(300) + "from_clip:\n  steps: true\n")
+    manifest = tmp_path / "library.yaml"
+    manifest.write_text("config: ladder.yaml\nsamples: 2\nclips:\n  - clip: fox.bvh\n")
+    ladder = tmp_path / "library" / "fox" / "run" / "step_ladder"
+    first = ladder / "steps-1000" / "check.json"
+
+    running = subprocess.Popen([TRAIN, "--manifest", manifest, "--index", "0"], stderr=subprocess.DEVNULL)
+    for _ in range(2400):
+        if first.exists() or running.poll() is not None:
+            break
+        time.sleep(0.05)
+    running.send_signal(signal.SIGKILL)
+    running.wait()
+    assert first.exists(), "the task ended or timed out before its first rung was scored"
+    assert not (tmp_path / "library" / "fox" / "run" / "latest").exists(), "killed too late"
+    scored = first.read_bytes()
+    finished = sorted(p.parent.name for p in ladder.glob("steps-*/check.json"))
+
+    again = task(manifest, 0)
+    assert again.returncode == 0, again.stderr
+    assert "task 0: trained" in again.stderr, again.stderr
+    # The rungs finished before the kill were kept, not trained again (a rung trained again
+    # would have written its scores anew, with its own training time).
+    assert first.read_bytes() == scored
+    assert all((ladder / name / "check.json").exists() for name in finished)
+    status = json.loads((tmp_path / "library" / "fox" / "status.json").read_text())
+    assert status["state"] == "done"
+    assert status["steps"] in (50, 75, 100, 150, 200, 250, 300, 400, 600, 1000), status

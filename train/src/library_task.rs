@@ -235,9 +235,13 @@ pub fn run_task(
         }
     };
     status.fingerprint = fingerprint.clone();
-    let plan = folder.prepare(&fingerprint, |run| {
-        checkpoint::latest(run).ok().flatten().is_some()
-    })?;
+    // A task killed during its step ladder keeps the rungs it finished (they are reused only
+    // when made from the same clip and configuration).
+    let plan = folder.prepare(
+        &fingerprint,
+        |run| checkpoint::latest(run).ok().flatten().is_some(),
+        &[crate::step_ladder::LADDER_FOLDER],
+    )?;
     if plan == Plan::UpToDate {
         return Ok(TaskEnd::UpToDate(folder.model()));
     }

@@ -13,7 +13,9 @@
 //! is not calm after all and trains as a varied one.
 //!
 //! The rungs live in the run folder's [`LADDER_FOLDER`], one folder each with its model and its
-//! scores (`check.json`); a start that was interrupted keeps the rungs it finished.
+//! scores (`check.json`); a start that was interrupted keeps the rungs it finished, and a start
+//! again reuses a finished rung only when it was made from the same clip bytes, configuration,
+//! check and trainer version ([`Ladder::rung_fingerprint`]).
 
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -55,6 +57,10 @@ pub struct RungCheck {
     pub train_seconds: f64,
     /// Seconds its samples took to make and score.
     pub check_seconds: f64,
+    /// What the rung was made from ([`Ladder::rung_fingerprint`]): a rung scored for another
+    /// clip, configuration, check or trainer version is trained again, not reused.
+    #[serde(default)]
+    pub made_from: String,
 }
 
 impl RungCheck {
@@ -172,16 +178,28 @@ impl Ladder {
         if let Some(most) = order.pop() {
             order.insert(0, most);
         }
+        let clip_sha256 = crate::clip_data::sha256_hex(&std::fs::read(clip).map_err(|source| {
+            TrainError::Io {
+                what: "read the clip",
+                path: clip.to_path_buf(),
+                source,
+            }
+        })?);
         let mut rungs: Vec<RungCheck> = Vec::with_capacity(order.len());
         for steps in order {
             if rungs.first().is_some_and(|most| !most.covers()) {
                 break;
             }
             let dir = folder.join(format!("steps-{steps}"));
-            let check = match read_check(&dir, steps) {
+            let made_from = self.rung_fingerprint(&clip_sha256, config, steps);
+            let check = match read_check(&dir, steps, &made_from) {
                 Some(check) => check,
                 None => match self.train_rung(clip, config, steps, &dir, device, stop)? {
-                    Some(check) => check,
+                    Some(check) => {
+                        let check = RungCheck { made_from, ..check };
+                        write_check(&dir, &check)?;
+                        check
+                    }
                     None => return Ok(Climb::Interrupted),
                 },
             };
@@ -190,6 +208,38 @@ impl Ladder {
         }
         rungs.sort_by_key(|r| r.steps);
         Ok(Climb::Done(rungs))
+    }
+
+    /// The configuration a rung of `steps` trains: `config` with the rung's steps and warm-up,
+    /// one checkpoint at its end, and no rule (its numbers are the rule's already).
+    pub fn rung_config(config: &TrainConfig, steps: u64) -> TrainConfig {
+        let mut rung = config.clone();
+        rung.from_clip = Default::default();
+        rung.training.steps = steps;
+        rung.training.warmup_steps = crate::clip_rule::calm_warmup_steps(steps);
+        rung.training.checkpoint_every = steps;
+        rung
+    }
+
+    /// What a rung of `steps` on the clip whose bytes hash to `clip_sha256` (SHA-256, hex) is
+    /// made from, hashed: the trainer's version, the clip, the rung's configuration
+    /// ([`Ladder::rung_config`] of `config`) and this ladder's check (samples and seed). A
+    /// finished rung is reused only when its scores record the same.
+    pub fn rung_fingerprint(&self, clip_sha256: &str, config: &TrainConfig, steps: u64) -> String {
+        let rung = serde_json::to_string(&Self::rung_config(config, steps))
+            .expect("a configuration serialises");
+        let parts = [
+            env!("CARGO_PKG_VERSION").to_string(),
+            clip_sha256.to_string(),
+            rung,
+            format!("{} samples, seed {}", self.samples, self.seed),
+        ];
+        let mut text = Vec::new();
+        for part in &parts {
+            text.extend_from_slice(&(part.len() as u64).to_le_bytes());
+            text.extend_from_slice(part.as_bytes());
+        }
+        crate::clip_data::sha256_hex(&text)
     }
 
     /// Trains one rung into `dir` (anything a killed rung left there is replaced), exports it
@@ -210,11 +260,7 @@ impl Ladder {
                 source,
             })?;
         }
-        let mut rung = config.clone();
-        rung.from_clip = Default::default();
-        rung.training.steps = steps;
-        rung.training.warmup_steps = crate::clip_rule::calm_warmup_steps(steps);
-        rung.training.checkpoint_every = steps;
+        let rung = Self::rung_config(config, steps);
         let started = Instant::now();
         let mut trainer = Trainer::start(clip, rung, dir, device.clone())?;
         let checkpoint = match trainer.run(stop, |_| {})? {
@@ -228,14 +274,6 @@ impl Ladder {
         let mut check = self.score(&model, clip, animation.as_deref())?;
         check.steps = steps;
         check.train_seconds = train_seconds;
-        let json = serde_json::to_string_pretty(&check).expect("scores serialise");
-        sinmdm::files::write_atomically(&dir.join(CHECK_FILE), json.as_bytes()).map_err(
-            |source| TrainError::Io {
-                what: "write a rung's scores",
-                path: dir.join(CHECK_FILE),
-                source,
-            },
-        )?;
         Ok(Some(check))
     }
 
@@ -290,6 +328,7 @@ impl Ladder {
             jitter_ratio: scores.raw_jitter_ratio,
             train_seconds: 0.0,
             check_seconds: started.elapsed().as_secs_f64(),
+            made_from: String::new(),
         })
     }
 }
@@ -358,12 +397,25 @@ pub fn start_run(
     Ok(Some(trainer))
 }
 
-/// The scores a finished rung left in `dir`, if it finished and trained `steps`.
-fn read_check(dir: &Path, steps: u64) -> Option<RungCheck> {
+/// Writes a finished rung's scores into its folder `dir` (whole, or not at all).
+fn write_check(dir: &Path, check: &RungCheck) -> Result<(), TrainError> {
+    let json = serde_json::to_string_pretty(check).expect("scores serialise");
+    sinmdm::files::write_atomically(&dir.join(CHECK_FILE), json.as_bytes()).map_err(|source| {
+        TrainError::Io {
+            what: "write a rung's scores",
+            path: dir.join(CHECK_FILE),
+            source,
+        }
+    })
+}
+
+/// The scores a finished rung left in `dir`, if it finished, trained `steps` and was made from
+/// `made_from` ([`Ladder::rung_fingerprint`]).
+fn read_check(dir: &Path, steps: u64, made_from: &str) -> Option<RungCheck> {
     let text = std::fs::read_to_string(dir.join(CHECK_FILE)).ok()?;
     serde_json::from_str::<RungCheck>(&text)
         .ok()
-        .filter(|c| c.steps == steps)
+        .filter(|c| c.steps == steps && c.made_from == made_from)
 }
 
 /// The ladder folder of the run folder `run`.
@@ -384,6 +436,7 @@ mod tests {
             jitter_ratio,
             train_seconds: 1.0,
             check_seconds: 1.0,
+            made_from: String::new(),
         }
     }
 

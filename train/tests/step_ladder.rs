@@ -177,16 +177,40 @@ fn scored(steps: u64, coverage: f64, replay_seconds: f64, jitter_ratio: f64) -> 
         jitter_ratio,
         train_seconds: 1.0,
         check_seconds: 1.0,
+        made_from: String::new(),
     }
 }
 
-/// Writes `rungs` into the ladder folder of `run`, as a climb stopped after them leaves them.
-fn leave_scored(run: &Path, rungs: &[RungCheck]) {
+/// What a rung of `steps` on the fox is made from, when `ladder` climbs it for `config`.
+fn fox_rung_fingerprint(ladder: &Ladder, config: &TrainConfig, steps: u64) -> String {
+    let clip = sinmdm_train::clip_data::sha256_hex(&std::fs::read(fox()).unwrap());
+    ladder.rung_fingerprint(&clip, config, steps)
+}
+
+/// Writes `rungs` into the ladder folder of `run`, as a climb of `ladder` with `config` on the
+/// fox, stopped after them, leaves them; returns them as written.
+fn leave_scored(
+    run: &Path,
+    ladder: &Ladder,
+    config: &TrainConfig,
+    rungs: &[RungCheck],
+) -> Vec<RungCheck> {
+    let mut written = Vec::new();
     for rung in rungs {
+        let rung = RungCheck {
+            made_from: fox_rung_fingerprint(ladder, config, rung.steps),
+            ..rung.clone()
+        };
         let dir = folder(run).join(format!("steps-{}", rung.steps));
         std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(dir.join("check.json"), serde_json::to_string(rung).unwrap()).unwrap();
+        std::fs::write(
+            dir.join("check.json"),
+            serde_json::to_string(&rung).unwrap(),
+        )
+        .unwrap();
+        written.push(rung);
     }
+    written
 }
 
 #[test]
@@ -196,24 +220,38 @@ fn scored_rungs_are_kept_and_the_widest_margin_trains() {
     // Rungs 4 and 12 scored already: only 8 is trained. Rung 4 has the widest margin any rung
     // can have (1: full coverage, no replay, the clip's jitter), so 8 can at best tie with it,
     // and a tie goes to fewer steps.
-    let (fewest, most) = (scored(4, 100.0, 0.0, 1.0), scored(12, 99.0, 0.5, 1.0));
-    leave_scored(&run, &[fewest.clone(), most.clone()]);
-    let mut heard: Vec<RungCheck> = Vec::new();
-    let trainer = start_fox(
+    let config = tiny_asking_for_steps();
+    let kept = leave_scored(
         &run,
-        tiny_asking_for_steps(),
         &three_rungs(),
-        false,
-        &mut |r| heard.push(r.clone()),
-    )
+        &config,
+        &[scored(4, 100.0, 0.0, 1.0), scored(12, 99.0, 0.5, 1.0)],
+    );
+    // Rung 8 was scored too, but for another configuration: it is trained again.
+    let mut other = config.clone();
+    other.model.dropout = 0.3;
+    let stale = leave_scored(&run, &three_rungs(), &other, &[scored(8, 100.0, 0.0, 1.0)]);
+    assert_ne!(
+        stale[0].made_from,
+        fox_rung_fingerprint(&three_rungs(), &config, 8)
+    );
+    let mut heard: Vec<RungCheck> = Vec::new();
+    let trainer = start_fox(&run, config.clone(), &three_rungs(), false, &mut |r| {
+        heard.push(r.clone())
+    })
     .unwrap();
     // The most-trained first (it covers the clip), then the others, fewest steps first.
     assert_eq!(
         heard.iter().map(|r| r.steps).collect::<Vec<_>>(),
         [12, 4, 8]
     );
-    assert_eq!((&heard[0], &heard[1]), (&most, &fewest));
+    assert_eq!((&heard[0], &heard[1]), (&kept[1], &kept[0]));
     assert!(folder(&run).join("steps-8/model.onnx").is_file());
+    assert_eq!(
+        heard[2].made_from,
+        fox_rung_fingerprint(&three_rungs(), &config, 8)
+    );
+    assert_ne!(heard[2], stale[0]);
     assert!(!folder(&run).join("steps-4/model.onnx").exists());
     let config = &trainer.state().config;
     assert_eq!(config.training.steps, 4);
@@ -232,9 +270,9 @@ fn scored_rungs_are_kept_and_the_widest_margin_trains() {
 fn a_clip_the_most_steps_do_not_cover_trains_as_a_varied_one() {
     let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
     let run = common::scratch("ladder", "varied");
-    leave_scored(&run, &[scored(12, 90.0, 0.5, 1.0)]);
     let mut config = tiny_asking_for_steps();
     config.from_clip.window = true;
+    leave_scored(&run, &three_rungs(), &config, &[scored(12, 90.0, 0.5, 1.0)]);
     let trainer = start_fox(&run, config, &three_rungs(), false, &mut |_| {}).unwrap();
     // Nothing under the most-trained rung is climbed.
     assert!(!folder(&run).join("steps-4").exists() && !folder(&run).join("steps-8").exists());
