@@ -10,9 +10,15 @@
 //!   keeps the one whose own samples meet the goals best; a calm clip that no short run covers
 //!   trains as a varied one ([`not_calm_after_all`]).
 //! - a **varied** clip (at or over it: a walk that turns and stops, a hop, a dog's run) covers
-//!   more the longer it trains, and its samples shake more than the clip. It keeps the
-//!   configuration's steps and trains with a wider QnA window ([`VARIED_WINDOW`]) that smooths
-//!   the samples and more dropout ([`VARIED_DROPOUT`]) that keeps them varied.
+//!   more the longer it trains. It keeps the configuration's steps, and its QnA window and
+//!   dropout follow its feet (the contact joints the clip's layout found):
+//!   - on two feet or fewer, its samples shake more than the clip at the configuration's window:
+//!     it trains a wider window ([`VARIED_WINDOW`]) that smooths them and more dropout
+//!     ([`VARIED_DROPOUT`]) that keeps them varied;
+//!   - on [`MANY_FEET`] feet or more (a dog, a horse, a fox), its samples at a window that serves
+//!     a biped keep too little of the clip (a fifth of a dog's one-second windows are never
+//!     made): the legs' phases must hold over a longer span. It trains the wide window
+//!     [`MANY_FEET_WINDOW`] with the configuration's dropout (more dropout costs it coverage).
 //!
 //! The measure is the benchmark's intra diversity ([`sinmdm_eval::intra_diversity`]): the mean
 //! distance, per frame, between two 15-frame windows of the clip's joint rotations and contact
@@ -37,11 +43,15 @@ pub fn calm_warmup_steps(steps: u64) -> u64 {
 pub fn calm_most_steps() -> u64 {
     crate::ladder_settings::LADDER_STEPS[crate::ladder_settings::LADDER_STEPS.len() - 1]
 }
-/// QnA window of a varied clip, meant at 30 fps (it follows the frame rate when the
-/// configuration's window does).
+/// QnA window of a varied clip on two feet or fewer, meant at 30 fps (it follows the frame rate
+/// when the configuration's window does).
 pub const VARIED_WINDOW: usize = 5;
-/// Dropout of a varied clip.
+/// Dropout of a varied clip on two feet or fewer.
 pub const VARIED_DROPOUT: f64 = 0.5;
+/// The feet (contact joints) from which a varied clip trains [`MANY_FEET_WINDOW`].
+pub const MANY_FEET: usize = 3;
+/// QnA window of a varied clip on [`MANY_FEET`] feet or more, meant at 30 fps: 47 frames, 1.57 s.
+pub const MANY_FEET_WINDOW: usize = 11;
 
 /// What the rule reads from a clip before training.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,6 +63,8 @@ pub struct ClipReading {
     /// The clip's own intra diversity ([`sinmdm_eval::intra_diversity`] over
     /// [`sinmdm_eval::LOCAL_WINDOW`]-frame windows of its metric features).
     pub intra_diversity: f64,
+    /// Its feet: the contact joints its layout found (or the configuration named).
+    pub feet: usize,
 }
 
 impl ClipReading {
@@ -65,7 +77,13 @@ impl ClipReading {
             frames: data.facts.frames,
             fps: layout.fps,
             intra_diversity: sinmdm_eval::intra_diversity(rows.view(), sinmdm_eval::LOCAL_WINDOW),
+            feet: layout.contact_joints.len(),
         }
+    }
+
+    /// Whether the clip stands on [`MANY_FEET`] feet or more.
+    pub fn has_many_feet(&self) -> bool {
+        self.feet >= MANY_FEET
     }
 
     /// Whether the clip is calm ([`CALM_INTRA_BELOW`]).
@@ -160,25 +178,58 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
             config.model.window
         ),
         (true, false) => {
-            let mut wider = config.model.clone();
-            wider.window = wider.window.max(VARIED_WINDOW);
-            let field = wider.at_fps(reading.fps).receptive_field();
-            if field <= reading.frames {
-                out.model.window = wider.window;
-                format!(
-                    "window          {}{}: a wider field smooths a varied clip's samples",
-                    wider.window,
-                    if config.model.window_follows_fps {
-                        " at 30 fps"
-                    } else {
-                        ""
-                    }
+            let (wanted, why) = if reading.has_many_feet() {
+                (
+                    MANY_FEET_WINDOW,
+                    format!(
+                        "on {} feet, a varied clip needs a wide field to keep its legs in step",
+                        reading.feet
+                    ),
                 )
             } else {
-                format!(
-                    "window          {} (the configuration's): the clip's {} frames are fewer than the {field} a wider window sees",
-                    config.model.window, reading.frames
+                (
+                    VARIED_WINDOW,
+                    "a wider field smooths a varied clip's samples".to_string(),
                 )
+            };
+            let at_30 = if config.model.window_follows_fps {
+                " at 30 fps"
+            } else {
+                ""
+            };
+            // The widest of the wanted windows that the clip is long enough for; never narrower
+            // than the configuration's.
+            let fits = |window: usize| {
+                let mut model = config.model.clone();
+                model.window = window;
+                model.at_fps(reading.fps).receptive_field() <= reading.frames
+            };
+            let wanted = wanted.max(config.model.window);
+            match [wanted, VARIED_WINDOW.max(config.model.window)]
+                .into_iter()
+                .find(|&w| fits(w))
+            {
+                Some(window) if window == wanted => {
+                    out.model.window = window;
+                    format!("window          {window}{at_30}: {why}")
+                }
+                Some(window) => {
+                    out.model.window = window;
+                    format!(
+                        "window          {window}{at_30}: the clip's {} frames are too few for window {wanted} ({why})",
+                        reading.frames
+                    )
+                }
+                None => {
+                    let mut wider = config.model.clone();
+                    wider.window = VARIED_WINDOW.max(config.model.window);
+                    format!(
+                        "window          {} (the configuration's): the clip's {} frames are fewer than the {} a wider window sees",
+                        config.model.window,
+                        reading.frames,
+                        wider.at_fps(reading.fps).receptive_field()
+                    )
+                }
             }
         }
     });
@@ -187,6 +238,10 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
         (true, true) => format!(
             "dropout         {} (the configuration's): the rule raises only a varied clip's",
             config.model.dropout
+        ),
+        (true, false) if reading.has_many_feet() => format!(
+            "dropout         {} (the configuration's): on {} feet, more dropout costs a varied clip coverage",
+            config.model.dropout, reading.feet
         ),
         (true, false) => {
             out.model.dropout = VARIED_DROPOUT;
@@ -225,6 +280,7 @@ mod tests {
             frames: 300,
             fps: 30.0,
             intra_diversity,
+            feet: 2,
         }
     }
 
@@ -306,6 +362,55 @@ mod tests {
         let mut wide = config.clone();
         wide.model.window = 7;
         assert_eq!(choose(&wide, reading(0.9)).config.model.window, 7);
+    }
+
+    #[test]
+    fn a_varied_clip_on_many_feet_trains_the_wide_window_with_the_configuration_dropout() {
+        let config = TrainConfig::parse(DEFAULT).unwrap();
+        let dog = ClipReading {
+            feet: 4,
+            ..reading(0.8)
+        };
+        let choice = choose(&config, dog);
+        let out = &choice.config;
+        assert_eq!(out.model.window, MANY_FEET_WINDOW);
+        assert_eq!(out.model.dropout, config.model.dropout);
+        assert_eq!(out.training.steps, config.training.steps);
+        assert!(
+            choice.lines[2].contains("on 4 feet") && choice.lines[3].contains("on 4 feet"),
+            "{:?}",
+            choice.lines
+        );
+        out.validate().unwrap();
+        // Two feet, or three: the boundary.
+        let biped = ClipReading { feet: 2, ..dog };
+        assert_eq!(choose(&config, biped).config.model.window, VARIED_WINDOW);
+        let three = ClipReading { feet: 3, ..dog };
+        assert_eq!(choose(&config, three).config.model.window, MANY_FEET_WINDOW);
+        // A calm clip on four feet (the fox) is left to the ladder, with the configuration's
+        // window.
+        let fox = ClipReading {
+            feet: 4,
+            ..reading(0.2)
+        };
+        let calm = choose(&config, fox);
+        assert!(calm.climb_ladder);
+        assert_eq!(calm.config.model.window, config.model.window);
+        // Window 11 sees 47 frames at 30 fps: a shorter clip gets window 5 (29 frames), and one
+        // shorter still the configuration's.
+        let short = ClipReading { frames: 46, ..dog };
+        let choice = choose(&config, short);
+        assert_eq!(choice.config.model.window, VARIED_WINDOW);
+        assert!(
+            choice.lines[2].contains("too few for window 11"),
+            "{:?}",
+            choice.lines
+        );
+        let shorter = ClipReading { frames: 28, ..dog };
+        assert_eq!(
+            choose(&config, shorter).config.model.window,
+            config.model.window
+        );
     }
 
     #[test]
