@@ -35,11 +35,11 @@ def grouped(n: int) -> str:
 
 
 def kept_parts(old: str) -> tuple[str, str]:
-    """The clip row and the hand-written sections (every one before "## Evaluation") of the old
-    card."""
+    """The clip row and the hand-written sections (every one before "## Evaluation" but the step
+    ladder's, which is written anew) of the old card."""
     clip = next((line for line in old.splitlines() if line.startswith("| clip |")), "")
     about = ""
-    match = re.search(r"^## (?!Evaluation).*?(?=^## Evaluation)", old, flags=re.S | re.M)
+    match = re.search(r"^## (?!Evaluation|Step ladder).*?(?=^## Evaluation)", old, flags=re.S | re.M)
     if match:
         about = match.group(0).strip() + "\n\n"
     return clip, about
@@ -59,6 +59,37 @@ def frames_seen(t: dict, state: dict) -> str:
     if t.get("frames_per_step"):
         return f"{t['frames_per_step']} frames per step ({seen})"
     return f"batch of {seen}"
+
+
+def ladder_rungs(run: pathlib.Path) -> list[dict]:
+    """The step ladder's rungs of a calm clip's run (step_ladder/steps-N/check.json), fewest
+    steps first; none for a varied clip's run."""
+    checks = [json.loads(p.read_text()) for p in (run / "step_ladder").glob("steps-*/check.json")]
+    return sorted(checks, key=lambda c: c["steps"])
+
+
+def ladder_section(rungs: list[dict], chosen: int) -> list[str]:
+    """The card's table of the step ladder: each rung's samples as the trainer scored them."""
+    if not rungs:
+        return []
+    text = [
+        "## Step ladder",
+        "",
+        "The clip is calm, so the trainer chose its steps by the samples of short runs (the step "
+        "ladder: docs/TRAINING_EXPERIMENTS.md, *The step ladder*; 20 samples of twice the clip, "
+        f"seed 1, default sampling). It trained the {chosen}-step rung:",
+        "",
+        "| rung | coverage | replay (s) | jitter x clip | global diversity | train + check (s) |",
+        "|---|---|---|---|---|---|",
+    ]
+    for r in rungs:
+        mark = " (chosen)" if r["steps"] == chosen else ""
+        text.append(
+            f"| {r['steps']}{mark} | {r['coverage']:.1f} | {r['replay_seconds']:.2f} | "
+            f"{r['jitter_ratio']:.2f} | {r['global_diversity']:.3f} | "
+            f"{r['train_seconds']:.0f} + {r['check_seconds']:.0f} |"
+        )
+    return text + [""]
 
 
 def evaluation(name: str, clip: str, model: pathlib.Path) -> list[str]:
@@ -116,14 +147,24 @@ def main() -> None:
     extra_args = " --fps clip" if d["fps"] is None else ""
     if d.get("root_layout", "world") != "world":
         extra_args += f" --root-layout {d['root_layout']}"
+    rungs = ladder_rungs(run)
+    elapsed = state["elapsed_seconds"]
+    ladder_seconds = sum(r["train_seconds"] + r["check_seconds"] for r in rungs)
+    if rungs:
+        total = elapsed + ladder_seconds
+        timing = (
+            f"{total:.0f} s ({total / 60:.1f} min: the step ladder's {len(rungs)} rungs "
+            f"{ladder_seconds:.0f} s, then the run {elapsed:.0f} s)"
+        )
+    else:
+        timing = f"{elapsed:.0f} s ({elapsed / 60:.1f} min)"
     rows = [
         ("clip", clip_row.split("|")[2].strip() if clip_row else f"`{clip}`"),
         ("config", config_row),
         ("steps", grouped(state["step"])),
         (
             "training time",
-            f"{state['elapsed_seconds']:.0f} s ({state['elapsed_seconds'] / 60:.1f} min) on a "
-            "2-core AMD EPYC virtual machine, no other training running",
+            f"{timing} on a 2-core AMD EPYC virtual machine, no other training running",
         ),
         ("loss", f"last step {state['loss']:.4f}, mean of the last {min(100, state['step'])} steps {state['recent_loss']:.4f}"),
         (
@@ -138,6 +179,7 @@ def main() -> None:
         "",
         f"Made with `sinmdm-train {clip} --out runs/{name}{extra_args} --export onnx-models/{name}.onnx`.",
         "",
+        *ladder_section(rungs, state["step"]),
         *([about.rstrip(), ""] if about.strip() else []),
         *evaluation(name, clip, model),
     ]

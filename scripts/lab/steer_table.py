@@ -72,8 +72,16 @@ def main() -> None:
         print("| course | root to path, mean / worst (heights) | facing against travel, median / "
               "share over 45 degrees | coverage | jitter x clip (planted) | skating (planted) |")
         print("|---|---|---|---|---|---|")
+        texts = []
         for name, extra in courses:
-            print(row(name, evaluate(model, clip, extra)), flush=True)
+            texts.append(evaluate(model, clip, extra))
+            print(row(name, texts[-1]), flush=True)
+        # How closely the velocity schedule was followed, over the samples' 2-second windows.
+        speed_off = [int(m) for m in re.findall(r"speed off by at most (\d+) %", texts[-1])]
+        turn_off = [int(m) for m in re.findall(r"turn by at most (\d+) %", texts[-1])]
+        if speed_off and turn_off:
+            print(f"\nvelocity schedule, worst 2-second window per sample: speed off by "
+                  f"{min(speed_off)}-{max(speed_off)} %, turn by {min(turn_off)}-{max(turn_off)} %")
 
 
 if __name__ == "__main__":
