@@ -22,15 +22,21 @@ pub fn fingerprint(clip_bytes: &[u8], entry: &ClipEntry, config_text: &str) -> S
         config: None,
         ..entry.clone()
     };
-    let mut hash = Sha256::new();
-    for part in [
+    sha256_of_parts(&[
         CODE_VERSION.as_bytes(),
         &Sha256::digest(clip_bytes),
         serde_json::to_string(&settings)
             .unwrap_or_default()
             .as_bytes(),
         config_text.as_bytes(),
-    ] {
+    ])
+}
+
+/// SHA-256 (hex) over `parts`, each preceded by its length (so that moving bytes from one part
+/// to the next changes the hash): what the project's fingerprints are made of.
+pub fn sha256_of_parts(parts: &[&[u8]]) -> String {
+    let mut hash = Sha256::new();
+    for part in parts {
         hash.update((part.len() as u64).to_le_bytes());
         hash.update(part);
     }

@@ -199,15 +199,16 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
             };
             // The widest of the wanted windows that the clip is long enough for; never narrower
             // than the configuration's.
-            let fits = |window: usize| {
+            let field = |window: usize| {
                 let mut model = config.model.clone();
                 model.window = window;
-                model.at_fps(reading.fps).receptive_field() <= reading.frames
+                model.at_fps(reading.fps).receptive_field()
             };
             let wanted = wanted.max(config.model.window);
-            match [wanted, VARIED_WINDOW.max(config.model.window)]
+            let fallback = VARIED_WINDOW.max(config.model.window);
+            match [wanted, fallback]
                 .into_iter()
-                .find(|&w| fits(w))
+                .find(|&w| field(w) <= reading.frames)
             {
                 Some(window) if window == wanted => {
                     out.model.window = window;
@@ -220,16 +221,12 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
                         reading.frames
                     )
                 }
-                None => {
-                    let mut wider = config.model.clone();
-                    wider.window = VARIED_WINDOW.max(config.model.window);
-                    format!(
-                        "window          {} (the configuration's): the clip's {} frames are fewer than the {} a wider window sees",
-                        config.model.window,
-                        reading.frames,
-                        wider.at_fps(reading.fps).receptive_field()
-                    )
-                }
+                None => format!(
+                    "window          {} (the configuration's): the clip's {} frames are fewer than the {} a wider window sees",
+                    config.model.window,
+                    reading.frames,
+                    field(fallback)
+                ),
             }
         }
     });

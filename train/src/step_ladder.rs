@@ -228,18 +228,13 @@ impl Ladder {
     pub fn rung_fingerprint(&self, clip_sha256: &str, config: &TrainConfig, steps: u64) -> String {
         let rung = serde_json::to_string(&Self::rung_config(config, steps))
             .expect("a configuration serialises");
-        let parts = [
-            env!("CARGO_PKG_VERSION").to_string(),
-            clip_sha256.to_string(),
-            rung,
-            format!("{} samples, seed {}", self.samples, self.seed),
-        ];
-        let mut text = Vec::new();
-        for part in &parts {
-            text.extend_from_slice(&(part.len() as u64).to_le_bytes());
-            text.extend_from_slice(part.as_bytes());
-        }
-        crate::clip_data::sha256_hex(&text)
+        let check = format!("{} samples, seed {}", self.samples, self.seed);
+        sinmdm_library::fingerprint::sha256_of_parts(&[
+            env!("CARGO_PKG_VERSION").as_bytes(),
+            clip_sha256.as_bytes(),
+            rung.as_bytes(),
+            check.as_bytes(),
+        ])
     }
 
     /// Trains one rung into `dir` (anything a killed rung left there is replaced), exports it
