@@ -139,7 +139,7 @@ def main() -> None:
         f"{m['window']}, dropout {m['dropout']}, cosine learning rate "
         f"from {t['learning_rate']:g} after {t['warmup_steps']} warm-up steps, weight average "
         f"{t.get('ema_decay')}, {frames_seen(t, state)}, {fps}, seed {t['seed']}; the step count, "
-        "window and dropout as the default's `from_clip` rule chose them from the clip)"
+        "window, dropout and channels as the default's `from_clip` rule chose them from the clip)"
     )
     if d.get("root_layout", "world") != "world":
         config_row += f", with the {d['root_layout']} root layout"

@@ -18,8 +18,12 @@ LADDER_STEPS = [50, 75, 100, 150, 200, 250, 300, 400, 600, 1000]
 VARIED_WINDOW = 5
 VARIED_DROPOUT = 0.5
 MANY_FEET = 3
-MANY_FEET_WINDOW = 11
+MANY_FEET_WINDOW = 7
+MANY_FEET_CHANNELS = 96
+MANY_FEET_STEPS = 13000
 DEFAULT_DROPOUT = 0.2
+DEFAULT_CHANNELS = 64
+DEFAULT_STEPS = 17000
 
 
 def numpy_intra_diversity(raw, columns):
@@ -49,6 +53,9 @@ def test_the_default_reads_the_clip_as_numpy_does(clip, tmp_path, sinmdm):
     assert found.group(1) == ("calm" if calm else "varied"), out
     window = re.search(r"receptive field \d+ frames \(QnA window (\d+)\)", out)
     steps = re.search(r"^steps +(?:up to )?(\d+) \(batch", out, re.M)
+    channels = re.search(r"^channels C +(\d+)$", out, re.M)
+    # The window is the rule's, chosen from the clip: no hint second-guesses it.
+    assert "hint" not in out, out
     if calm:
         # A calm clip's steps are chosen when training starts, by the step ladder: the dry run
         # names its rungs and trains none of them.
@@ -57,13 +64,17 @@ def test_the_default_reads_the_clip_as_numpy_does(clip, tmp_path, sinmdm):
         assert f"short runs of {rungs} steps" in out, out
         assert int(steps.group(1)) == LADDER_STEPS[-1], out
         assert window.group(1) == "3", out
+        assert int(channels.group(1)) == DEFAULT_CHANNELS, out
     else:
         # The feet are the clip's contact labels, one column each in the features.
         feet = sum(c.endswith(".contact") for c in doc["columns"])
-        assert int(steps.group(1)) == 17000, out
         if feet >= MANY_FEET:
             assert window.group(1) == str(MANY_FEET_WINDOW), out
+            assert int(channels.group(1)) == MANY_FEET_CHANNELS, out
+            assert int(steps.group(1)) == MANY_FEET_STEPS, out
             assert f"dropout         {DEFAULT_DROPOUT} (the configuration's): on {feet} feet" in out, out
         else:
             assert window.group(1) == str(VARIED_WINDOW), out
+            assert int(channels.group(1)) == DEFAULT_CHANNELS, out
+            assert int(steps.group(1)) == DEFAULT_STEPS, out
             assert f"dropout         {VARIED_DROPOUT}" in out, out

@@ -17,8 +17,11 @@
 //!     ([`VARIED_DROPOUT`]) that keeps them varied;
 //!   - on [`MANY_FEET`] feet or more (a dog, a horse, a fox), its samples at a window that serves
 //!     a biped keep too little of the clip (a fifth of a dog's one-second windows are never
-//!     made): the legs' phases must hold over a longer span. It trains the wide window
-//!     [`MANY_FEET_WINDOW`] with the configuration's dropout (more dropout costs it coverage).
+//!     made): the legs' phases must hold over a longer span, and the network needs the width to
+//!     hold four legs' phases at once. It trains the wider window [`MANY_FEET_WINDOW`] with
+//!     [`MANY_FEET_CHANNELS`] channels and the configuration's dropout (more dropout costs it
+//!     coverage), for [`MANY_FEET_STEPS`] steps, which the wider network's steps fit in the
+//!     time 17 000 of the configuration's take.
 //!
 //! The measure is the benchmark's intra diversity ([`sinmdm_eval::intra_diversity`]): the mean
 //! distance, per frame, between two 15-frame windows of the clip's joint rotations and contact
@@ -48,10 +51,18 @@ pub fn calm_most_steps() -> u64 {
 pub const VARIED_WINDOW: usize = 5;
 /// Dropout of a varied clip on two feet or fewer.
 pub const VARIED_DROPOUT: f64 = 0.5;
-/// The feet (contact joints) from which a varied clip trains [`MANY_FEET_WINDOW`].
+/// The feet (contact joints) from which a varied clip trains [`MANY_FEET_WINDOW`] and
+/// [`MANY_FEET_CHANNELS`].
 pub const MANY_FEET: usize = 3;
-/// QnA window of a varied clip on [`MANY_FEET`] feet or more, meant at 30 fps: 47 frames, 1.57 s.
-pub const MANY_FEET_WINDOW: usize = 11;
+/// QnA window of a varied clip on [`MANY_FEET`] feet or more, meant at 30 fps: 35 frames, 1.17 s.
+pub const MANY_FEET_WINDOW: usize = 7;
+/// Channels of a varied clip on [`MANY_FEET`] feet or more (never fewer than the
+/// configuration's).
+pub const MANY_FEET_CHANNELS: usize = 96;
+/// Steps of a varied clip on [`MANY_FEET`] feet or more whose channels the rule widened (at most
+/// the configuration's): a step of 96 channels at window 7 costs about 0.04 s on 2 cores, so the
+/// run takes what 17 000 steps of 64 channels at window 11 took (8.5-9 minutes).
+pub const MANY_FEET_STEPS: u64 = 13_000;
 
 /// What the rule reads from a clip before training.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -151,6 +162,12 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
     let mut lines = Vec::new();
     lines.push(format!("clip            {kind}"));
     let kept = "the configuration's; from_clip does not ask for it";
+    // A varied clip on many feet trains a wider network, if asked and if the heads divide it.
+    let widen = !calm
+        && reading.has_many_feet()
+        && asked.channels
+        && config.model.channels < MANY_FEET_CHANNELS
+        && MANY_FEET_CHANNELS.is_multiple_of(config.model.heads);
     lines.push(match (asked.steps, calm) {
         (false, _) => format!("steps           {} ({kept})", config.training.steps),
         (true, true) => {
@@ -164,6 +181,13 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
                 crate::ladder_settings::goals::COVERAGE,
                 crate::ladder_settings::goals::REPLAY_SECONDS,
                 crate::ladder_settings::goals::JITTER_RATIO,
+            )
+        }
+        (true, false) if widen && config.training.steps > MANY_FEET_STEPS => {
+            out.training.steps = MANY_FEET_STEPS;
+            format!(
+                "steps           {MANY_FEET_STEPS}: the {MANY_FEET_CHANNELS} channels below cost more a step, and this many fit the time {} steps of {} channels take",
+                config.training.steps, config.model.channels
             )
         }
         (true, false) => format!(
@@ -182,7 +206,7 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
                 (
                     MANY_FEET_WINDOW,
                     format!(
-                        "on {} feet, a varied clip needs a wide field to keep its legs in step",
+                        "on {} feet, a varied clip needs a wider field to keep its legs in step",
                         reading.feet
                     ),
                 )
@@ -247,6 +271,28 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
             )
         }
     });
+    lines.push(match (asked.channels, calm) {
+        (false, _) => format!("channels        {} ({kept})", config.model.channels),
+        (true, true) => format!(
+            "channels        {} (the configuration's): the rule widens only a varied clip's network",
+            config.model.channels
+        ),
+        (true, false) if widen => {
+            out.model.channels = MANY_FEET_CHANNELS;
+            format!(
+                "channels        {MANY_FEET_CHANNELS}: on {} feet, the network needs the width to hold every leg's phase at once",
+                reading.feet
+            )
+        }
+        (true, false) if reading.has_many_feet() => format!(
+            "channels        {} (the configuration's): at least {MANY_FEET_CHANNELS}, or {} heads do not divide {MANY_FEET_CHANNELS}",
+            config.model.channels, config.model.heads
+        ),
+        (true, false) => format!(
+            "channels        {} (the configuration's): on {} feet, the configuration's width serves",
+            config.model.channels, reading.feet
+        ),
+    });
     RuleChoice {
         reading,
         config: out,
@@ -288,6 +334,7 @@ mod tests {
             steps: true,
             window: true,
             dropout: true,
+            channels: true,
         };
         assert_eq!(config.from_clip, all);
         // A configuration without the section trains its numbers as written.
@@ -347,6 +394,7 @@ mod tests {
             assert_eq!(out.training.warmup_steps, config.training.warmup_steps);
             assert_eq!(out.model.window, VARIED_WINDOW);
             assert_eq!(out.model.dropout, VARIED_DROPOUT);
+            assert_eq!(out.model.channels, config.model.channels, "two feet");
             assert!(
                 out.model.window_follows_fps,
                 "the window still follows the frame rate"
@@ -362,7 +410,7 @@ mod tests {
     }
 
     #[test]
-    fn a_varied_clip_on_many_feet_trains_the_wide_window_with_the_configuration_dropout() {
+    fn a_varied_clip_on_many_feet_trains_a_wider_network_for_fewer_steps() {
         let config = TrainConfig::parse(DEFAULT).unwrap();
         let dog = ClipReading {
             feet: 4,
@@ -371,14 +419,42 @@ mod tests {
         let choice = choose(&config, dog);
         let out = &choice.config;
         assert_eq!(out.model.window, MANY_FEET_WINDOW);
+        assert_eq!(out.model.channels, MANY_FEET_CHANNELS);
         assert_eq!(out.model.dropout, config.model.dropout);
-        assert_eq!(out.training.steps, config.training.steps);
+        assert_eq!(out.training.steps, MANY_FEET_STEPS);
+        assert!(MANY_FEET_STEPS < config.training.steps);
+        assert_eq!(out.training.warmup_steps, config.training.warmup_steps);
         assert!(
-            choice.lines[2].contains("on 4 feet") && choice.lines[3].contains("on 4 feet"),
+            choice.lines[1].contains("13000: the 96 channels below cost more a step")
+                && choice.lines[2].contains("on 4 feet")
+                && choice.lines[3].contains("on 4 feet")
+                && choice.lines[4].starts_with("channels        96: on 4 feet"),
             "{:?}",
             choice.lines
         );
         out.validate().unwrap();
+        // A configuration already as wide, or with fewer steps, keeps its numbers; heads that do
+        // not divide the wider width keep the configuration's width and steps.
+        let mut wide = config.clone();
+        wide.model.channels = 128;
+        let kept = choose(&wide, dog).config;
+        assert_eq!((kept.model.channels, kept.training.steps), (128, 17_000));
+        let mut short = config.clone();
+        short.training.steps = 5_000;
+        assert_eq!(choose(&short, dog).config.training.steps, 5_000);
+        let mut odd_heads = config.clone();
+        odd_heads.model.heads = 64;
+        odd_heads.validate().unwrap();
+        let kept = choose(&odd_heads, dog);
+        assert_eq!(
+            (kept.config.model.channels, kept.config.training.steps),
+            (64, 17_000)
+        );
+        assert!(
+            kept.lines[4].contains("64 heads do not divide 96"),
+            "{:?}",
+            kept.lines
+        );
         // Two feet, or three: the boundary.
         let biped = ClipReading { feet: 2, ..dog };
         assert_eq!(choose(&config, biped).config.model.window, VARIED_WINDOW);
@@ -393,13 +469,13 @@ mod tests {
         let calm = choose(&config, fox);
         assert!(calm.climb_ladder);
         assert_eq!(calm.config.model.window, config.model.window);
-        // Window 11 sees 47 frames at 30 fps: a shorter clip gets window 5 (29 frames), and one
+        // Window 7 sees 35 frames at 30 fps: a shorter clip gets window 5 (29 frames), and one
         // shorter still the configuration's.
-        let short = ClipReading { frames: 46, ..dog };
+        let short = ClipReading { frames: 34, ..dog };
         let choice = choose(&config, short);
         assert_eq!(choice.config.model.window, VARIED_WINDOW);
         assert!(
-            choice.lines[2].contains("too few for window 11"),
+            choice.lines[2].contains("too few for window 7"),
             "{:?}",
             choice.lines
         );
@@ -415,9 +491,20 @@ mod tests {
         let mut config = TrainConfig::parse(DEFAULT).unwrap();
         config.from_clip.window = false;
         config.from_clip.dropout = false;
+        config.from_clip.channels = false;
         let varied = choose(&config, reading(0.9));
         assert_eq!(varied.config.model.window, config.model.window);
         assert_eq!(varied.config.model.dropout, config.model.dropout);
+        // Not asked for the channels, a dog keeps the configuration's width and steps.
+        let dog = choose(
+            &config,
+            ClipReading {
+                feet: 4,
+                ..reading(0.9)
+            },
+        );
+        assert_eq!(dog.config.model.channels, config.model.channels);
+        assert_eq!(dog.config.training.steps, config.training.steps);
         assert!(
             varied
                 .lines

@@ -156,6 +156,16 @@ pub enum Climb {
     Interrupted,
 }
 
+/// The clip a ladder climbs on: its file, and the SHA-256 (hex) of its bytes as [`ClipData`]
+/// holds it, which goes into each rung's fingerprint.
+#[derive(Debug, Clone, Copy)]
+pub struct LadderClip<'a> {
+    /// The clip's file.
+    pub path: &'a Path,
+    /// SHA-256 of the file's bytes, in hex.
+    pub sha256: &'a str,
+}
+
 impl Ladder {
     /// Trains and scores the rungs of the ladder on `clip` with `config` (its steps and warm-up
     /// replaced by each rung's), in `folder`: the most-trained rung first, and the others, fewest
@@ -165,7 +175,7 @@ impl Ladder {
     /// come back sorted by their steps.
     pub fn climb(
         &self,
-        clip: &Path,
+        clip: LadderClip<'_>,
         config: &TrainConfig,
         folder: &Path,
         device: &Device,
@@ -178,23 +188,16 @@ impl Ladder {
         if let Some(most) = order.pop() {
             order.insert(0, most);
         }
-        let clip_sha256 = crate::clip_data::sha256_hex(&std::fs::read(clip).map_err(|source| {
-            TrainError::Io {
-                what: "read the clip",
-                path: clip.to_path_buf(),
-                source,
-            }
-        })?);
         let mut rungs: Vec<RungCheck> = Vec::with_capacity(order.len());
         for steps in order {
             if rungs.first().is_some_and(|most| !most.covers()) {
                 break;
             }
             let dir = folder.join(format!("steps-{steps}"));
-            let made_from = self.rung_fingerprint(&clip_sha256, config, steps);
+            let made_from = self.rung_fingerprint(clip.sha256, config, steps);
             let check = match read_check(&dir, steps, &made_from) {
                 Some(check) => check,
-                None => match self.train_rung(clip, config, steps, &dir, device, stop)? {
+                None => match self.train_rung(clip.path, config, steps, &dir, device, stop)? {
                     Some(check) => {
                         let check = RungCheck { made_from, ..check };
                         write_check(&dir, &check)?;
@@ -347,9 +350,20 @@ pub fn start_run(
     let data = ClipData::load(clip, &config.data, &config.model)?;
     let choice = match crate::clip_rule::apply(&config, &data) {
         Some(choice) if choice.climb_ladder => choice,
-        _ => return Trainer::start(clip, config, run, device).map(Some),
+        _ => return Trainer::start_loaded(clip, data, config, run, device).map(Some),
     };
-    let rungs = match ladder.climb(clip, &choice.config, &folder(run), &device, stop, on_rung)? {
+    let on_clip = LadderClip {
+        path: clip,
+        sha256: &data.facts.sha256,
+    };
+    let rungs = match ladder.climb(
+        on_clip,
+        &choice.config,
+        &folder(run),
+        &device,
+        stop,
+        on_rung,
+    )? {
         Climb::Done(rungs) => rungs,
         Climb::Interrupted => return Ok(None),
     };
@@ -387,8 +401,8 @@ pub fn start_run(
     };
     lines.push("step ladder (each rung's samples, scored):".into());
     lines.extend(rungs.iter().map(|r| format!("  {}", r.line())));
-    let mut trainer = Trainer::start(clip, chosen, run, device)?;
-    trainer.set_rule_lines(lines);
+    let mut trainer = Trainer::start_loaded(clip, data, chosen, run, device)?;
+    trainer.set_rule(lines, config.from_clip.window);
     Ok(Some(trainer))
 }
 

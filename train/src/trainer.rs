@@ -57,6 +57,8 @@ pub struct Trainer {
     injected_faults: BTreeSet<u64>,
     /// What the rule that reads the clip chose for a new run, a line per setting.
     rule: Option<Vec<String>>,
+    /// Whether that rule chose the QnA window from the clip (so no hint second-guesses it).
+    rule_chose_window: bool,
 }
 
 /// A new network, its weight average and optimiser for `config`, drawn from the run's seed.
@@ -135,6 +137,7 @@ impl Trainer {
             last_checkpoint,
             injected_faults: BTreeSet::new(),
             rule: None,
+            rule_chose_window: false,
         }
     }
 
@@ -159,10 +162,24 @@ impl Trainer {
     ) -> Result<Trainer, TrainError> {
         Trainer::check_new_run(run)?;
         let data = ClipData::load(clip, &config.data, &config.model)?;
+        Trainer::start_loaded(clip, data, config, run, device)
+    }
+
+    /// [`Trainer::start`] for a clip already read: `data` is `clip` as [`ClipData::load`] read
+    /// it with `config`'s data section.
+    pub fn start_loaded(
+        clip: &Path,
+        data: ClipData,
+        config: TrainConfig,
+        run: &Path,
+        device: Device,
+    ) -> Result<Trainer, TrainError> {
+        Trainer::check_new_run(run)?;
         // The run saves the numbers it trains: what the rule that reads the clip chose, a
         // window that follows the frame rate and a root layout chosen from the clip, resolved.
         // (The steps of a calm clip are left to the step ladder, which `step_ladder::start_run`
         // climbs before it calls this; called directly, a calm clip trains the ladder's most.)
+        let rule_chose_window = config.from_clip.window;
         let (config, rule) = match crate::clip_rule::apply(&config, &data) {
             Some(choice) => (choice.config, Some(choice.lines)),
             None => (config, None),
@@ -195,6 +212,7 @@ impl Trainer {
         };
         let parts = (model, average, optimizer);
         let mut trainer = Trainer::assemble(run, device, parts, data, state, log, None);
+        trainer.rule_chose_window = rule_chose_window && rule.is_some();
         trainer.rule = rule;
         Ok(trainer)
     }
@@ -228,6 +246,9 @@ impl Trainer {
             }
             if rule.dropout {
                 asked.model.dropout = saved.model.dropout;
+            }
+            if rule.channels {
+                asked.model.channels = saved.model.channels;
             }
             asked.from_clip = crate::config::FromClip::default();
             let mut asked = asked.at_fps(state.clip.layout.fps);
@@ -301,8 +322,12 @@ impl Trainer {
     }
 
     /// A line for the user when the clip's motion stays correlated for much longer than the
-    /// network sees at once ([`crate::motion_span::wider_window_hint`]).
+    /// network sees at once ([`crate::motion_span::wider_window_hint`]); none when the rule that
+    /// reads the clip chose the window.
     pub fn wider_window_hint(&self) -> Option<String> {
+        if self.rule_chose_window {
+            return None;
+        }
         let fps = self.clip.facts.layout.fps;
         let frames = crate::motion_span::decorrelation_frames(self.clip.features.view(), fps)?;
         crate::motion_span::wider_window_hint(frames, fps, &self.state.config.model)
@@ -314,9 +339,11 @@ impl Trainer {
         self.rule.as_deref()
     }
 
-    /// Replaces the rule's lines (the step ladder's choice, made before this run started).
-    pub(crate) fn set_rule_lines(&mut self, lines: Vec<String>) {
+    /// Replaces the rule's lines (the step ladder's choice, made before this run started);
+    /// `chose_window` says whether the rule chose the QnA window.
+    pub(crate) fn set_rule(&mut self, lines: Vec<String>, chose_window: bool) {
         self.rule = Some(lines);
+        self.rule_chose_window = chose_window;
     }
 
     /// Whether all configured steps are done.

@@ -236,6 +236,7 @@ fn dry_run(args: &Args) -> Result<()> {
     };
     let config = new_run_config(args)?;
     let data = ClipData::load(clip, &config.data, &config.model)?;
+    let rule_chose_window = config.from_clip.window;
     let (config, rule, ladder) = match clip_rule::apply(&config, &data) {
         Some(choice) => (choice.config, Some(choice.lines), choice.climb_ladder),
         None => (config, None, false),
@@ -277,7 +278,11 @@ fn dry_run(args: &Args) -> Result<()> {
                 "motion span     {:.2} s (the lag at which the features' autocorrelation first falls below zero)",
                 frames as f64 / fps
             );
-            if let Some(hint) = motion_span::wider_window_hint(frames, fps, &config.model) {
+            // The rule's window is chosen from the clip; a hint would second-guess it.
+            let hint = (!(rule_chose_window && rule.is_some()))
+                .then(|| motion_span::wider_window_hint(frames, fps, &config.model))
+                .flatten();
+            if let Some(hint) = hint {
                 println!("hint            {hint}");
             }
         }

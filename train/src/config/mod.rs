@@ -224,12 +224,15 @@ pub struct FromClip {
     /// `model.dropout`.
     #[serde(default)]
     pub dropout: bool,
+    /// `model.channels`.
+    #[serde(default)]
+    pub channels: bool,
 }
 
 impl FromClip {
     /// Whether the rule chooses nothing.
     pub fn is_off(&self) -> bool {
-        !(self.steps || self.window || self.dropout)
+        !(self.steps || self.window || self.dropout || self.channels)
     }
 }
 
