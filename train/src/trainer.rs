@@ -232,30 +232,7 @@ impl Trainer {
         })?;
         let mut state = checkpoint::load_state(&dir)?;
         if let Some(asked) = &config {
-            let mut asked = asked.clone();
-            // What the rule that reads the clip chose when the run started stands.
-            let rule = asked.from_clip;
-            let saved = &state.config;
-            if rule.steps {
-                asked.training.steps = saved.training.steps;
-                asked.training.warmup_steps = saved.training.warmup_steps;
-            }
-            if rule.window {
-                asked.model.window = saved.model.window;
-                asked.model.window_follows_fps = false;
-            }
-            if rule.dropout {
-                asked.model.dropout = saved.model.dropout;
-            }
-            if rule.channels {
-                asked.model.channels = saved.model.channels;
-            }
-            asked.from_clip = crate::config::FromClip::default();
-            let mut asked = asked.at_fps(state.clip.layout.fps);
-            // `auto` chose from this clip when the run started: the choice stands.
-            if asked.data.root_layout == sinmdm::motion::RootLayout::Auto {
-                asked.data.root_layout = state.config.data.root_layout;
-            }
+            let asked = asked.for_resume(&state.config, state.clip.layout.fps);
             if let Some(message) = state.config.resume_difference(&asked) {
                 return Err(TrainError::Checkpoint { path: dir, message });
             }

@@ -237,6 +237,35 @@ impl FromClip {
 }
 
 impl TrainConfig {
+    /// The configuration `self` asks a run that started as `saved` (on a clip trained at `fps`)
+    /// to continue with: what the rule that reads the clip chose when the run started stands in
+    /// for every part `self.from_clip` leaves to the rule, and so does the root layout `auto`
+    /// chose. Compare it with `saved` by [`TrainConfig::resume_difference`].
+    pub fn for_resume(&self, saved: &TrainConfig, fps: f64) -> TrainConfig {
+        let mut asked = self.clone();
+        let rule = asked.from_clip;
+        if rule.steps {
+            asked.training.steps = saved.training.steps;
+            asked.training.warmup_steps = saved.training.warmup_steps;
+        }
+        if rule.window {
+            asked.model.window = saved.model.window;
+            asked.model.window_follows_fps = false;
+        }
+        if rule.dropout {
+            asked.model.dropout = saved.model.dropout;
+        }
+        if rule.channels {
+            asked.model.channels = saved.model.channels;
+        }
+        asked.from_clip = FromClip::default();
+        let mut asked = asked.at_fps(fps);
+        if asked.data.root_layout == sinmdm::motion::RootLayout::Auto {
+            asked.data.root_layout = saved.data.root_layout;
+        }
+        asked
+    }
+
     /// The configuration as trained on a clip at `fps` ([`ModelConfig::at_fps`]).
     pub fn at_fps(&self, fps: f64) -> TrainConfig {
         TrainConfig {
@@ -369,6 +398,39 @@ mod tests {
         assert_eq!(paper.training.batch_size, 64);
         assert_eq!(paper.training.steps, 60_000);
         assert_eq!(paper.model.receptive_field(), 23);
+    }
+
+    #[test]
+    fn a_resume_with_the_default_keeps_what_the_rule_chose_for_a_dog() {
+        let default = TrainConfig::parse(include_str!("../../../configs/default.yaml")).unwrap();
+        // What a new run on a varied clip on four feet at 30 fps saved: the rule's window,
+        // channels and steps, the root layout auto chose.
+        let dog = crate::clip_rule::ClipReading {
+            frames: 527,
+            fps: 30.0,
+            intra_diversity: 0.77,
+            feet: 4,
+        };
+        let mut saved = crate::clip_rule::choose(&default, dog).config.at_fps(30.0);
+        saved.data.root_layout = sinmdm::motion::RootLayout::Heading;
+        assert_eq!(
+            (
+                saved.model.channels,
+                saved.model.window,
+                saved.training.steps
+            ),
+            (96, 7, 13_000)
+        );
+        let asked = default.for_resume(&saved, 30.0);
+        assert_eq!(saved.resume_difference(&asked), None);
+        // A configuration that does not leave the channels to the rule asks for 64: refused,
+        // naming the setting.
+        let mut fixed = default.clone();
+        fixed.from_clip.channels = false;
+        let message = saved
+            .resume_difference(&fixed.for_resume(&saved, 30.0))
+            .unwrap();
+        assert!(message.contains("model.channels = 96"), "{message}");
     }
 
     #[test]
