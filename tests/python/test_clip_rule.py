@@ -56,6 +56,16 @@ def test_the_default_reads_the_clip_as_numpy_does(clip, tmp_path, sinmdm):
     channels = re.search(r"^channels C +(\d+)$", out, re.M)
     # The window is the rule's, chosen from the clip: no hint second-guesses it.
     assert "hint" not in out, out
+    # The feet the rule reads are the clip's contact columns, and they are the feet of the
+    # animal the clip shows: two for a human, four for a dog or a fox (a running dog's nose and
+    # the tail a dog lies on are chain ends that touch the ground now and then, not feet).
+    feet_line = re.search(r"^feet +(\d+) \(([^)]*)\)", out, re.M)
+    assert feet_line, out
+    named = feet_line.group(2).split(", ")
+    contact = [c[: -len(".contact")] for c in doc["columns"] if c.endswith(".contact")]
+    assert sorted(named) == sorted(contact) and int(feet_line.group(1)) == len(contact), out
+    animal = clip.stem.split("_")[0]
+    assert len(contact) == {"human": 2, "dog": 4, "fox": 4}[animal], (clip.stem, contact)
     if calm:
         # A calm clip's steps are chosen when training starts, by the step ladder: the dry run
         # names its rungs and trains none of them.

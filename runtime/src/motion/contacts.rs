@@ -21,9 +21,10 @@ use super::up::{height_of, horizontal};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactConfig {
-    /// Joint names to label. `None` chooses automatically: the chain ends (joints without
-    /// child joints) whose contact point comes within `ground_fraction` of the skeleton height
-    /// of the lowest point of the whole clip.
+    /// Joint names to label. `None` chooses automatically ([`choose_contact_joints`]): the
+    /// chain ends (joints without child joints) whose contact point comes within
+    /// `ground_fraction` of the skeleton height of the frame's lowest point in at least
+    /// [`GROUND_SHARE`] of the frames.
     pub joints: Option<Vec<String>>,
     /// A joint is in contact while its speed is below this many skeleton heights per second.
     pub speed_threshold: f64,
@@ -41,29 +42,39 @@ impl Default for ContactConfig {
     }
 }
 
+/// The share of a clip's frames in which a chain end must be at the ground to be a contact
+/// joint. A foot carries the body in a third of the frames or more (a dog's paw at a run 0.33,
+/// a human's toe at a walk 0.5-0.97, an idle fox's paws all of them); a chain end that only
+/// touches the ground now and then does not (a running dog's nose 0.02, the tail of a dog that
+/// lies down for a second and then walks 0.13).
+pub const GROUND_SHARE: f64 = 0.25;
+
 /// The chain-end joints whose contact point comes within `ground_fraction * height` of the
-/// clip's lowest point.
+/// frame's lowest point (every joint and End Site) in at least [`GROUND_SHARE`] of the frames.
+/// Each frame is measured against its own lowest point, so a clip on uneven ground, or one that
+/// lies down on some frames, still finds the feet that carry it on the others.
 pub fn choose_contact_joints(
     skeleton: &Skeleton,
     poses: &[GlobalPose],
     height: f64,
     ground_fraction: f64,
 ) -> Vec<usize> {
-    let lowest_of = |joint: usize| {
-        poses
-            .iter()
-            .map(|p| height_of(p.contact_point(joint)))
-            .fold(f64::INFINITY, f64::min)
-    };
-    let ground = poses
-        .iter()
-        .flat_map(|p| p.points())
-        .map(height_of)
-        .fold(f64::INFINITY, f64::min);
-    skeleton
-        .leaves()
+    let leaves = skeleton.leaves();
+    let mut grounded = vec![0usize; leaves.len()];
+    for pose in poses {
+        let ground = pose.points().map(height_of).fold(f64::INFINITY, f64::min);
+        for (count, &leaf) in grounded.iter_mut().zip(&leaves) {
+            if height_of(pose.contact_point(leaf)) - ground <= ground_fraction * height {
+                *count += 1;
+            }
+        }
+    }
+    let needed = GROUND_SHARE * poses.len() as f64;
+    leaves
         .into_iter()
-        .filter(|&j| lowest_of(j) - ground <= ground_fraction * height)
+        .zip(grounded)
+        .filter(|&(_, count)| count > 0 && count as f64 >= needed)
+        .map(|(leaf, _)| leaf)
         .collect()
 }
 
@@ -319,9 +330,9 @@ mod tests {
         assert_eq!(joint_speeds(&positions, 10.0), vec![10.0, 15.0, 20.0]);
     }
 
-    #[test]
-    fn automatic_choice_takes_chain_ends_near_the_ground() {
-        use crate::motion::skeleton::{Joint, Skeleton};
+    /// A root with one chain end per name below it, joints at the origin.
+    fn star(ends: &[&str]) -> Skeleton {
+        use crate::motion::skeleton::Joint;
         let joint = |name: &str, parent| Joint {
             name: name.into(),
             parent,
@@ -329,19 +340,47 @@ mod tests {
             channels: vec![],
             end_site: None,
         };
+        let mut joints = vec![joint("root", None)];
+        joints.extend(ends.iter().map(|name| joint(name, Some(0))));
+        Skeleton { joints }
+    }
+
+    #[test]
+    fn automatic_choice_takes_chain_ends_near_the_ground() {
         // root -> foot (leaf, at the ground) and root -> hand (leaf, high up).
-        let skeleton = Skeleton {
-            joints: vec![
-                joint("root", None),
-                joint("foot", Some(0)),
-                joint("hand", Some(0)),
-            ],
-        };
+        let skeleton = star(&["foot", "hand"]);
         let poses = vec![pose(&[
             Vec3([0.0, 1.0, 0.0]),
             Vec3([0.0, 0.02, 0.0]),
             Vec3([0.0, 1.4, 0.0]),
         ])];
         assert_eq!(choose_contact_joints(&skeleton, &poses, 1.4, 0.05), vec![1]);
+    }
+
+    #[test]
+    fn feet_are_the_chain_ends_at_the_ground_in_a_quarter_of_the_frames() {
+        // A body with two paws, a nose and a tail. For 8 frames it stands on its paws; for 2
+        // it lies with its tail 0.1 under the paws' floor (a lower spot, or a tail end that
+        // sinks into it), and for 1 its nose touches the ground.
+        let skeleton = star(&["paw_a", "paw_b", "nose", "tail"]);
+        let at = |y: [f64; 5]| pose(&y.map(|y| Vec3([0.0, y, 0.0])));
+        let mut poses = vec![at([0.5, 0.0, 0.02, 0.4, 0.4]); 7];
+        poses.push(at([0.5, 0.0, 0.02, 0.0, 0.4]));
+        poses.extend(vec![at([0.15, 0.05, 0.05, 0.2, -0.1]); 2]);
+        // Against the clip's lowest point (the lying tail) no paw would count; against each
+        // frame's own, both paws are at the ground in 8 of 10 frames, the nose in 1 and the
+        // tail in 2: under a quarter.
+        assert_eq!(
+            choose_contact_joints(&skeleton, &poses, 1.0, 0.05),
+            vec![1, 2]
+        );
+        // A tail on the ground in a quarter of the frames or more counts (3 of 11).
+        let mut lying = poses.clone();
+        lying.truncate(8);
+        lying.extend(vec![at([0.15, 0.05, 0.05, 0.2, -0.1]); 3]);
+        assert_eq!(
+            choose_contact_joints(&skeleton, &lying, 1.0, 0.05),
+            vec![1, 2, 4]
+        );
     }
 }

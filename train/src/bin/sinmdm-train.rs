@@ -263,6 +263,22 @@ fn dry_run(args: &Args) -> Result<()> {
         println!("cycle           in place: contacts measured against the treadmill");
     }
     println!("features F      {features}");
+    let layout = &data.facts.layout;
+    let feet: Vec<&str> = layout
+        .contact_joints
+        .iter()
+        .map(|&j| layout.skeleton.joints[j].name.as_str())
+        .collect();
+    println!(
+        "feet            {} ({}): {}",
+        feet.len(),
+        feet.join(", "),
+        if config.data.contact_joints.is_some() {
+            "data.contact_joints in the config"
+        } else {
+            "the chain ends that touch the ground (data.contact_joints overrides)"
+        }
+    );
     println!("root            {}", data.facts.root);
     println!("channels C      {}", config.model.channels);
     println!("parameters      {}", model.num_params());
