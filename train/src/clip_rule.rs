@@ -116,6 +116,9 @@ pub struct RuleChoice {
     /// Whether the steps are left to the step ladder ([`crate::step_ladder`]): a calm clip whose
     /// steps the rule was asked for. `config` then holds the ladder's most steps.
     pub climb_ladder: bool,
+    /// Whether the configuration left the QnA window to the rule (so the window `config` holds
+    /// is the rule's choice for this clip).
+    pub window_from_clip: bool,
 }
 
 /// What the rule chooses for a new run on `data` with `config`; `None` when its `from_clip`
@@ -298,6 +301,7 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
         config: out,
         lines,
         climb_ladder: calm && asked.steps,
+        window_from_clip: asked.window,
     }
 }
 

@@ -31,6 +31,7 @@ use sinmdm_formats::{AnimationChoice, ReadOptions, read_clip};
 pub use crate::ladder_settings::{CHECK_SAMPLES, CHECK_SEED, LADDER_STEPS, goals};
 
 use crate::clip_data::ClipData;
+use crate::clip_rule::RuleChoice;
 use crate::config::TrainConfig;
 use crate::error::TrainError;
 use crate::trainer::{RunEnd, Trainer};
@@ -350,7 +351,8 @@ pub fn start_run(
     let data = ClipData::load(clip, &config.data, &config.model)?;
     let choice = match crate::clip_rule::apply(&config, &data) {
         Some(choice) if choice.climb_ladder => choice,
-        _ => return Trainer::start_loaded(clip, data, config, run, device).map(Some),
+        Some(choice) => return Trainer::start_chosen(clip, data, choice, run, device).map(Some),
+        None => return Trainer::start_loaded(clip, data, config, run, device).map(Some),
     };
     let on_clip = LadderClip {
         path: clip,
@@ -367,9 +369,9 @@ pub fn start_run(
         Climb::Done(rungs) => rungs,
         Climb::Interrupted => return Ok(None),
     };
-    let (chosen, mut lines) = match choose(&rungs) {
+    let mut chosen = match choose(&rungs) {
         Some(best) => {
-            let mut chosen = choice.config.clone();
+            let mut chosen = choice.config;
             chosen.training.steps = best.steps;
             chosen.training.warmup_steps = crate::clip_rule::calm_warmup_steps(best.steps);
             let why = if best.meets_goals() {
@@ -377,14 +379,18 @@ pub fn start_run(
             } else {
                 "no rung of the step ladder meets every goal; this one misses them least"
             };
-            let mut lines = choice.lines.clone();
+            let mut lines = choice.lines;
             for line in lines.iter_mut().filter(|l| l.starts_with("steps ")) {
                 *line = format!(
                     "steps           {} (warm-up {}): {why}",
                     chosen.training.steps, chosen.training.warmup_steps
                 );
             }
-            (chosen, lines)
+            RuleChoice {
+                config: chosen,
+                lines,
+                ..choice
+            }
         }
         None => {
             let most = rungs
@@ -395,15 +401,16 @@ pub fn start_run(
                 "no short run of the step ladder covered it (at most {:.1} at {} steps)",
                 most.coverage, most.steps
             );
-            let varied = crate::clip_rule::not_calm_after_all(&config, choice.reading, &why);
-            (varied.config, varied.lines)
+            crate::clip_rule::not_calm_after_all(&config, choice.reading, &why)
         }
     };
-    lines.push("step ladder (each rung's samples, scored):".into());
-    lines.extend(rungs.iter().map(|r| format!("  {}", r.line())));
-    let mut trainer = Trainer::start_loaded(clip, data, chosen, run, device)?;
-    trainer.set_rule(lines, config.from_clip.window);
-    Ok(Some(trainer))
+    chosen
+        .lines
+        .push("step ladder (each rung's samples, scored):".into());
+    chosen
+        .lines
+        .extend(rungs.iter().map(|r| format!("  {}", r.line())));
+    Trainer::start_chosen(clip, data, chosen, run, device).map(Some)
 }
 
 /// Writes a finished rung's scores into its folder `dir` (whole, or not at all).

@@ -13,6 +13,7 @@ use sinmdm::diffusion::Schedule;
 
 use crate::checkpoint::{self, CheckpointState};
 use crate::clip_data::ClipData;
+use crate::clip_rule::RuleChoice;
 use crate::config::TrainConfig;
 use crate::data::make_batch;
 use crate::error::{TrainError, io};
@@ -55,10 +56,8 @@ pub struct Trainer {
     last_checkpoint: Option<PathBuf>,
     /// Steps (1-based) whose gradients tests turn into NaN, once each.
     injected_faults: BTreeSet<u64>,
-    /// What the rule that reads the clip chose for a new run, a line per setting.
-    rule: Option<Vec<String>>,
-    /// Whether that rule chose the QnA window from the clip (so no hint second-guesses it).
-    rule_chose_window: bool,
+    /// What the rule that reads the clip chose for a new run started here.
+    rule: Option<RuleChoice>,
 }
 
 /// A new network, its weight average and optimiser for `config`, drawn from the run's seed.
@@ -137,7 +136,6 @@ impl Trainer {
             last_checkpoint,
             injected_faults: BTreeSet::new(),
             rule: None,
-            rule_chose_window: false,
         }
     }
 
@@ -174,16 +172,39 @@ impl Trainer {
         run: &Path,
         device: Device,
     ) -> Result<Trainer, TrainError> {
+        // (The steps of a calm clip are left to the step ladder, which `step_ladder::start_run`
+        // climbs before it starts the run; called directly, a calm clip trains the ladder's most.)
+        match crate::clip_rule::apply(&config, &data) {
+            Some(choice) => Trainer::start_chosen(clip, data, choice, run, device),
+            None => Trainer::begin(clip, data, config, None, run, device),
+        }
+    }
+
+    /// [`Trainer::start_loaded`] once the rule that reads the clip has chosen: `choice.config`
+    /// trains, and `choice` is what the run says the rule chose.
+    pub fn start_chosen(
+        clip: &Path,
+        data: ClipData,
+        choice: RuleChoice,
+        run: &Path,
+        device: Device,
+    ) -> Result<Trainer, TrainError> {
+        let config = choice.config.clone();
+        Trainer::begin(clip, data, config, Some(choice), run, device)
+    }
+
+    /// Starts a new run of `config` (the rule, if any, applied) on the clip `data` was read from.
+    fn begin(
+        clip: &Path,
+        data: ClipData,
+        config: TrainConfig,
+        rule: Option<RuleChoice>,
+        run: &Path,
+        device: Device,
+    ) -> Result<Trainer, TrainError> {
         Trainer::check_new_run(run)?;
         // The run saves the numbers it trains: what the rule that reads the clip chose, a
         // window that follows the frame rate and a root layout chosen from the clip, resolved.
-        // (The steps of a calm clip are left to the step ladder, which `step_ladder::start_run`
-        // climbs before it calls this; called directly, a calm clip trains the ladder's most.)
-        let rule_chose_window = config.from_clip.window;
-        let (config, rule) = match crate::clip_rule::apply(&config, &data) {
-            Some(choice) => (choice.config, Some(choice.lines)),
-            None => (config, None),
-        };
         let mut config = config.at_fps(data.facts.layout.fps);
         config.data.root_layout = data.facts.root_layout();
         std::fs::create_dir_all(run).map_err(io("create the output folder", run))?;
@@ -212,7 +233,6 @@ impl Trainer {
         };
         let parts = (model, average, optimizer);
         let mut trainer = Trainer::assemble(run, device, parts, data, state, log, None);
-        trainer.rule_chose_window = rule_chose_window && rule.is_some();
         trainer.rule = rule;
         Ok(trainer)
     }
@@ -302,7 +322,7 @@ impl Trainer {
     /// network sees at once ([`crate::motion_span::wider_window_hint`]); none when the rule that
     /// reads the clip chose the window.
     pub fn wider_window_hint(&self) -> Option<String> {
-        if self.rule_chose_window {
+        if self.rule.as_ref().is_some_and(|r| r.window_from_clip) {
             return None;
         }
         let fps = self.clip.facts.layout.fps;
@@ -313,14 +333,7 @@ impl Trainer {
     /// What the rule that reads the clip chose for this run, a line per setting, when it was
     /// started here with a configuration that asks for the rule ([`crate::clip_rule`]).
     pub fn rule_lines(&self) -> Option<&[String]> {
-        self.rule.as_deref()
-    }
-
-    /// Replaces the rule's lines (the step ladder's choice, made before this run started);
-    /// `chose_window` says whether the rule chose the QnA window.
-    pub(crate) fn set_rule(&mut self, lines: Vec<String>, chose_window: bool) {
-        self.rule = Some(lines);
-        self.rule_chose_window = chose_window;
+        self.rule.as_ref().map(|r| r.lines.as_slice())
     }
 
     /// Whether all configured steps are done.

@@ -236,10 +236,14 @@ fn dry_run(args: &Args) -> Result<()> {
     };
     let config = new_run_config(args)?;
     let data = ClipData::load(clip, &config.data, &config.model)?;
-    let rule_chose_window = config.from_clip.window;
-    let (config, rule, ladder) = match clip_rule::apply(&config, &data) {
-        Some(choice) => (choice.config, Some(choice.lines), choice.climb_ladder),
-        None => (config, None, false),
+    let (config, rule, ladder, window_from_clip) = match clip_rule::apply(&config, &data) {
+        Some(choice) => (
+            choice.config,
+            Some(choice.lines),
+            choice.climb_ladder,
+            choice.window_from_clip,
+        ),
+        None => (config, None, false, false),
     };
     let config = config.at_fps(data.facts.layout.fps);
     let features = data.features.nrows();
@@ -295,7 +299,7 @@ fn dry_run(args: &Args) -> Result<()> {
                 frames as f64 / fps
             );
             // The rule's window is chosen from the clip; a hint would second-guess it.
-            let hint = (!(rule_chose_window && rule.is_some()))
+            let hint = (!window_from_clip)
                 .then(|| motion_span::wider_window_hint(frames, fps, &config.model))
                 .flatten();
             if let Some(hint) = hint {
