@@ -7,7 +7,8 @@
 #   VARIANT   a name for the variant; runs go to out/variants/CLIP.VARIANT (+ .onnx, .json, .log,
 #             .trained holding the trainer's wall seconds). A finished clip is skipped.
 #   CONFIG    a training config (- for none, so sinmdm-train chooses the default)
-# CLIPS (environment): the clip names to run, space-separated (default: all eleven).
+# CLIPS (environment): the clip names to run, space-separated (default: all eleven); NAME=PATH
+#   runs a clip from outside the project under NAME.
 # Pause any other training or benchmark while this runs: the times are wall-clock.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -36,7 +37,12 @@ declare -A files=(
 )
 clips=${CLIPS:-"${!files[*]}"}
 for name in $clips; do
-  clip=$shared/${files[$name]:?unknown clip $name}
+  if [[ $name == *=* ]]; then
+    clip=${name#*=}
+    name=${name%%=*}
+  else
+    clip=$shared/${files[$name]:?unknown clip $name}
+  fi
   extra=()
   [ "$name" = dog_walk_mann_60fps ] && extra=(--fps clip)
   [ "$config" != - ] && extra+=(--config "$config")

@@ -24,6 +24,10 @@ MANY_FEET_STEPS = 13000
 DEFAULT_DROPOUT = 0.2
 DEFAULT_CHANNELS = 64
 DEFAULT_STEPS = 17000
+# A step's cost grows with the QnA window k as 10 + k; steps fitted to a wider window are rounded
+# down to 500 (WINDOW_STEP_COST_OFFSET, FITTED_STEPS_ROUNDING).
+WINDOW_STEP_COST_OFFSET = 10
+FITTED_STEPS_ROUNDING = 500
 
 
 def numpy_intra_diversity(raw, columns):
@@ -88,3 +92,32 @@ def test_the_default_reads_the_clip_as_numpy_does(clip, tmp_path, sinmdm):
             assert int(channels.group(1)) == DEFAULT_CHANNELS, out
             assert int(steps.group(1)) == DEFAULT_STEPS, out
             assert f"dropout         {VARIED_DROPOUT}" in out, out
+
+
+def window_at_fps(window, fps):
+    """The QnA window that keeps the receptive field's seconds at `fps` (docs/SPEC.md, the
+    network's shape): the receptive half-width 8 + 3 (k - 1) / 2 grows by fps / 30."""
+    half = 8 + 3 * (window - 1) // 2
+    wanted = half * max(fps / 30.0, 1.0)
+    return 2 * max(int(np.floor((wanted - 8) / 3 + 0.5)), window // 2) + 1
+
+
+@pytest.mark.parametrize("rate", [60, 120])
+def test_a_varied_clip_above_30_fps_trains_the_steps_that_fit_the_same_time(rate):
+    # The CMU hop is varied and captured at 120 fps: learned at 60 or 120 fps, its window follows
+    # the frame rate and its steps fall so that (10 + k) x steps stays within the 30 fps run's.
+    clip = [c for c in clips() if c.name == "human_hop_cmu_131_03.bvh"][0]
+    out = subprocess.run([str(TRAIN), str(clip), "--fps", str(rate), "--dry-run"], check=True,
+                         capture_output=True, text=True).stdout
+    assert re.search(r"clip +varied", out), out
+    trained = window_at_fps(VARIED_WINDOW, rate)
+    window = re.search(r"receptive field (\d+) frames \(QnA window (\d+)\)", out)
+    assert int(window.group(2)) == trained, out
+    assert int(window.group(1)) == 14 + 3 * trained, out
+    steps = int(re.search(r"^steps +(\d+) \(batch", out, re.M).group(1))
+    budget = DEFAULT_STEPS * (WINDOW_STEP_COST_OFFSET + VARIED_WINDOW)
+    cost = WINDOW_STEP_COST_OFFSET + trained
+    assert steps % FITTED_STEPS_ROUNDING == 0, out
+    assert steps * cost <= budget < (steps + FITTED_STEPS_ROUNDING) * cost, (steps, out)
+    assert f"at {rate} fps the window is {trained}" in out, out
+    assert f"meant at 30 fps, {DEFAULT_STEPS} (the configuration's)" in out, out

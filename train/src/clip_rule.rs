@@ -23,6 +23,10 @@
 //!     coverage), for [`MANY_FEET_STEPS`] steps, which the wider network's steps fit in the
 //!     time 17 000 of the configuration's take.
 //!
+//!   A varied clip's steps are meant at 30 fps. Learned at a higher rate, its window follows the
+//!   frame rate and a step costs more ([`window_step_cost`]), so its steps fall to those that fit
+//!   the same time ([`steps_at_window`]): 7 500 for a dog at 60 fps, whose window 7 becomes 19.
+//!
 //! The measure is the benchmark's intra diversity ([`sinmdm_eval::intra_diversity`]): the mean
 //! distance, per frame, between two 15-frame windows of the clip's joint rotations and contact
 //! labels. The rule names no clip; its threshold and the varied clip's setting were chosen on the
@@ -63,6 +67,14 @@ pub const MANY_FEET_CHANNELS: usize = 96;
 /// the configuration's): a step of 96 channels at window 7 costs about 0.04 s on 2 cores, so the
 /// run takes what 17 000 steps of 64 channels at window 11 took (8.5-9 minutes).
 pub const MANY_FEET_STEPS: u64 = 13_000;
+/// How much of a training step does not grow with the QnA window, in window frames: a step at
+/// window `k` costs about as much as `WINDOW_STEP_COST_OFFSET + k` frames of window
+/// ([`window_step_cost`]). Whole runs of the dog walk with 96 channels on 2 cores took 0.040 s a
+/// step at window 7 (30 fps) and 0.066 s at window 19 (60 fps), 1.65x, against 1.71x here
+/// (docs/TRAINING_EXPERIMENTS.md, "Steps at a higher frame rate").
+pub const WINDOW_STEP_COST_OFFSET: f64 = 10.0;
+/// The steps fitted to a wider window's cost are rounded down to a multiple of this.
+pub const FITTED_STEPS_ROUNDING: u64 = 500;
 
 /// What the rule reads from a clip before training.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -296,6 +308,26 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
             config.model.channels, reading.feet
         ),
     });
+    // The steps above are meant at 30 fps. At a higher rate the window follows the frame rate,
+    // a step costs more, and a varied clip's steps fall to fit the same time.
+    if asked.steps && !calm {
+        let at_30 = out.model.window;
+        let trained = out.model.at_fps(reading.fps).window;
+        let steps = steps_at_window(out.training.steps, at_30, trained);
+        if steps < out.training.steps {
+            let meant = lines[1]
+                .trim_start_matches("steps")
+                .trim_start()
+                .to_string();
+            lines[1] = format!(
+                "steps           {steps}: at {} fps the window is {trained}, whose steps cost {:.2}x those of window {at_30}, so this many fit the time of the steps meant at 30 fps, {meant}",
+                reading.fps,
+                window_step_cost(trained) / window_step_cost(at_30),
+            );
+            out.training.steps = steps;
+            out.training.warmup_steps = out.training.warmup_steps.min(steps / 10);
+        }
+    }
     RuleChoice {
         reading,
         config: out,
@@ -303,6 +335,24 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
         climb_ladder: calm && asked.steps,
         window_from_clip: asked.window,
     }
+}
+
+/// What a training step costs at QnA window `window`, relative to the rest of the network: the
+/// step grows with the window as `WINDOW_STEP_COST_OFFSET + window`.
+pub fn window_step_cost(window: usize) -> f64 {
+    WINDOW_STEP_COST_OFFSET + window as f64
+}
+
+/// Steps at window `trained` that take the time `steps` take at window `at_30` (the window the
+/// rule chose at 30 fps), rounded down to [`FITTED_STEPS_ROUNDING`]; `steps` where the trained
+/// window is no wider.
+pub fn steps_at_window(steps: u64, at_30: usize, trained: usize) -> u64 {
+    if trained <= at_30 {
+        return steps;
+    }
+    let fitted = steps as f64 * window_step_cost(at_30) / window_step_cost(trained);
+    let unit = FITTED_STEPS_ROUNDING;
+    ((fitted / unit as f64).floor() as u64 * unit).clamp(unit, steps)
 }
 
 /// The ladder's rungs as words: "50, 75, ... and 300".
@@ -488,6 +538,64 @@ mod tests {
             choose(&config, shorter).config.model.window,
             config.model.window
         );
+    }
+
+    #[test]
+    fn a_varied_clip_at_a_higher_frame_rate_trains_the_steps_that_fit_the_same_time() {
+        let config = TrainConfig::parse(DEFAULT).unwrap();
+        // The most steps, in whole units of the rounding, whose cost at the wider window is
+        // within that of the 30 fps steps.
+        let unit = FITTED_STEPS_ROUNDING;
+        let fits = |steps: u64, at_30: usize, trained: usize, chosen: u64| {
+            let budget = steps as f64 * window_step_cost(at_30);
+            chosen.is_multiple_of(unit)
+                && chosen as f64 * window_step_cost(trained) <= budget
+                && (chosen + unit) as f64 * window_step_cost(trained) > budget
+        };
+        for (feet, at_30, steps) in [(2, VARIED_WINDOW, 17_000), (4, MANY_FEET_WINDOW, 13_000)] {
+            let at_60 = ClipReading {
+                frames: 1054,
+                fps: 60.0,
+                feet,
+                ..reading(0.8)
+            };
+            let choice = choose(&config, at_60);
+            let out = &choice.config;
+            // The window is still the one meant at 30 fps; the run widens it at 60.
+            assert_eq!(out.model.window, at_30);
+            let trained = out.model.at_fps(60.0).window;
+            assert_eq!(trained, if feet == 2 { 15 } else { 19 });
+            assert!(
+                fits(steps, at_30, trained, out.training.steps),
+                "{feet} feet: {} steps",
+                out.training.steps
+            );
+            assert!(out.training.warmup_steps <= out.training.steps / 10);
+            assert!(
+                choice.lines[1].starts_with(&format!("steps           {}:", out.training.steps))
+                    && choice.lines[1].contains(&format!("at 60 fps the window is {trained}"))
+                    && choice.lines[1].contains(&format!("meant at 30 fps, {steps}")),
+                "{:?}",
+                choice.lines
+            );
+            out.validate().unwrap();
+            // At 30 fps, or with a window that does not follow the frame rate, nothing falls.
+            let at_30_fps = ClipReading { fps: 30.0, ..at_60 };
+            assert_eq!(choose(&config, at_30_fps).config.training.steps, steps);
+            let mut fixed = config.clone();
+            fixed.model.window_follows_fps = false;
+            assert_eq!(choose(&fixed, at_60).config.training.steps, steps);
+        }
+        // A calm clip's steps are the ladder's at any rate.
+        let calm = ClipReading {
+            fps: 60.0,
+            ..reading(0.3)
+        };
+        assert_eq!(
+            choose(&config, calm).config.training.steps,
+            calm_most_steps()
+        );
+        assert_eq!(steps_at_window(17_000, 5, 5), 17_000);
     }
 
     #[test]
