@@ -19,7 +19,8 @@ setting: `sinmdm eval` of the trained model, 20 samples of twice the clip, seed 
 `where` names the section of docs/TRAINING_EXPERIMENTS.md that gives the run). Settings: `ladder`
 (the step ladder's choice, its time including the ladder's), `d17k` (window 3, dropout 0.2,
 17 000 steps: the default before the rule), `wKdNN` (window K, dropout 0.NN, 17 000 steps),
-`wKcCsNk` (window K, C channels, N 000 steps, dropout 0.2). A clip with no cell for a setting
+`wKcCsNk` (window K, C channels, N 000 steps, dropout 0.2), `wKcCdNNsNk` (the same with dropout
+0.NN). A clip with no cell for a setting
 misses every goal with it. A varied clip placed under T climbs the ladder first, whose
 1 000-step rung does not cover it (measured on the CMU walk, the hop and the dog walk), and
 trains its varied setting a minute later (LADDER_MINUTES).
