@@ -183,14 +183,15 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
         && asked.channels
         && config.model.channels < MANY_FEET_CHANNELS
         && MANY_FEET_CHANNELS.is_multiple_of(config.model.heads);
-    lines.push(match (asked.steps, calm) {
-        (false, _) => format!("steps           {} ({kept})", config.training.steps),
+    // What the steps line says after its label (the steps meant at 30 fps, and why).
+    let steps_said = match (asked.steps, calm) {
+        (false, _) => format!("{} ({kept})", config.training.steps),
         (true, true) => {
             let steps = calm_most_steps();
             out.training.steps = steps;
             out.training.warmup_steps = calm_warmup_steps(steps);
             format!(
-                "steps           chosen by the step ladder when training starts: short runs of {} steps (warm-up a third), each sampled {} times and scored, and the one that meets coverage >= {}, replay <= {} s and jitter within {}x of the clip's either way with the widest margin trains the model (a calm clip is covered within a few hundred steps, and replays the longer it trains)",
+                "chosen by the step ladder when training starts: short runs of {} steps (warm-up a third), each sampled {} times and scored, and the one that meets coverage >= {}, replay <= {} s and jitter within {}x of the clip's either way with the widest margin trains the model (a calm clip is covered within a few hundred steps, and replays the longer it trains)",
                 ladder_list(),
                 crate::ladder_settings::CHECK_SAMPLES,
                 crate::ladder_settings::goals::COVERAGE,
@@ -201,15 +202,17 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
         (true, false) if widen && config.training.steps > MANY_FEET_STEPS => {
             out.training.steps = MANY_FEET_STEPS;
             format!(
-                "steps           {MANY_FEET_STEPS}: the {MANY_FEET_CHANNELS} channels below cost more a step, and this many fit the time {} steps of {} channels take",
+                "{MANY_FEET_STEPS}: the {MANY_FEET_CHANNELS} channels below cost more a step, and this many fit the time {} steps of {} channels take",
                 config.training.steps, config.model.channels
             )
         }
         (true, false) => format!(
-            "steps           {} (the configuration's): a varied clip covers more the longer it trains",
+            "{} (the configuration's): a varied clip covers more the longer it trains",
             config.training.steps
         ),
-    });
+    };
+    let steps_line = lines.len();
+    lines.push(format!("steps           {steps_said}"));
     lines.push(match (asked.window, calm) {
         (false, _) => format!("window          {} ({kept})", config.model.window),
         (true, true) => format!(
@@ -315,12 +318,8 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
         let trained = out.model.at_fps(reading.fps).window;
         let steps = steps_at_window(out.training.steps, at_30, trained);
         if steps < out.training.steps {
-            let meant = lines[1]
-                .trim_start_matches("steps")
-                .trim_start()
-                .to_string();
-            lines[1] = format!(
-                "steps           {steps}: at {} fps the window is {trained}, whose steps cost {:.2}x those of window {at_30}, so this many fit the time of the steps meant at 30 fps, {meant}",
+            lines[steps_line] = format!(
+                "steps           {steps}: at {} fps the window is {trained}, whose steps cost {:.2}x those of window {at_30}, so this many fit the time of the steps meant at 30 fps, {steps_said}",
                 reading.fps,
                 window_step_cost(trained) / window_step_cost(at_30),
             );
