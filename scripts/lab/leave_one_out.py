@@ -5,7 +5,9 @@ T is calm and its steps are chosen by its own step ladder (nothing chosen on oth
 other clip is varied and trains a setting chosen for its feet: V2 on two feet or fewer, V4 on
 three or more. For every clip H in turn, T, V2 and V4 are chosen on the other clips alone (the
 most clips meeting every goal; ties go to the smaller total shortfall, then to the more varied
-samples (the summed global diversity), then to the threshold in the widest gap between clips),
+samples (the summed global diversity; `--tie-break margin` puts the summed margin of the clips
+that meet every goal, each its nearest goal's, in its place), then to the threshold in the widest
+gap between clips),
 and H is judged with what was chosen. The same motion at another frame rate (a name ending in
 `_60fps`) is left out with H: it is not another clip. The script prints that table, the one with the rule chosen
 on all the clips, and every measured cell.
@@ -25,7 +27,7 @@ misses every goal with it. A varied clip placed under T climbs the ladder first,
 1 000-step rung does not cover it (measured on the CMU walk, the hop and the dog walk), and
 trains its varied setting a minute later (LADDER_MINUTES).
 
-Usage: python3 scripts/lab/leave_one_out.py [measured_settings.csv]"""
+Usage: python3 scripts/lab/leave_one_out.py [--tie-break diversity|margin] [measured_settings.csv]"""
 
 import csv
 import math
@@ -74,6 +76,19 @@ def shortfalls(s):
     return f
 
 
+def margin(s):
+    """The nearest goal's margin (scaled as the shortfalls are): how far a cell that meets every
+    goal is from missing one."""
+    m = [(s["coverage"] - 95.0) / 5.0, (1.5 - s["jitter"]) / 0.5]
+    if s["intra"] >= 0.7:
+        m.append((s["diversity"] - 1.2) / 0.2)
+    else:
+        m.append((1.0 - s["replay"]) / 0.5)
+    if s["minutes"] is not None:
+        m.append(10.0 - s["minutes"])
+    return min(m)
+
+
 def judge(s):
     """(every goal met, total shortfall); a cell never measured misses every goal."""
     if s is None:
@@ -97,7 +112,7 @@ def trained(cells, feet, intra, name, rule):
     return varied, cells.get((name, varied))
 
 
-def choose(cells, feet, intra, train):
+def choose(cells, feet, intra, train, tie_break="diversity"):
     settings = sorted({s for (_, s) in cells} - {"ladder"})
     values = sorted(intra[n] for n in train)
     cuts = [(values[0] - 0.05, 0.05)] + [
@@ -107,14 +122,16 @@ def choose(cells, feet, intra, train):
         for v2 in settings:
             for v4 in settings:
                 rule = (threshold, v2, v4)
-                met, short, diversity = 0, 0.0, 0.0
+                met, short, diversity, margins = 0, 0.0, 0.0, 0.0
                 for n in train:
                     _, cell = trained(cells, feet, intra, n, rule)
                     ok, s = judge(cell)
                     met += ok
                     short += s
                     diversity += cell["diversity"] if cell else 0.0
-                key = (met, -short, diversity, gap)
+                    margins += margin(cell) if ok else 0.0
+                third = margins if tie_break == "margin" else diversity
+                key = (met, -short, third, gap)
                 if best is None or key > best[0]:
                     best = (key, rule)
     return best[1]
@@ -131,7 +148,15 @@ def row(name, label, cell):
 
 
 def main():
-    path = sys.argv[1] if len(sys.argv) > 1 else HERE / "measured_settings.csv"
+    args = sys.argv[1:]
+    tie_break = "diversity"
+    if "--tie-break" in args:
+        i = args.index("--tie-break")
+        tie_break = args[i + 1]
+        del args[i:i + 2]
+        if tie_break not in ("margin", "diversity"):
+            sys.exit("--tie-break takes margin or diversity")
+    path = args[0] if args else HERE / "measured_settings.csv"
     cells, feet, intra = load(path)
     clips = sorted(intra)
     header = ("| clip | chosen on the others | coverage | global diversity | clip intra | replay s "
@@ -141,13 +166,13 @@ def main():
     print(header)
     met = 0
     for held in clips:
-        rule = choose(cells, feet, intra, [n for n in clips if source(n) != source(held)])
+        rule = choose(cells, feet, intra, [n for n in clips if source(n) != source(held)], tie_break)
         setting, cell = trained(cells, feet, intra, held, rule)
         met += judge(cell)[0]
         print(row(held, f"T {rule[0]:.3f}, V2 {rule[1]}, V4 {rule[2]}: {setting}", cell))
     print(f"\n{met} of {len(clips)} clips meet every goal on clips the rule was not chosen on.\n")
 
-    rule = choose(cells, feet, intra, clips)
+    rule = choose(cells, feet, intra, clips, tie_break)
     print(f"Chosen on all {len(clips)}: T {rule[0]:.3f}, V2 {rule[1]}, V4 {rule[2]}\n")
     print(header)
     met = 0

@@ -28,6 +28,21 @@ DEFAULT_STEPS = 17000
 # down to 500 (WINDOW_STEP_COST_OFFSET, FITTED_STEPS_ROUNDING).
 WINDOW_STEP_COST_OFFSET = 10
 FITTED_STEPS_ROUNDING = 500
+# The default's frames a step and most items (configs/default.yaml); a varied clip's items come
+# in multiples of 2 (BATCH_ITEMS_MULTIPLE).
+FRAMES_PER_STEP = 1024
+BATCH_SIZE = 8
+
+
+def items_of(frames, paired):
+    """The copies of a clip of `frames` frames in a step: round(1024 / frames) within 1..8, half
+    away from zero as Rust rounds; a varied clip (`paired`) that fits the budget and would get an
+    odd count gets the even neighbour whose frames come nearer 1 024 (the smaller on a tie)."""
+    items = min(max(int(np.floor(FRAMES_PER_STEP / frames + 0.5)), 1), BATCH_SIZE)
+    if not paired or frames > FRAMES_PER_STEP or items % 2 == 0:
+        return items
+    evens = [n for n in (items - 1, items + 1) if 2 <= n <= BATCH_SIZE]
+    return min(evens, key=lambda n: (abs(n * frames - FRAMES_PER_STEP), n))
 
 
 def numpy_intra_diversity(raw, columns):
@@ -58,6 +73,9 @@ def test_the_default_reads_the_clip_as_numpy_does(clip, tmp_path, sinmdm):
     window = re.search(r"receptive field \d+ frames \(QnA window (\d+)\)", out)
     steps = re.search(r"^steps +(?:up to )?(\d+) \(batch", out, re.M)
     channels = re.search(r"^channels C +(\d+)$", out, re.M)
+    frames = int(re.search(r"\((\d+) frames at [0-9.]+ fps\)", out).group(1))
+    batch = int(re.search(r"^steps +(?:up to )?\d+ \(batch (\d+) x", out, re.M).group(1))
+    assert batch == items_of(frames, paired=not calm), (frames, out)
     # The window is the rule's, chosen from the clip: no hint second-guesses it.
     assert "hint" not in out, out
     # The feet the rule reads are the clip's contact columns, and they are the feet of the
@@ -121,3 +139,18 @@ def test_a_varied_clip_above_30_fps_trains_the_steps_that_fit_the_same_time(rate
     assert steps * cost <= budget < (steps + FITTED_STEPS_ROUNDING) * cost, (steps, out)
     assert f"at {rate} fps the window is {trained}" in out, out
     assert f"meant at 30 fps, {DEFAULT_STEPS} (the configuration's)" in out, out
+
+
+def test_a_varied_clip_whose_copies_would_be_odd_trains_them_in_pairs():
+    # The CMU hop learned at 40 fps is 368 frames: round(1024 / 368) = 3 copies a step, two on one
+    # core and one on the other; 2 copies (736 frames) come nearer 1 024 than 4 (1 472).
+    clip = [c for c in clips() if c.name == "human_hop_cmu_131_03.bvh"][0]
+    out = subprocess.run([str(TRAIN), str(clip), "--fps", "40", "--dry-run"], check=True,
+                         capture_output=True, text=True).stdout
+    assert re.search(r"clip +varied", out), out
+    frames = int(re.search(r"\((\d+) frames at 40 fps\)", out).group(1))
+    assert frames == 368, out
+    assert items_of(frames, paired=False) == 3 and items_of(frames, paired=True) == 2
+    assert re.search(r"^steps +\d+ \(batch 2 x the whole clip\)", out, re.M), out
+    assert re.search(r"batch +2 items of the clip's 368 frames, 736 frames a step: the "
+                     r"configuration's 1024 would make 3", out), out

@@ -75,6 +75,12 @@ pub const MANY_FEET_STEPS: u64 = 13_000;
 pub const WINDOW_STEP_COST_OFFSET: f64 = 10.0;
 /// The steps fitted to a wider window's cost are rounded down to a multiple of this.
 pub const FITTED_STEPS_ROUNDING: u64 = 500;
+/// A varied clip's step holds its copies of the clip in a multiple of this many items. The
+/// trainer shares a step's items among the cores, item by item, so an odd count leaves one of
+/// the two cores of the 10-minute goal's machine idle for part of every step: 3 items take as
+/// long as 4 (a dog of 409 frames trained 13 000 steps in 12.1 minutes, against 9.1 for one of
+/// 527 frames in 2 items; docs/TRAINING_EXPERIMENTS.md, "Items in pairs").
+pub const BATCH_ITEMS_MULTIPLE: usize = 2;
 
 /// What the rule reads from a clip before training.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -311,6 +317,14 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
             config.model.channels, reading.feet
         ),
     });
+    lines.push(batch_line(
+        config,
+        &mut out,
+        reading,
+        asked.batch,
+        calm,
+        kept,
+    ));
     // The steps above are meant at 30 fps. At a higher rate the window follows the frame rate,
     // a step costs more, and a varied clip's steps fall to fit the same time.
     if asked.steps && !calm {
@@ -334,6 +348,70 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
         climb_ladder: calm && asked.steps,
         window_from_clip: asked.window,
     }
+}
+
+/// The rule's batch line; it sets `out.training.frames_per_step` where it pairs the items.
+fn batch_line(
+    config: &TrainConfig,
+    out: &mut TrainConfig,
+    reading: ClipReading,
+    asked: bool,
+    calm: bool,
+    kept: &str,
+) -> String {
+    let frames = reading.frames;
+    let items = config.training.batch_shape(frames).items;
+    let Some(budget) = config.training.frames_per_step else {
+        return format!(
+            "batch           {items} copies of the whole clip (the configuration's batch_size; it sets no frames_per_step)"
+        );
+    };
+    let theirs = format!("{items} items of the clip's {frames} frames from {budget} frames a step");
+    if !asked {
+        return format!("batch           {theirs} ({kept})");
+    }
+    if calm {
+        return format!(
+            "batch           {theirs} (the configuration's): the rule pairs only a varied clip's items"
+        );
+    }
+    match paired_items(budget, frames, config.training.batch_size) {
+        Some(paired) => {
+            out.training.frames_per_step = Some(paired * frames);
+            format!(
+                "batch           {paired} items of the clip's {frames} frames, {} frames a step: the configuration's {budget} would make {items}, and a step's items are shared among the cores, so an odd count leaves one of two cores idle for part of every step",
+                paired * frames
+            )
+        }
+        None if frames > budget => format!(
+            "batch           {theirs} (the configuration's): each item a random window of the longer clip"
+        ),
+        None => format!(
+            "batch           {theirs} (the configuration's): a multiple of {BATCH_ITEMS_MULTIPLE}, which the cores share evenly"
+        ),
+    }
+}
+
+/// The items a varied clip of `frames` frames trains in a step, a multiple of
+/// [`BATCH_ITEMS_MULTIPLE`], in place of the `round(budget / frames)` a budget of `budget`
+/// frames a step gives (at most `most_items`): the multiple whose frames come nearest the budget
+/// (the smaller on a tie). `None` where the budget's count is already a multiple, where the clip
+/// is longer than the budget (each item is then a window of it), or where no multiple fits.
+pub fn paired_items(budget: usize, frames: usize, most_items: usize) -> Option<usize> {
+    let unit = BATCH_ITEMS_MULTIPLE;
+    if frames == 0 || frames > budget {
+        return None;
+    }
+    let items = ((budget as f64 / frames as f64).round() as usize).clamp(1, most_items.max(1));
+    if items.is_multiple_of(unit) {
+        return None;
+    }
+    let lower = items - items % unit;
+    let upper = lower + unit;
+    [lower, upper]
+        .into_iter()
+        .filter(|&n| n >= unit && n <= most_items)
+        .min_by_key(|&n| (n * frames).abs_diff(budget))
 }
 
 /// What a training step costs at QnA window `window`, relative to the rest of the network: the
@@ -388,6 +466,7 @@ mod tests {
             window: true,
             dropout: true,
             channels: true,
+            batch: true,
         };
         assert_eq!(config.from_clip, all);
         // A configuration without the section trains its numbers as written.
@@ -419,6 +498,75 @@ mod tests {
         fixed.from_clip.steps = false;
         assert!(!choose(&fixed, reading(0.5)).climb_ladder);
         assert_eq!(calm_warmup_steps(75), 25);
+    }
+
+    #[test]
+    fn paired_items_take_the_even_count_whose_frames_come_nearest_the_budget() {
+        // (clip frames, batch_size, items in pairs or None), for 1 024 frames a step; worked
+        // out by hand from round(1024 / frames): 409 -> 3 (2 x 409 = 818 is 206 short of the
+        // budget, 4 x 409 = 1 636 is 612 over), 297 -> 3 (594 is 430 short, 1 188 is 164
+        // over), 213 -> 5 (852 is 172 short, 1 278 is 254 over), 779 -> 1 (only 2 is a pair).
+        let cases = [
+            (409, 8, Some(2)),
+            (297, 8, Some(4)),
+            (213, 8, Some(4)),
+            (779, 8, Some(2)),
+            (341, 8, Some(4)), // 3: 682 is 342 short, 1 364 only 340 over
+            (527, 8, None),    // 2 already
+            (180, 8, None),    // 6 already
+            (1054, 8, None),   // longer than the budget: one window of it
+            (100, 8, None),    // 10, held to batch_size 8
+            (100, 7, Some(6)), // 10, held to 7; 8 is over batch_size
+            (700, 1, None),    // batch_size 1 has no pair
+        ];
+        for (frames, most, want) in cases {
+            assert_eq!(paired_items(1024, frames, most), want, "{frames} frames");
+        }
+    }
+
+    #[test]
+    fn a_varied_clip_trains_its_items_in_pairs_and_a_calm_one_as_configured() {
+        let config = TrainConfig::parse(DEFAULT).unwrap();
+        let budget = config.training.frames_per_step.unwrap();
+        let mut dog = reading(0.8);
+        dog.frames = 409;
+        dog.feet = 4;
+        let choice = choose(&config, dog);
+        assert_eq!(choice.config.training.frames_per_step, Some(818));
+        assert_eq!(choice.config.training.batch_shape(409).items, 2);
+        assert_eq!(
+            config.training.batch_shape(409).items,
+            3,
+            "what it replaces"
+        );
+        let line = choice
+            .lines
+            .iter()
+            .find(|l| l.starts_with("batch"))
+            .unwrap();
+        assert!(
+            line.contains("2 items") && line.contains("would make 3"),
+            "{line}"
+        );
+        // Calm, or not asked for the batch, or already in pairs: the configuration's budget.
+        let mut calm = dog;
+        calm.intra_diversity = 0.5;
+        assert_eq!(
+            choose(&config, calm).config.training.frames_per_step,
+            Some(budget)
+        );
+        let mut fixed = config.clone();
+        fixed.from_clip.batch = false;
+        assert_eq!(
+            choose(&fixed, dog).config.training.frames_per_step,
+            Some(budget)
+        );
+        let mut even = dog;
+        even.frames = 527;
+        assert_eq!(
+            choose(&config, even).config.training.frames_per_step,
+            Some(budget)
+        );
     }
 
     #[test]

@@ -227,12 +227,15 @@ pub struct FromClip {
     /// `model.channels`.
     #[serde(default)]
     pub channels: bool,
+    /// `training.frames_per_step` (so that a step's items come in pairs).
+    #[serde(default)]
+    pub batch: bool,
 }
 
 impl FromClip {
     /// Whether the rule chooses nothing.
     pub fn is_off(&self) -> bool {
-        !(self.steps || self.window || self.dropout || self.channels)
+        !(self.steps || self.window || self.dropout || self.channels || self.batch)
     }
 }
 
@@ -257,6 +260,9 @@ impl TrainConfig {
         }
         if rule.channels {
             asked.model.channels = saved.model.channels;
+        }
+        if rule.batch {
+            asked.training.frames_per_step = saved.training.frames_per_step;
         }
         asked.from_clip = FromClip::default();
         let mut asked = asked.at_fps(fps);
@@ -431,6 +437,34 @@ mod tests {
             .resume_difference(&fixed.for_resume(&saved, 30.0))
             .unwrap();
         assert!(message.contains("model.channels = 96"), "{message}");
+    }
+
+    #[test]
+    fn a_resume_with_the_default_keeps_the_batch_the_rule_paired() {
+        let default = TrainConfig::parse(include_str!("../../../configs/default.yaml")).unwrap();
+        // A varied dog of 409 frames: 1 024 frames a step would make 3 copies; the rule made 2.
+        let dog = crate::clip_rule::ClipReading {
+            frames: 409,
+            fps: 30.0,
+            intra_diversity: 0.76,
+            feet: 4,
+        };
+        let mut saved = crate::clip_rule::choose(&default, dog).config.at_fps(30.0);
+        saved.data.root_layout = sinmdm::motion::RootLayout::Heading;
+        assert_eq!(saved.training.frames_per_step, Some(818));
+        assert_eq!(
+            saved.resume_difference(&default.for_resume(&saved, 30.0)),
+            None
+        );
+        let mut fixed = default.clone();
+        fixed.from_clip.batch = false;
+        let message = saved
+            .resume_difference(&fixed.for_resume(&saved, 30.0))
+            .unwrap();
+        assert!(
+            message.contains("training.frames_per_step = 818"),
+            "{message}"
+        );
     }
 
     #[test]
