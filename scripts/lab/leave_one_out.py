@@ -152,7 +152,7 @@ def main():
     tie_break = "diversity"
     if "--tie-break" in args:
         i = args.index("--tie-break")
-        tie_break = args[i + 1]
+        tie_break = args[i + 1] if i + 1 < len(args) else ""
         del args[i:i + 2]
         if tie_break not in ("margin", "diversity"):
             sys.exit("--tie-break takes margin or diversity")

@@ -37,9 +37,10 @@ BATCH_SIZE = 8
 def items_of(frames, paired):
     """The copies of a clip of `frames` frames in a step: round(1024 / frames) within 1..8, half
     away from zero as Rust rounds; a varied clip (`paired`) that fits the budget and would get an
-    odd count gets the even neighbour whose frames come nearer 1 024 (the smaller on a tie)."""
+    odd count of 3 or more gets the even neighbour whose frames come nearer 1 024 (the smaller on
+    a tie)."""
     items = min(max(int(np.floor(FRAMES_PER_STEP / frames + 0.5)), 1), BATCH_SIZE)
-    if not paired or frames > FRAMES_PER_STEP or items % 2 == 0:
+    if not paired or frames > FRAMES_PER_STEP or items % 2 == 0 or items == 1:
         return items
     evens = [n for n in (items - 1, items + 1) if 2 <= n <= BATCH_SIZE]
     return min(evens, key=lambda n: (abs(n * frames - FRAMES_PER_STEP), n))

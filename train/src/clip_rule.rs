@@ -75,11 +75,12 @@ pub const MANY_FEET_STEPS: u64 = 13_000;
 pub const WINDOW_STEP_COST_OFFSET: f64 = 10.0;
 /// The steps fitted to a wider window's cost are rounded down to a multiple of this.
 pub const FITTED_STEPS_ROUNDING: u64 = 500;
-/// A varied clip's step holds its copies of the clip in a multiple of this many items. The
-/// trainer shares a step's items among the cores, item by item, so an odd count leaves one of
-/// the two cores of the 10-minute goal's machine idle for part of every step: 3 items take as
-/// long as 4 (a dog of 409 frames trained 13 000 steps in 12.1 minutes, against 9.1 for one of
-/// 527 frames in 2 items; docs/TRAINING_EXPERIMENTS.md, "Items in pairs").
+/// A varied clip that would train an odd count of copies of the clip a step, 3 or more, trains
+/// an even one: a multiple of this. The trainer shares a step's items among the cores, item by
+/// item, so an odd count leaves one of the two cores of the 10-minute goal's machine idle for
+/// part of every step: 3 items take as long as 4 (the rule's setting trained 13 000 steps of a
+/// dog of 409 frames in 13.2 minutes in 3 items, 7.2 in 2; docs/TRAINING_EXPERIMENTS.md, "Items
+/// in pairs"). A single copy is left alone: pairing it would double a step's frames, unmeasured.
 pub const BATCH_ITEMS_MULTIPLE: usize = 2;
 
 /// What the rule reads from a clip before training.
@@ -375,7 +376,7 @@ fn batch_line(
             "batch           {theirs} (the configuration's): the rule pairs only a varied clip's items"
         );
     }
-    match paired_items(budget, frames, config.training.batch_size) {
+    match paired_items(items, frames, budget, config.training.batch_size) {
         Some(paired) => {
             out.training.frames_per_step = Some(paired * frames);
             format!(
@@ -393,24 +394,26 @@ fn batch_line(
 }
 
 /// The items a varied clip of `frames` frames trains in a step, a multiple of
-/// [`BATCH_ITEMS_MULTIPLE`], in place of the `round(budget / frames)` a budget of `budget`
-/// frames a step gives (at most `most_items`): the multiple whose frames come nearest the budget
-/// (the smaller on a tie). `None` where the budget's count is already a multiple, where the clip
-/// is longer than the budget (each item is then a window of it), or where no multiple fits.
-pub fn paired_items(budget: usize, frames: usize, most_items: usize) -> Option<usize> {
+/// [`BATCH_ITEMS_MULTIPLE`], in place of the `items` a budget of `budget` frames a step gives it
+/// (at most `most_items`): of the two multiples next to `items`, the one whose frames come
+/// nearest the budget (the smaller on a tie). `None` where `items` is already a multiple or a
+/// single copy, where the clip is longer than the budget (each item is then a window of it), or
+/// where no multiple fits.
+pub fn paired_items(
+    items: usize,
+    frames: usize,
+    budget: usize,
+    most_items: usize,
+) -> Option<usize> {
     let unit = BATCH_ITEMS_MULTIPLE;
-    if frames == 0 || frames > budget {
-        return None;
-    }
-    let items = ((budget as f64 / frames as f64).round() as usize).clamp(1, most_items.max(1));
-    if items.is_multiple_of(unit) {
+    if frames == 0 || frames > budget || items < unit || items.is_multiple_of(unit) {
         return None;
     }
     let lower = items - items % unit;
     let upper = lower + unit;
     [lower, upper]
         .into_iter()
-        .filter(|&n| n >= unit && n <= most_items)
+        .filter(|&n| n <= most_items)
         .min_by_key(|&n| (n * frames).abs_diff(budget))
 }
 
@@ -505,22 +508,30 @@ mod tests {
         // (clip frames, batch_size, items in pairs or None), for 1 024 frames a step; worked
         // out by hand from round(1024 / frames): 409 -> 3 (2 x 409 = 818 is 206 short of the
         // budget, 4 x 409 = 1 636 is 612 over), 297 -> 3 (594 is 430 short, 1 188 is 164
-        // over), 213 -> 5 (852 is 172 short, 1 278 is 254 over), 779 -> 1 (only 2 is a pair).
+        // over), 213 -> 5 (852 is 172 short, 1 278 is 254 over).
         let cases = [
             (409, 8, Some(2)),
             (297, 8, Some(4)),
             (213, 8, Some(4)),
-            (779, 8, Some(2)),
             (341, 8, Some(4)), // 3: 682 is 342 short, 1 364 only 340 over
+            (779, 8, None),    // 1: a single copy is left alone
             (527, 8, None),    // 2 already
             (180, 8, None),    // 6 already
             (1054, 8, None),   // longer than the budget: one window of it
             (100, 8, None),    // 10, held to batch_size 8
             (100, 7, Some(6)), // 10, held to 7; 8 is over batch_size
-            (700, 1, None),    // batch_size 1 has no pair
+            (300, 3, Some(2)), // 3, held to 3; 4 is over batch_size
         ];
+        let mut config = TrainConfig::parse(DEFAULT).unwrap().training;
+        config.frames_per_step = Some(1024);
         for (frames, most, want) in cases {
-            assert_eq!(paired_items(1024, frames, most), want, "{frames} frames");
+            config.batch_size = most;
+            let items = config.batch_shape(frames).items;
+            assert_eq!(
+                paired_items(items, frames, 1024, most),
+                want,
+                "{frames} frames"
+            );
         }
     }
 
