@@ -566,6 +566,9 @@ mod tests {
             choose(&config, calm).config.training.frames_per_step,
             Some(budget)
         );
+        // A calm clip that no rung covered trains as a varied one, in pairs.
+        let after_all = not_calm_after_all(&config, calm, "no rung covered it");
+        assert_eq!(after_all.config.training.frames_per_step, Some(818));
         let mut fixed = config.clone();
         fixed.from_clip.batch = false;
         assert_eq!(
