@@ -63,30 +63,26 @@ def source(name):
     return name
 
 
-def shortfalls(s):
-    """Each goal's shortfall (0 when met), scaled so that one unit is about one goal missed."""
-    f = {"coverage": max(0.0, 95.0 - s["coverage"]) / 5.0,
-         "jitter": max(0.0, s["jitter"] - 1.5) / 0.5}
+def goal_margins(s):
+    """Each goal's signed margin (negative when missed), scaled so that one unit is about one goal."""
+    m = {"coverage": (s["coverage"] - 95.0) / 5.0, "jitter": (1.5 - s["jitter"]) / 0.5}
     if s["intra"] >= 0.7:
-        f["diversity"] = max(0.0, 1.2 - s["diversity"]) / 0.2
+        m["diversity"] = (s["diversity"] - 1.2) / 0.2
     else:
-        f["replay"] = max(0.0, s["replay"] - 1.0) / 0.5
+        m["replay"] = (1.0 - s["replay"]) / 0.5
     if s["minutes"] is not None:
-        f["time"] = max(0.0, s["minutes"] - 10.0)
-    return f
+        m["time"] = 10.0 - s["minutes"]
+    return m
+
+
+def shortfalls(s):
+    """Each goal's shortfall (0 when met), in the units of `goal_margins`."""
+    return {goal: max(0.0, -v) for goal, v in goal_margins(s).items()}
 
 
 def margin(s):
-    """The nearest goal's margin (scaled as the shortfalls are): how far a cell that meets every
-    goal is from missing one."""
-    m = [(s["coverage"] - 95.0) / 5.0, (1.5 - s["jitter"]) / 0.5]
-    if s["intra"] >= 0.7:
-        m.append((s["diversity"] - 1.2) / 0.2)
-    else:
-        m.append((1.0 - s["replay"]) / 0.5)
-    if s["minutes"] is not None:
-        m.append(10.0 - s["minutes"])
-    return min(m)
+    """The nearest goal's margin: how far a cell that meets every goal is from missing one."""
+    return min(goal_margins(s).values())
 
 
 def judge(s):

@@ -406,19 +406,28 @@ mod tests {
         assert_eq!(paper.model.receptive_field(), 23);
     }
 
-    #[test]
-    fn a_resume_with_the_default_keeps_what_the_rule_chose_for_a_dog() {
+    /// The default, and what a new run with it on a varied clip of `frames` frames on four feet
+    /// at 30 fps saved: the rule's choices, and the root layout auto chose.
+    fn the_default_and_a_dog_run_it_saved(
+        frames: usize,
+        intra_diversity: f64,
+    ) -> (TrainConfig, TrainConfig) {
         let default = TrainConfig::parse(include_str!("../../../configs/default.yaml")).unwrap();
-        // What a new run on a varied clip on four feet at 30 fps saved: the rule's window,
-        // channels and steps, the root layout auto chose.
         let dog = crate::clip_rule::ClipReading {
-            frames: 527,
+            frames,
             fps: 30.0,
-            intra_diversity: 0.77,
+            intra_diversity,
             feet: 4,
         };
         let mut saved = crate::clip_rule::choose(&default, dog).config.at_fps(30.0);
         saved.data.root_layout = sinmdm::motion::RootLayout::Heading;
+        (default, saved)
+    }
+
+    #[test]
+    fn a_resume_with_the_default_keeps_what_the_rule_chose_for_a_dog() {
+        // The rule's window, channels and steps.
+        let (default, saved) = the_default_and_a_dog_run_it_saved(527, 0.77);
         assert_eq!(
             (
                 saved.model.channels,
@@ -441,16 +450,8 @@ mod tests {
 
     #[test]
     fn a_resume_with_the_default_keeps_the_batch_the_rule_paired() {
-        let default = TrainConfig::parse(include_str!("../../../configs/default.yaml")).unwrap();
         // A varied dog of 409 frames: 1 024 frames a step would make 3 copies; the rule made 2.
-        let dog = crate::clip_rule::ClipReading {
-            frames: 409,
-            fps: 30.0,
-            intra_diversity: 0.76,
-            feet: 4,
-        };
-        let mut saved = crate::clip_rule::choose(&default, dog).config.at_fps(30.0);
-        saved.data.root_layout = sinmdm::motion::RootLayout::Heading;
+        let (default, saved) = the_default_and_a_dog_run_it_saved(409, 0.76);
         assert_eq!(saved.training.frames_per_step, Some(818));
         assert_eq!(
             saved.resume_difference(&default.for_resume(&saved, 30.0)),
