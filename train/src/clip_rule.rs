@@ -387,6 +387,9 @@ fn batch_line(
         None if frames > budget => format!(
             "batch           {theirs} (the configuration's): each item a random window of the longer clip"
         ),
+        None if items < BATCH_ITEMS_MULTIPLE => format!(
+            "batch           {theirs} (the configuration's): a single copy is left alone, as a second would double a step's frames"
+        ),
         None => format!(
             "batch           {theirs} (the configuration's): a multiple of {BATCH_ITEMS_MULTIPLE}, which the cores share evenly"
         ),
@@ -580,6 +583,33 @@ mod tests {
         assert_eq!(
             choose(&config, even).config.training.frames_per_step,
             Some(budget)
+        );
+        // Each line says why its count stands: 2 copies of 527 frames are already a pair, 1 of
+        // 818 a single copy, and a clip of 1 054 frames trains one window of it a step.
+        let batch_line_of = |frames: usize| {
+            let clip = ClipReading { frames, ..dog };
+            let choice = choose(&config, clip);
+            assert_eq!(choice.config.training.frames_per_step, Some(budget));
+            choice
+                .lines
+                .into_iter()
+                .find(|l| l.starts_with("batch"))
+                .unwrap()
+        };
+        let line = batch_line_of(527);
+        assert!(
+            line.starts_with("batch           2 items") && line.contains("a multiple of 2"),
+            "{line}"
+        );
+        let line = batch_line_of(818);
+        assert!(
+            line.starts_with("batch           1 items") && line.contains("a single copy"),
+            "{line}"
+        );
+        let line = batch_line_of(1054);
+        assert!(
+            line.starts_with("batch           1 items") && line.contains("a random window"),
+            "{line}"
         );
     }
 
