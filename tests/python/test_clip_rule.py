@@ -2,6 +2,7 @@
 trainer reads before training, against the benchmark's measure computed with numpy from the
 features `sinmdm encode` writes, and the choice the default makes from it."""
 
+import math
 import re
 import subprocess
 
@@ -155,3 +156,47 @@ def test_a_varied_clip_whose_copies_would_be_odd_trains_them_in_pairs():
     assert re.search(r"^steps +\d+ \(batch 2 x the whole clip\)", out, re.M), out
     assert re.search(r"batch +2 items of the clip's 368 frames, 736 frames a step: the "
                      r"configuration's 1024 would make 3", out), out
+
+
+def lying_dog_bvh(lying, standing):
+    """A four-legged figure (Y-up) that lies for `lying` frames, its legs folded forward at its
+    hips' height (6 over the floor) and its tail sloping down to the floor, then stands for
+    `standing` frames on its four paws (End Sites on the floor), hips 32 up, tail level."""
+    legs = [("FrontLeft", 8, 20), ("FrontRight", -8, 20), ("HindLeft", 8, -20), ("HindRight", -8, -20)]
+    rot = "CHANNELS 3 Zrotation Xrotation Yrotation"
+    lines = ["HIERARCHY", "ROOT Hips", "{", "OFFSET 0 0 0",
+             "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",
+             "JOINT Neck", "{", "OFFSET 0 10 25", rot, "End Site", "{", "OFFSET 0 5 0", "}", "}"]
+    for name, x, z in legs:
+        lines += [f"JOINT {name}UpLeg", "{", f"OFFSET {x} 0 {z}", rot,
+                  f"JOINT {name}Leg", "{", "OFFSET 0 -15 0", rot,
+                  f"JOINT {name}Paw", "{", "OFFSET 0 -15 0", rot,
+                  "End Site", "{", "OFFSET 0 -2 0", "}", "}", "}", "}"]
+    lines += ["JOINT Tail", "{", "OFFSET 0 0 -20", rot, "JOINT Tail1", "{", "OFFSET 0 0 -20", rot,
+              "End Site", "{", "OFFSET 0 0 -5", "}", "}", "}", "}"]
+    # Tail, Tail1 and End Site reach 45 back; turned down by asin(6 / 45) the end meets the floor.
+    tail_down = -math.degrees(math.asin(6 / 45))
+    # Hips (6 channels), neck, then each leg's UpLeg (turned -90 about X: the leg points
+    # forward), Leg and Paw, then Tail and Tail1.
+    lie = [0, 6, 0, 0, 0, 0] + [0, 0, 0] + ([0, -90, 0] + [0, 0, 0] * 2) * 4 + [0, tail_down, 0, 0, 0, 0]
+    stand = [0, 32, 0, 0, 0, 0] + [0, 0, 0] * 15
+    lines += ["MOTION", f"Frames: {lying + standing}", "Frame Time: 0.0333333"]
+    lines += [" ".join(f"{v:.6f}" for v in (lie if f < lying else stand))
+              for f in range(lying + standing)]
+    return "\n".join(lines) + "\n"
+
+
+def test_a_figure_that_lies_most_of_the_clip_stands_on_its_paws(tmp_path, sinmdm):
+    # Lying for 80 frames of 100, the tail is the frame's lowest point in 80 and the folded paws
+    # are 6 over the floor (the height is about 24, the tolerance 0.05 of it); standing for 20,
+    # the paws are on the floor. Over every frame the tail would be the one chain end at the
+    # ground in a quarter of them (80 against the paws' 20); over the frames the figure stands
+    # in (its hips 32 up, against 6 lying: under 0.35 of that), the paws are, in all of them.
+    clip = tmp_path / "lying_dog.bvh"
+    clip.write_text(lying_dog_bvh(80, 20))
+    out = sinmdm("inspect", clip, "--up", "y")
+    contacts = re.search(r"^contacts +(.*) \(in contact", out, re.M)
+    assert contacts, out
+    named = [part.rsplit(" ", 1)[0] for part in contacts.group(1).split(", ")]
+    assert sorted(named) == sorted(f"{leg}Paw" for leg in
+                                   ("FrontLeft", "FrontRight", "HindLeft", "HindRight")), out
