@@ -174,8 +174,9 @@ def lying_dog_bvh(lying, standing):
                   "End Site", "{", "OFFSET 0 -2 0", "}", "}", "}", "}"]
     lines += ["JOINT Tail", "{", "OFFSET 0 0 -20", rot, "JOINT Tail1", "{", "OFFSET 0 0 -20", rot,
               "End Site", "{", "OFFSET 0 0 -5", "}", "}", "}", "}"]
-    # Tail, Tail1 and End Site reach 45 back; turned down by asin(6 / 45) the end meets the floor.
-    tail_down = -math.degrees(math.asin(6 / 45))
+    # The Tail joint sits 20 behind the hips at their height; turned down by asin(6 / 25), what
+    # hangs from it (Tail1 20 and its End Site 5) brings the tail's end to the floor.
+    tail_down = -math.degrees(math.asin(6 / 25))
     # Hips (6 channels), neck, then each leg's UpLeg (turned -90 about X: the leg points
     # forward), Leg and Paw, then Tail and Tail1.
     lie = [0, 6, 0, 0, 0, 0] + [0, 0, 0] + ([0, -90, 0] + [0, 0, 0] * 2) * 4 + [0, tail_down, 0, 0, 0, 0]
@@ -188,7 +189,7 @@ def lying_dog_bvh(lying, standing):
 
 def test_a_figure_that_lies_most_of_the_clip_stands_on_its_paws(tmp_path, sinmdm):
     # Lying for 80 frames of 100, the tail is the frame's lowest point in 80 and the folded paws
-    # are 6 over the floor (the height is about 24, the tolerance 0.05 of it); standing for 20,
+    # are 6 over the floor (the height is about 26, the tolerance 0.05 of it); standing for 20,
     # the paws are on the floor. Over every frame the tail would be the one chain end at the
     # ground in a quarter of them (80 against the paws' 20); over the frames the figure stands
     # in (its hips 32 up, against 6 lying: under 0.35 of that), the paws are, in all of them.

@@ -367,7 +367,9 @@ fn batch_line(
             "batch           {items} copies of the whole clip (the configuration's batch_size; it sets no frames_per_step)"
         );
     };
-    let theirs = format!("{items} items of the clip's {frames} frames from {budget} frames a step");
+    let noun = if items == 1 { "item" } else { "items" };
+    let theirs =
+        format!("{items} {noun} of the clip's {frames} frames from {budget} frames a step");
     if !asked {
         return format!("batch           {theirs} ({kept})");
     }
@@ -387,7 +389,7 @@ fn batch_line(
         None if frames > budget => format!(
             "batch           {theirs} (the configuration's): each item a random window of the longer clip"
         ),
-        None if items < BATCH_ITEMS_MULTIPLE => format!(
+        None if items == 1 => format!(
             "batch           {theirs} (the configuration's): a single copy is left alone, as a second would double a step's frames"
         ),
         None => format!(
@@ -603,12 +605,12 @@ mod tests {
         );
         let line = batch_line_of(818);
         assert!(
-            line.starts_with("batch           1 items") && line.contains("a single copy"),
+            line.starts_with("batch           1 item of") && line.contains("a single copy"),
             "{line}"
         );
         let line = batch_line_of(1054);
         assert!(
-            line.starts_with("batch           1 items") && line.contains("a random window"),
+            line.starts_with("batch           1 item of") && line.contains("a random window"),
             "{line}"
         );
     }

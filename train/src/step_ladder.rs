@@ -125,7 +125,8 @@ impl RungCheck {
 /// goal no rung meets does not give up a second goal for it (the fox's idle replays whatever
 /// the steps, 1.66-2.06 s; its 75-step rung replayed 0.15 s less than the 50-step one at 2.28x
 /// the clip's jitter against 1.42x). Fewer steps on a tie. `None` when no rung covers the clip
-/// (it is not calm after all).
+/// (it is not calm after all); where one does, the rung chosen may still be one a hair under
+/// coverage, when the covering rungs miss the other goals by more.
 pub fn choose(rungs: &[RungCheck]) -> Option<&RungCheck> {
     if !rungs.iter().any(RungCheck::covers) {
         return None;
@@ -388,7 +389,7 @@ pub fn start_run(
             let why = if best.meets_goals() {
                 "the rung of the step ladder that meets every goal with the widest margin"
             } else {
-                "no rung of the step ladder meets every goal; this one misses them least"
+                "no rung of the step ladder meets every goal; this one misses them by least in all"
             };
             let mut lines = choice.lines;
             for line in lines.iter_mut().filter(|l| l.starts_with("steps ")) {

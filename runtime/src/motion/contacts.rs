@@ -24,7 +24,7 @@ pub struct ContactConfig {
     /// Joint names to label. `None` chooses automatically ([`choose_contact_joints`]): the
     /// chain ends (joints without child joints) whose contact point comes within
     /// `ground_fraction` of the skeleton height of the frame's lowest point in at least
-    /// [`GROUND_SHARE`] of the frames.
+    /// [`GROUND_SHARE`] of the frames in which the figure stands ([`standing_frames`]).
     pub joints: Option<Vec<String>>,
     /// A joint is in contact while its speed is below this many skeleton heights per second.
     pub speed_threshold: f64,
@@ -42,8 +42,8 @@ impl Default for ContactConfig {
     }
 }
 
-/// The share of a clip's frames in which a chain end must be at the ground to be a contact
-/// joint. A foot carries the body in a third of the frames or more (a dog's paw at a run 0.33,
+/// The share of the frames a figure stands in ([`standing_frames`]) in which a chain end must be
+/// at the ground to be a contact joint. A foot carries the body in a third of the frames or more (a dog's paw at a run 0.33,
 /// a human's toe at a walk 0.5-0.97, an idle fox's paws all of them); a chain end that only
 /// touches the ground now and then does not (a running dog's nose 0.02, the tail of a dog that
 /// lies down for a second and then walks 0.13).
@@ -107,8 +107,9 @@ pub fn standing_frames(
         .iter()
         .map(|pose| height_of(pose.joints[root]) - lowest_point(pose))
         .collect();
+    // `f64::max` passes over a NaN lift, so no lift at all leaves the fold at minus infinity.
     let highest = lift.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if highest.is_nan() || highest <= ground_fraction * height {
+    if highest <= ground_fraction * height {
         return vec![true; poses.len()];
     }
     lift.iter()
@@ -414,11 +415,11 @@ mod tests {
             vec![1, 2]
         );
         // A tail on the ground in a quarter of the frames or more counts (3 of 11).
-        let mut lying = poses.clone();
-        lying.truncate(8);
-        lying.extend(vec![at([0.15, 0.05, 0.05, 0.2, -0.1]); 3]);
+        let mut sitting = poses.clone();
+        sitting.truncate(8);
+        sitting.extend(vec![at([0.15, 0.05, 0.05, 0.2, -0.1]); 3]);
         assert_eq!(
-            choose_contact_joints(&skeleton, &lying, 1.0, 0.05),
+            choose_contact_joints(&skeleton, &sitting, 1.0, 0.05),
             vec![1, 2, 4]
         );
     }
