@@ -13,6 +13,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::fk::GlobalPose;
+use super::ground::lowest_point;
 use super::math::Vec3;
 use super::skeleton::Skeleton;
 use super::up::{height_of, horizontal};
@@ -86,11 +87,6 @@ pub fn choose_contact_joints(
         .filter(|&(_, count)| count > 0 && count as f64 >= needed)
         .map(|(leaf, _)| leaf)
         .collect()
-}
-
-/// The height of a pose's lowest point (every joint and End Site).
-fn lowest_point(pose: &GlobalPose) -> f64 {
-    pose.points().map(height_of).fold(f64::INFINITY, f64::min)
 }
 
 /// Whether the figure stands in each frame ([`STANDING_ROOT_SHARE`]). A root that never rises

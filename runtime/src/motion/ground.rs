@@ -7,6 +7,11 @@ use crate::motion::up::height_of;
 /// enough to be the floor, robust to a few frames of a foot through it.
 pub const GROUND_PERCENTILE: f64 = 5.0;
 
+/// The height of a canonical-frame pose's lowest point (every joint and End Site).
+pub fn lowest_point(pose: &GlobalPose) -> f64 {
+    pose.points().map(height_of).fold(f64::INFINITY, f64::min)
+}
+
 /// The ground level of canonical-frame `poses`: the [`GROUND_PERCENTILE`]th percentile of each
 /// frame's lowest contact point of `contact_joints`, or of its lowest point of all when there
 /// are no contact joints. 0 for no frames.
@@ -15,7 +20,7 @@ pub fn ground_level(contact_joints: &[usize], poses: &[GlobalPose]) -> f64 {
         .iter()
         .map(|pose| {
             if contact_joints.is_empty() {
-                pose.points().map(height_of).fold(f64::INFINITY, f64::min)
+                lowest_point(pose)
             } else {
                 contact_joints
                     .iter()

@@ -6,14 +6,14 @@ use std::ops::Range;
 
 use super::chain::{LegChain, leg_chain};
 use super::options::{Kept, PlantOptions, PlantStats};
-use super::solve::{Wanted, lowest, smooth_upper_envelope, solve_frame};
+use super::solve::{Wanted, smooth_upper_envelope, solve_frame};
 use super::spans::contact_spans;
 use super::stance::stance_travel;
 use super::targets::{ChainTrack, chain_targets, grow_spans};
 use crate::motion::clip::LocalMotion;
 use crate::motion::features::{FeatureLayout, MotionError};
 use crate::motion::fk::{GlobalPose, global_pose, global_poses};
-use crate::motion::ground::ground_level;
+use crate::motion::ground::{ground_level, lowest_point};
 use crate::motion::math::Vec3;
 use crate::motion::up::{UP, height_of, horizontal, to_canonical, to_file};
 
@@ -293,7 +293,7 @@ impl<'a> Planting<'a> {
                 &frame_targets(f),
                 self.options,
             );
-            *need = (ground - lowest(&solved)).max(0.0);
+            *need = (ground - lowest_point(&solved)).max(0.0);
         }
         let lift = smooth_upper_envelope(&deficit, self.blend_frames());
         let (mut miss_sum, mut miss_count) = (0.0, 0usize);
@@ -309,7 +309,7 @@ impl<'a> Planting<'a> {
                 self.options,
             );
             let mut total_lift = shift;
-            let rest = ground - lowest(&solved);
+            let rest = ground - lowest_point(&solved);
             if rest > 0.0 && free {
                 // What the smooth lift and the legs could not fix: lift the root the rest.
                 out.translations[f * out.skeleton.len() + top][UP] += rest;

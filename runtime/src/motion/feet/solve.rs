@@ -8,7 +8,7 @@ use crate::motion::fk::{GlobalPose, global_pose};
 use crate::motion::ik::{TurnChain, least_turn};
 use crate::motion::math::{self, Mat3, Vec3};
 use crate::motion::skeleton::Skeleton;
-use crate::motion::up::{UP, height_of};
+use crate::motion::up::UP;
 
 use super::options::PlantOptions;
 
@@ -124,11 +124,6 @@ fn soften(top: Vec3, current: Vec3, goal: Vec3, reach: f64, share: f64) -> Vec3 
     }
     let wanted = (d0 + eased(d) - eased(d0)).min(d.max(d0));
     top + (offset * (wanted / d))
-}
-
-/// The lowest height of a pose's joints and End Sites.
-pub(super) fn lowest(pose: &GlobalPose) -> f64 {
-    pose.points().map(height_of).fold(f64::INFINITY, f64::min)
 }
 
 /// An envelope at least `values` everywhere that rises and falls over `radius` frames: a
