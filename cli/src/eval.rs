@@ -341,11 +341,20 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     println!();
     print!("{}", feet.markdown_table());
     println!();
-    println!(
+    print!(
         "replay: the samples' longest verbatim copies of the clip (frames within {} root-mean-square \
          per 6D component) last {:.2} s on average, {:.2} s at most",
         replay.tolerance, replay.mean_seconds, replay.max_seconds
     );
+    // A clip that holds a pose still puts a floor under the figure: say how high.
+    if replay.clip_hold_frames > 1 {
+        print!(
+            "; the clip itself holds one pose for {:.2} s, which a sample that holds it as long is \
+             counted to copy",
+            replay.clip_hold_seconds
+        );
+    }
+    println!();
 
     let beats = match &dance {
         Some(dance) => {

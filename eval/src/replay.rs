@@ -7,6 +7,11 @@
 //! frame, each pair within [`REPLAY_TOLERANCE`]; the sample's replay is its longest such run,
 //! and a model's is the mean over its samples (at most 1 s is the goal for calm clips).
 //!
+//! A clip that holds one pose still for a while sets a floor under the measure: a sample that
+//! holds that pose as long as the clip does matches the clip's consecutive held frames, one by
+//! one, so its faithful hold counts as a copy of that length. [`longest_hold`] reads that floor
+//! off the clip, and the report gives it beside the samples' runs.
+//!
 //! Frames are compared by their 6D joint rotations alone (contact labels and root motion are
 //! left out), as the root-mean-square difference per 6D component: a 6D component is a unit
 //! vector's coordinate, so 0.05 is about 3 degrees of rotation on every joint, a distance that
@@ -61,6 +66,29 @@ pub fn longest_replay(
     longest
 }
 
+/// The longest the clip holds one of its own poses: the most consecutive `clip` frames (rows are
+/// frames) that all lie within `tolerance` root-mean-square per column of one clip frame. A
+/// sample that holds that pose as long copies those frames by [`longest_replay`]'s measure, so
+/// this is the verbatim run a faithful hold is counted. 0 for an empty clip.
+pub fn longest_hold(clip: ArrayView2<'_, f64>, tolerance: f64) -> usize {
+    let width = clip.ncols().max(1) as f64;
+    let limit = tolerance * tolerance * width;
+    let mut longest = 0;
+    for pose in clip.rows() {
+        let mut run = 0;
+        for frame in clip.rows() {
+            let sq: f64 = pose
+                .iter()
+                .zip(frame.iter())
+                .map(|(p, q)| (p - q) * (p - q))
+                .sum();
+            run = if sq <= limit { run + 1 } else { 0 };
+            longest = longest.max(run);
+        }
+    }
+    longest
+}
+
 /// The replay of a set of samples against their clip.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ReplayReport {
@@ -74,6 +102,13 @@ pub struct ReplayReport {
     pub mean_seconds: f64,
     /// The longest run of any sample, in seconds.
     pub max_seconds: f64,
+    /// The longest the clip holds one pose ([`longest_hold`]), in frames: a sample that holds
+    /// it as long is counted a copy this long.
+    #[serde(default)]
+    pub clip_hold_frames: usize,
+    /// The same, in seconds.
+    #[serde(default)]
+    pub clip_hold_seconds: f64,
 }
 
 impl ReplayReport {
@@ -110,12 +145,15 @@ impl ReplayReport {
             longest_frames.iter().map(|&f| seconds(f)).sum::<f64>() / longest_frames.len() as f64
         };
         let max_seconds = longest_frames.iter().copied().max().map_or(0.0, seconds);
+        let clip_hold_frames = longest_hold(clip, tolerance);
         ReplayReport {
             tolerance,
             fps,
             longest_frames,
             mean_seconds,
             max_seconds,
+            clip_hold_frames,
+            clip_hold_seconds: seconds(clip_hold_frames),
         }
     }
 }
@@ -179,6 +217,25 @@ mod tests {
     }
 
     #[test]
+    fn a_held_pose_is_the_longest_run_of_frames_near_one_of_them() {
+        // Frames 10..40 hold frame 10's pose, every other one off it by 0.04 on every column
+        // (within 0.05 of it, and of each other).
+        let mut clip = distinct_clip(60, 6);
+        let pose = clip.row(10).to_owned();
+        for (i, frame) in (10..40).enumerate() {
+            let wobble = if i % 2 == 0 { 0.0 } else { 0.04 };
+            clip.row_mut(frame).assign(&pose.mapv(|v| v + wobble));
+        }
+        assert_eq!(longest_hold(clip.view(), 0.05), 30);
+        // A sample that holds the pose 30 frames copies the held frames one by one.
+        let held = Array2::from_shape_fn((30, 6), |(_, c)| pose[c]);
+        assert_eq!(longest_replay(held.view(), clip.view(), 0.05), 30);
+        // Under a tighter tolerance no two consecutive frames are alike: the hold is one frame.
+        assert_eq!(longest_hold(clip.view(), 0.03), 1);
+        assert_eq!(longest_hold(clip.slice(s![..0, ..]), 0.05), 0);
+    }
+
+    #[test]
     fn the_report_gives_seconds() {
         let clip = distinct_clip(60, 6);
         let copy = |len: usize| {
@@ -191,5 +248,10 @@ mod tests {
         assert_eq!(report.longest_frames, vec![30, 60]);
         assert!((report.mean_seconds - 1.5).abs() < 1e-12);
         assert!((report.max_seconds - 2.0).abs() < 1e-12);
+        assert_eq!(
+            report.clip_hold_frames, 1,
+            "no two frames of the clip alike"
+        );
+        assert!((report.clip_hold_seconds - 1.0 / 30.0).abs() < 1e-12);
     }
 }

@@ -22,7 +22,7 @@ MANY_FEET = 3
 MANY_FEET_WINDOW = 7
 MANY_FEET_CHANNELS = 96
 MANY_FEET_STEPS = 13000
-DEFAULT_DROPOUT = 0.2
+MANY_FEET_DROPOUT = 0.3
 DEFAULT_CHANNELS = 64
 DEFAULT_STEPS = 17000
 # A step's cost grows with the QnA window k as 10 + k; steps fitted to a wider window are rounded
@@ -106,7 +106,7 @@ def test_the_default_reads_the_clip_as_numpy_does(clip, tmp_path, sinmdm):
             assert window.group(1) == str(MANY_FEET_WINDOW), out
             assert int(channels.group(1)) == MANY_FEET_CHANNELS, out
             assert int(steps.group(1)) == MANY_FEET_STEPS, out
-            assert f"dropout         {DEFAULT_DROPOUT} (the configuration's): on {feet} feet" in out, out
+            assert f"dropout         {MANY_FEET_DROPOUT}: on {feet} feet" in out, out
         else:
             assert window.group(1) == str(VARIED_WINDOW), out
             assert int(channels.group(1)) == DEFAULT_CHANNELS, out

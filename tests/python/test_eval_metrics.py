@@ -119,6 +119,20 @@ def longest_replay(sample, clip, tolerance):
     return best
 
 
+def longest_hold(clip, tolerance):
+    """The most consecutive clip frames within `tolerance` root-mean-square per column of one clip
+    frame: every pose tried against every run of frames, walked frame by frame."""
+    best = 0
+    for pose in clip:
+        near = np.sqrt(((clip - pose) ** 2).mean(axis=1)) <= tolerance
+        for start in range(len(clip)):
+            n = 0
+            while start + n < len(clip) and near[start + n]:
+                n += 1
+            best = max(best, n)
+    return best
+
+
 def test_eval_replay_matches_a_naive_search(tmp_path):
     """The replay figure against every start pair walked in numpy, at the default tolerance and
     at a loose one under which the tiny model's samples do copy stretches of the clip."""
@@ -127,7 +141,7 @@ def test_eval_replay_matches_a_naive_search(tmp_path):
     done = run("encode", WALK, "-m", MODEL, "-o", clip_json)
     assert done.returncode == 0, done.stderr
     clip = rotations(clip_json)[0]
-    longest = {}
+    longest, holds = {}, {}
     for tolerance in (0.05, 0.6):
         scores_json = tmp_path / f"scores_{tolerance}.json"
         done = run("eval", "-m", MODEL, "--clip", WALK, "--samples", 3, "--frames", 80, "--steps", 5,
@@ -142,6 +156,13 @@ def test_eval_replay_matches_a_naive_search(tmp_path):
         fps = replay["fps"]
         assert abs(replay["mean_seconds"] - np.mean(expected) / fps) < 1e-12
         assert abs(replay["max_seconds"] - max(expected) / fps) < 1e-12
+        hold = longest_hold(clip, tolerance)
+        assert replay["clip_hold_frames"] == hold, tolerance
+        assert abs(replay["clip_hold_seconds"] - hold / fps) < 1e-12
+        holds[tolerance] = hold
         longest[tolerance] = expected
-    # The loose tolerance finds copies, so the comparison above checked real runs.
+    # The loose tolerance finds copies, so the comparison above checked real runs; and the walk
+    # stands still for a while before it walks, so at the default tolerance its hold is a real
+    # run of frames, neither one frame nor the whole clip.
     assert max(longest[0.6]) >= 2, longest
+    assert 2 <= holds[0.05] < len(clip), holds

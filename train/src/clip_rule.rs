@@ -19,9 +19,10 @@
 //!     a biped keep too little of the clip (a fifth of a dog's one-second windows are never
 //!     made): the legs' phases must hold over a longer span, and the network needs the width to
 //!     hold four legs' phases at once. It trains the wider window [`MANY_FEET_WINDOW`] with
-//!     [`MANY_FEET_CHANNELS`] channels and the configuration's dropout (more dropout costs it
-//!     coverage), for [`MANY_FEET_STEPS`] steps, which the wider network's steps fit in the
-//!     time 17 000 of the configuration's take.
+//!     [`MANY_FEET_CHANNELS`] channels and a little more dropout ([`MANY_FEET_DROPOUT`]: a dog
+//!     that stands still between its walk and its run is not varied enough with less, and more
+//!     costs a dog's walk coverage), for [`MANY_FEET_STEPS`] steps, which the wider network's
+//!     steps fit in the time 17 000 of the configuration's take.
 //!
 //!   A varied clip's steps are meant at 30 fps. Learned at a higher rate, its window follows the
 //!   frame rate and a step costs more ([`window_step_cost`]), so its steps fall to those that fit
@@ -63,6 +64,12 @@ pub const MANY_FEET_WINDOW: usize = 7;
 /// Channels of a varied clip on [`MANY_FEET`] feet or more (never fewer than the
 /// configuration's).
 pub const MANY_FEET_CHANNELS: usize = 96;
+/// Dropout of a varied clip on [`MANY_FEET`] feet or more (chosen on clips at the default's
+/// 30 fps, and trained at any rate): at the configuration's 0.2 a dog that walks, stands and runs
+/// keeps too little global diversity (1.185), and more costs a dog's walk coverage (95.7 at 0.3,
+/// 94.4 at its own 60 fps with 0.25, 92.5 with 0.3; docs/TRAINING_EXPERIMENTS.md, "The default's
+/// frame rate, and a dog's dropout").
+pub const MANY_FEET_DROPOUT: f64 = 0.3;
 /// Steps of a varied clip on [`MANY_FEET`] feet or more whose channels the rule widened (at most
 /// the configuration's): a step of 96 channels at window 7 costs about 0.04 s on 2 cores, so the
 /// run takes what 17 000 steps of 64 channels at window 11 took (8.5-9 minutes).
@@ -285,10 +292,13 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
             "dropout         {} (the configuration's): the rule raises only a varied clip's",
             config.model.dropout
         ),
-        (true, false) if reading.has_many_feet() => format!(
-            "dropout         {} (the configuration's): on {} feet, more dropout costs a varied clip coverage",
-            config.model.dropout, reading.feet
-        ),
+        (true, false) if reading.has_many_feet() => {
+            out.model.dropout = MANY_FEET_DROPOUT;
+            format!(
+                "dropout         {MANY_FEET_DROPOUT}: on {} feet, keeps a varied clip's samples varied (more costs it coverage)",
+                reading.feet
+            )
+        }
         (true, false) => {
             out.model.dropout = VARIED_DROPOUT;
             format!(
@@ -667,14 +677,18 @@ mod tests {
         let out = &choice.config;
         assert_eq!(out.model.window, MANY_FEET_WINDOW);
         assert_eq!(out.model.channels, MANY_FEET_CHANNELS);
-        assert_eq!(out.model.dropout, config.model.dropout);
+        assert_eq!(out.model.dropout, MANY_FEET_DROPOUT);
+        assert!(
+            config.model.dropout < MANY_FEET_DROPOUT && MANY_FEET_DROPOUT < VARIED_DROPOUT,
+            "more than the configuration's, less than a biped's"
+        );
         assert_eq!(out.training.steps, MANY_FEET_STEPS);
         assert!(MANY_FEET_STEPS < config.training.steps);
         assert_eq!(out.training.warmup_steps, config.training.warmup_steps);
         assert!(
             choice.lines[1].contains("13000: the 96 channels below cost more a step")
                 && choice.lines[2].contains("on 4 feet")
-                && choice.lines[3].contains("on 4 feet")
+                && choice.lines[3].starts_with("dropout         0.3: on 4 feet")
                 && choice.lines[4].starts_with("channels        96: on 4 feet"),
             "{:?}",
             choice.lines
@@ -800,7 +814,8 @@ mod tests {
         let varied = choose(&config, reading(0.9));
         assert_eq!(varied.config.model.window, config.model.window);
         assert_eq!(varied.config.model.dropout, config.model.dropout);
-        // Not asked for the channels, a dog keeps the configuration's width and steps.
+        // Not asked for the channels or the dropout, a dog keeps the configuration's width, steps
+        // and dropout.
         let dog = choose(
             &config,
             ClipReading {
@@ -810,6 +825,7 @@ mod tests {
         );
         assert_eq!(dog.config.model.channels, config.model.channels);
         assert_eq!(dog.config.training.steps, config.training.steps);
+        assert_eq!(dog.config.model.dropout, config.model.dropout);
         assert!(
             varied
                 .lines
