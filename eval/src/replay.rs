@@ -17,7 +17,7 @@
 //! vector's coordinate, so 0.05 is about 3 degrees of rotation on every joint, a distance that
 //! does not grow with the skeleton's joint count.
 
-use ndarray::{Array2, ArrayView2, ArrayView3};
+use ndarray::{Array2, ArrayView1, ArrayView2, ArrayView3};
 use serde::{Deserialize, Serialize};
 
 use sinmdm::motion::{ColumnKind, FeatureLayout};
@@ -34,6 +34,30 @@ pub fn rotation_rows(layout: &FeatureLayout, features: ArrayView2<'_, f32>) -> A
     })
 }
 
+/// Whether one frame copies another: within a tolerance root-mean-square per column, compared
+/// as a sum of squares, so no square root per pair.
+struct FrameMatch {
+    /// The largest sum of squared differences that still copies.
+    limit: f64,
+}
+
+impl FrameMatch {
+    fn new(tolerance: f64, columns: usize) -> Self {
+        FrameMatch {
+            limit: tolerance * tolerance * columns.max(1) as f64,
+        }
+    }
+
+    fn copies(&self, a: ArrayView1<'_, f64>, b: ArrayView1<'_, f64>) -> bool {
+        let mut sq = 0.0;
+        for (p, q) in a.iter().zip(b.iter()) {
+            let d = p - q;
+            sq += d * d;
+        }
+        sq <= self.limit
+    }
+}
+
 /// The longest run of consecutive `sample` frames that copy consecutive `clip` frames (rows are
 /// frames, both with the same columns), each pair within `tolerance` root-mean-square per
 /// column. 0 when no frame is that close.
@@ -43,9 +67,7 @@ pub fn longest_replay(
     tolerance: f64,
 ) -> usize {
     assert_eq!(sample.ncols(), clip.ncols(), "feature widths differ");
-    let width = sample.ncols().max(1) as f64;
-    // Compared as sums of squares, so no square root per pair.
-    let limit = tolerance * tolerance * width;
+    let alike = FrameMatch::new(tolerance, clip.ncols());
     let clip_frames = clip.nrows();
     // run[k + 1]: length of the copy ending at the previous sample frame and clip frame k.
     let mut previous = vec![0usize; clip_frames + 1];
@@ -53,12 +75,11 @@ pub fn longest_replay(
     let mut longest = 0;
     for a in sample.rows() {
         for (k, b) in clip.rows().into_iter().enumerate() {
-            let mut sq = 0.0;
-            for (p, q) in a.iter().zip(b.iter()) {
-                let d = p - q;
-                sq += d * d;
-            }
-            current[k + 1] = if sq <= limit { previous[k] + 1 } else { 0 };
+            current[k + 1] = if alike.copies(a, b) {
+                previous[k] + 1
+            } else {
+                0
+            };
             longest = longest.max(current[k + 1]);
         }
         std::mem::swap(&mut previous, &mut current);
@@ -71,18 +92,16 @@ pub fn longest_replay(
 /// sample that holds that pose as long copies those frames by [`longest_replay`]'s measure, so
 /// this is the verbatim run a faithful hold is counted. 0 for an empty clip.
 pub fn longest_hold(clip: ArrayView2<'_, f64>, tolerance: f64) -> usize {
-    let width = clip.ncols().max(1) as f64;
-    let limit = tolerance * tolerance * width;
+    let alike = FrameMatch::new(tolerance, clip.ncols());
     let mut longest = 0;
     for pose in clip.rows() {
         let mut run = 0;
         for frame in clip.rows() {
-            let sq: f64 = pose
-                .iter()
-                .zip(frame.iter())
-                .map(|(p, q)| (p - q) * (p - q))
-                .sum();
-            run = if sq <= limit { run + 1 } else { 0 };
+            run = if alike.copies(pose, frame) {
+                run + 1
+            } else {
+                0
+            };
             longest = longest.max(run);
         }
     }
