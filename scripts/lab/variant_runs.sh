@@ -22,19 +22,11 @@ train=target/release/sinmdm-train
 export_bin=target/release/sinmdm-export
 sinmdm=target/release/sinmdm
 
-declare -A files=(
-  [human_kick_bandai]=human_kick_bandai_kick_normal_001.bvh
-  [human_walk_happy_bandai]=human_walk_happy_bandai_001.bvh
-  [human_walk_sad_bandai]=human_walk_sad_bandai_001.bvh
-  [dog_run_mann]=dog_run_mann_d1_010_kan01_004.bvh
-  [human_zombie_walk_fair]=human_zombie_walk_fair.bvh
-  [fox_survey_khronos]=fox_survey_khronos.bvh
-  [human_dance_rokoko]=human_dance_rokoko_jesse.bvh
-  [human_walk_cmu]=human_walk_cmu_131_01.bvh
-  [human_hop_cmu]=human_hop_cmu_131_03.bvh
-  [dog_walk_mann]=dog_walk_mann_d1_047z_kan01_004.bvh
-  [dog_walk_mann_60fps]=dog_walk_mann_d1_047z_kan01_004.bvh
-)
+source scripts/lab/project_clips.sh
+declare -A files=()
+for name in "${!project_clip_files[@]}"; do files[$name]=${project_clip_files[$name]}; done
+# The dog walk learned at its own 60 fps (--fps clip, below).
+files[dog_walk_mann_60fps]=${files[dog_walk_mann]}
 clips=${CLIPS:-"${!files[*]}"}
 for name in $clips; do
   if [[ $name == *=* ]]; then
