@@ -354,6 +354,13 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             replay.clip_hold_seconds
         );
     }
+    // So does a clip that moves slowly: motion that is not a copy still matches it for a while.
+    if replay.clip_backwards_frames > 1 {
+        print!(
+            "; the clip played backwards, which is no copy, scores {:.2} s",
+            replay.clip_backwards_seconds
+        );
+    }
     println!();
 
     let beats = match &dance {

@@ -12,12 +12,18 @@
 //! one, so its faithful hold counts as a copy of that length. [`longest_hold`] reads that floor
 //! off the clip, and the report gives it beside the samples' runs.
 //!
+//! A clip that moves slowly sets another: its frames lie so close together that motion which
+//! is plainly not the clip played back still matches it over long runs. The report scores the
+//! clip played backwards ([`longest_backwards`]) as that floor: a sample's replay no longer than
+//! what the clip backwards scores is no evidence that the sample copies it (on the fox's idle,
+//! 2.00 s).
+//!
 //! Frames are compared by their 6D joint rotations alone (contact labels and root motion are
 //! left out), as the root-mean-square difference per 6D component: a 6D component is a unit
 //! vector's coordinate, so 0.05 is about 3 degrees of rotation on every joint, a distance that
 //! does not grow with the skeleton's joint count.
 
-use ndarray::{Array2, ArrayView1, ArrayView2, ArrayView3};
+use ndarray::{Array2, ArrayView1, ArrayView2, ArrayView3, s};
 use serde::{Deserialize, Serialize};
 
 use sinmdm::motion::{ColumnKind, FeatureLayout};
@@ -108,6 +114,14 @@ pub fn longest_hold(clip: ArrayView2<'_, f64>, tolerance: f64) -> usize {
     longest
 }
 
+/// What [`longest_replay`] gives the clip played backwards against itself, in frames: motion
+/// that is not a copy, so a sample's replay no longer than this is no evidence of copying. A
+/// clip whose frames all differ scores 1 (each frame meets only itself, never two in a row); a
+/// slow one, many.
+pub fn longest_backwards(clip: ArrayView2<'_, f64>, tolerance: f64) -> usize {
+    longest_replay(clip.slice(s![..;-1, ..]), clip, tolerance)
+}
+
 /// The replay of a set of samples against their clip.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ReplayReport {
@@ -128,6 +142,13 @@ pub struct ReplayReport {
     /// The same, in seconds.
     #[serde(default)]
     pub clip_hold_seconds: f64,
+    /// What the clip played backwards scores ([`longest_backwards`]), in frames: the replay of
+    /// motion that is not a copy.
+    #[serde(default)]
+    pub clip_backwards_frames: usize,
+    /// The same, in seconds.
+    #[serde(default)]
+    pub clip_backwards_seconds: f64,
 }
 
 impl ReplayReport {
@@ -165,6 +186,7 @@ impl ReplayReport {
         };
         let max_seconds = longest_frames.iter().copied().max().map_or(0.0, seconds);
         let clip_hold_frames = longest_hold(clip, tolerance);
+        let clip_backwards_frames = longest_backwards(clip, tolerance);
         ReplayReport {
             tolerance,
             fps,
@@ -173,6 +195,8 @@ impl ReplayReport {
             max_seconds,
             clip_hold_frames,
             clip_hold_seconds: seconds(clip_hold_frames),
+            clip_backwards_frames,
+            clip_backwards_seconds: seconds(clip_backwards_frames),
         }
     }
 }
@@ -180,7 +204,7 @@ impl ReplayReport {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ndarray::{Array2, s};
+    use ndarray::Array2;
 
     /// A clip of pseudo-random values in [-1, 1]: any two of its frames differ by far more
     /// than the tolerance (about 0.8 root-mean-square).
@@ -272,5 +296,25 @@ mod tests {
             "no two frames of the clip alike"
         );
         assert!((report.clip_hold_seconds - 1.0 / 30.0).abs() < 1e-12);
+        assert_eq!(
+            report.clip_backwards_frames, 1,
+            "backwards, each frame meets only itself"
+        );
+        assert!((report.clip_backwards_seconds - 1.0 / 30.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_slow_clip_played_backwards_matches_itself_for_a_long_run() {
+        // A clip whose first 20 frames drift 0.011 a frame on every column, the rest far apart.
+        // Backwards, clip frame a meets clip frame b when both lie in the drift within 4 frames
+        // of each other (0.044; 5 frames is 0.055). Along a run a falls by one a frame and b
+        // rises by one, so a - b steps by 2: through 4, 2, 0, -2, -4 at the longest, 5 frames.
+        let mut clip = distinct_clip(50, 4);
+        for f in 0..20 {
+            clip.row_mut(f).fill(0.011 * f as f64);
+        }
+        assert_eq!(longest_backwards(clip.view(), 0.05), 5);
+        // Without the drift, backwards meets itself at single frames only.
+        assert_eq!(longest_backwards(distinct_clip(50, 4).view(), 0.05), 1);
     }
 }

@@ -141,7 +141,7 @@ def test_eval_replay_matches_a_naive_search(tmp_path):
     done = run("encode", WALK, "-m", MODEL, "-o", clip_json)
     assert done.returncode == 0, done.stderr
     clip = rotations(clip_json)[0]
-    longest, holds = {}, {}
+    longest, holds, reversed_runs = {}, {}, {}
     for tolerance in (0.05, 0.6):
         scores_json = tmp_path / f"scores_{tolerance}.json"
         done = run("eval", "-m", MODEL, "--clip", WALK, "--samples", 3, "--frames", 80, "--steps", 5,
@@ -159,10 +159,16 @@ def test_eval_replay_matches_a_naive_search(tmp_path):
         hold = longest_hold(clip, tolerance)
         assert replay["clip_hold_frames"] == hold, tolerance
         assert abs(replay["clip_hold_seconds"] - hold / fps) < 1e-12
+        backwards = longest_replay(clip[::-1], clip, tolerance)
+        assert replay["clip_backwards_frames"] == backwards, tolerance
+        assert abs(replay["clip_backwards_seconds"] - backwards / fps) < 1e-12
         holds[tolerance] = hold
+        reversed_runs[tolerance] = backwards
         longest[tolerance] = expected
     # The loose tolerance finds copies, so the comparison above checked real runs; and the walk
     # stands still for a while before it walks, so at the default tolerance its hold is a real
-    # run of frames, neither one frame nor the whole clip.
+    # run of frames, neither one frame nor the whole clip; played backwards, that stand matches
+    # itself over a run of frames too, so the backwards figure was checked on a real run.
     assert max(longest[0.6]) >= 2, longest
     assert 2 <= holds[0.05] < len(clip), holds
+    assert 2 <= reversed_runs[0.05] < len(clip), reversed_runs
