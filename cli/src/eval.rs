@@ -354,10 +354,11 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             replay.clip_hold_seconds
         );
     }
-    // So does a clip that moves slowly: motion that is not a copy still matches it for a while.
+    // So does a clip that looks alike both ways over a stretch (slow, or a move and its return):
+    // the clip played backwards, not a copy, still matches it there. One frame is the least.
     if replay.clip_backwards_frames > 1 {
         print!(
-            "; the clip played backwards, which is no copy, scores {:.2} s",
+            "; the clip played backwards (not a copy) scores {:.2} s",
             replay.clip_backwards_seconds
         );
     }

@@ -12,11 +12,11 @@
 //! one, so its faithful hold counts as a copy of that length. [`longest_hold`] reads that floor
 //! off the clip, and the report gives it beside the samples' runs.
 //!
-//! A clip that moves slowly sets another: its frames lie so close together that motion which
-//! is plainly not the clip played back still matches it over long runs. The report scores the
-//! clip played backwards ([`longest_backwards`]) as that floor: a sample's replay no longer than
-//! what the clip backwards scores is no evidence that the sample copies it (on the fox's idle,
-//! 2.00 s).
+//! A clip that looks alike both ways over a stretch (a hold, a slow passage, a move and its
+//! return) sets another: motion that is plainly not the clip played back still matches it over
+//! long runs there. The report scores the clip played backwards ([`longest_backwards`]) as that
+//! floor: a sample's replay near it is weak evidence that the sample copies the clip, one well
+//! over it strong (on the fox's slow idle the clip backwards scores 2.00 s, its samples 1.97 s).
 //!
 //! Frames are compared by their 6D joint rotations alone (contact labels and root motion are
 //! left out), as the root-mean-square difference per 6D component: a 6D component is a unit
@@ -114,10 +114,10 @@ pub fn longest_hold(clip: ArrayView2<'_, f64>, tolerance: f64) -> usize {
     longest
 }
 
-/// What [`longest_replay`] gives the clip played backwards against itself, in frames: motion
-/// that is not a copy, so a sample's replay no longer than this is no evidence of copying. A
-/// clip whose frames all differ scores 1 (each frame meets only itself, never two in a row); a
-/// slow one, many.
+/// [`longest_replay`] with the clip played backwards as the sample, against the clip, in
+/// frames: what motion that is not a copy scores on the measure, from the stretch of the clip
+/// that looks most alike both ways. 0 for an empty clip; 1 for a clip whose frames all differ
+/// (each frame meets only itself, never two in a row); a slow clip, many.
 pub fn longest_backwards(clip: ArrayView2<'_, f64>, tolerance: f64) -> usize {
     longest_replay(clip.slice(s![..;-1, ..]), clip, tolerance)
 }
@@ -136,14 +136,14 @@ pub struct ReplayReport {
     /// The longest run of any sample, in seconds.
     pub max_seconds: f64,
     /// The longest the clip holds one pose ([`longest_hold`]), in frames: a sample that holds
-    /// it as long is counted a copy this long.
+    /// it as long is counted a copy this long (0 in reports written before this field).
     #[serde(default)]
     pub clip_hold_frames: usize,
     /// The same, in seconds.
     #[serde(default)]
     pub clip_hold_seconds: f64,
-    /// What the clip played backwards scores ([`longest_backwards`]), in frames: the replay of
-    /// motion that is not a copy.
+    /// [`longest_backwards`] of the clip, in frames: the replay that the clip played backwards,
+    /// not a copy, scores (0 in reports written before this field).
     #[serde(default)]
     pub clip_backwards_frames: usize,
     /// The same, in seconds.

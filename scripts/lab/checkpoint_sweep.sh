@@ -22,17 +22,12 @@ export_bin=target/release/sinmdm-export
 sinmdm=target/release/sinmdm
 
 # name : clip file : extra sinmdm-train arguments
-all=("human_kick_bandai:human_kick_bandai_kick_normal_001.bvh:"
-     "human_walk_happy_bandai:human_walk_happy_bandai_001.bvh:"
-     "human_walk_sad_bandai:human_walk_sad_bandai_001.bvh:"
-     "dog_run_mann:dog_run_mann_d1_010_kan01_004.bvh:"
-     "human_zombie_walk_fair:human_zombie_walk_fair.bvh:"
-     "fox_survey_khronos:fox_survey_khronos.bvh:"
-     "human_dance_rokoko:human_dance_rokoko_jesse.bvh:"
-     "human_walk_cmu:human_walk_cmu_131_01.bvh:"
-     "human_hop_cmu:human_hop_cmu_131_03.bvh:"
-     "dog_walk_mann:dog_walk_mann_d1_047z_kan01_004.bvh:"
-     "dog_walk_mann_60fps:dog_walk_mann_d1_047z_kan01_004.bvh:--fps clip")
+source scripts/lab/project_clips.sh
+all=()
+for name in $(printf '%s\n' "${!project_clip_files[@]}" | sort); do
+  all+=("$name:${project_clip_files[$name]}:")
+done
+all+=("dog_walk_mann_60fps:${project_clip_files[dog_walk_mann]}:--fps clip")
 
 step_name() { printf 'step-%08d' "$1"; }
 

@@ -7,9 +7,12 @@ backwards, the clip faster or slower) can still score more than the 1 s the calm
 allows. This script scores such motion, built from the clip itself, on the same measure:
 
 - hold: the longest the clip keeps one pose (what a sample standing still as long scores);
-- backwards: the clip played in reverse;
+- backwards: the clip played in reverse (high wherever a stretch of the clip looks alike both
+  ways: a hold, a slow passage, a move and its return);
 - at 0.5x ... 3x: the clip re-timed at that speed (linear interpolation between frames); a
-  speed s multiplies the clip's accelerations, and so its jitter, by s squared;
+  speed s multiplies smooth motion's accelerations, and so about its jitter, by s squared
+  (derived, not measured here), and makes the motion 1/s times the clip's length, which caps
+  its run (the samples are twice the clip's length);
 - samples (where given): the mean over a model's samples, as `sinmdm eval` reports it.
 
 Inputs are features JSON files: a clip's from `sinmdm encode CLIP -m MODEL -o CLIP.json` (any
@@ -24,7 +27,7 @@ import json
 
 import numpy as np
 
-SPEEDS = (0.5, 1.5, 2.0, 2.5, 3.0)
+SPEEDS = (0.5, 0.8, 1.2, 1.5, 2.0, 2.5, 3.0)
 
 
 def rotations(path):
@@ -35,13 +38,21 @@ def rotations(path):
     return motions, float(data["fps"])
 
 
+def close_pairs(motion, clip, tolerance, chunk=128):
+    """Row by row, which clip frames each motion frame lies within `tolerance` root-mean-square
+    per column of (a chunk of motion frames at a time, so a long clip's differences fit in
+    memory)."""
+    for start in range(0, len(motion), chunk):
+        part = motion[start:start + chunk]
+        yield from np.sqrt(((part[:, None, :] - clip[None, :, :]) ** 2).mean(axis=2)) <= tolerance
+
+
 def longest_copy(motion, clip, tolerance):
     """Frames in the longest run motion[s..s+L] matching clip[k..k+L] pair by pair: one pass over
     the motion's frames, carrying each clip frame's current run along the diagonal."""
-    close = np.sqrt(((motion[:, None, :] - clip[None, :, :]) ** 2).mean(axis=2)) <= tolerance
     run = np.zeros(len(clip), dtype=int)
     best = 0
-    for row in close:
+    for row in close_pairs(motion, clip, tolerance):
         run = np.where(row, np.concatenate(([0], run[:-1])) + 1, 0)
         best = max(best, int(run.max()))
     return best
@@ -75,7 +86,7 @@ def main():
     parser.add_argument("--tolerance", type=float, default=0.05)
     args = parser.parse_args()
     tol = args.tolerance
-    heads = ["clip", "clip s", "hold", "backwards"] + [f"at {s:g}x" for s in SPEEDS] + ["samples"]
+    heads = ["clip", "length s", "hold", "backwards"] + [f"at {s:g}x" for s in SPEEDS] + ["samples"]
     print("| " + " | ".join(heads) + " |")
     print("|" + "---|" * len(heads))
     for item in args.clips:

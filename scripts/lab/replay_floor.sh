@@ -4,14 +4,15 @@
 # scripts/lab/replay_floor.py says what each column is.
 #
 # Usage: scripts/lab/replay_floor.sh SHARED_BVH_DIR
-# CLIPS (environment): the clip names to score, space-separated (default: the ten in
-#   SHARED_BVH_DIR); NAME=PATH scores a clip from outside the project under NAME.
-# Each clip's features come from a two-step training run on it (it only gives `sinmdm encode` the
-# skeleton's layout), in out/replay_floor/.
+# CLIPS (environment): the clip names to score, space-separated (default: the ten of
+#   scripts/lab/project_clips.sh); NAME=PATH scores a clip from outside the project under NAME.
+# OUT (environment): where the runs and features go (default out/replay_floor). Each clip's
+# features come from a two-step training run on it (it only gives `sinmdm encode` the skeleton's
+# layout); a clip already there is not run again.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 shared=${1:?usage: replay_floor.sh SHARED_BVH_DIR}
-out=out/replay_floor
+out=${OUT:-out/replay_floor}
 mkdir -p "$out"
 source scripts/lab/project_clips.sh
 config=$out/two_steps.yaml

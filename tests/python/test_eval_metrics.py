@@ -167,8 +167,9 @@ def test_eval_replay_matches_a_naive_search(tmp_path):
         longest[tolerance] = expected
     # The loose tolerance finds copies, so the comparison above checked real runs; and the walk
     # stands still for a while before it walks, so at the default tolerance its hold is a real
-    # run of frames, neither one frame nor the whole clip; played backwards, that stand matches
-    # itself over a run of frames too, so the backwards figure was checked on a real run.
+    # run of frames, neither one frame nor the whole clip; and this clip played backwards
+    # matches itself over more than one frame (a hold alone would not make it so), so the
+    # backwards figure was checked on a real run too.
     assert max(longest[0.6]) >= 2, longest
     assert 2 <= holds[0.05] < len(clip), holds
     assert 2 <= reversed_runs[0.05] < len(clip), reversed_runs
