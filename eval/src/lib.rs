@@ -55,7 +55,9 @@ pub use model_eval::{
     GoalScores, ModelEvalError, ModelEvaluation, evaluate_generated, evaluate_model, goal_scores,
 };
 pub use patched_nn::patched_nearest_neighbour;
-pub use replay::{REPLAY_TOLERANCE, ReplayReport, longest_hold, longest_replay, rotation_rows};
+pub use replay::{
+    REPLAY_TOLERANCE, ReplayReport, longest_backwards, longest_hold, longest_replay, rotation_rows,
+};
 pub use window_match::DiagonalSums;
 
 /// Window of the coverage metric and shortest piece of the global diversity, in frames.

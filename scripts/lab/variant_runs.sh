@@ -23,17 +23,15 @@ export_bin=target/release/sinmdm-export
 sinmdm=target/release/sinmdm
 
 source scripts/lab/project_clips.sh
-declare -A files=()
-for name in "${!project_clip_files[@]}"; do files[$name]=${project_clip_files[$name]}; done
 # The dog walk learned at its own 60 fps (--fps clip, below).
-files[dog_walk_mann_60fps]=${files[dog_walk_mann]}
-clips=${CLIPS:-"${!files[*]}"}
+project_clip_files[dog_walk_mann_60fps]=${project_clip_files[dog_walk_mann]}
+clips=${CLIPS:-"${!project_clip_files[*]}"}
 for name in $clips; do
   if [[ $name == *=* ]]; then
     clip=${name#*=}
     name=${name%%=*}
   else
-    clip=$shared/${files[$name]:?unknown clip $name}
+    clip=$shared/${project_clip_files[$name]:?unknown clip $name}
   fi
   extra=()
   [ "$name" = dog_walk_mann_60fps ] && extra=(--fps clip)
