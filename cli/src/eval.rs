@@ -17,8 +17,8 @@ use sinmdm::files::write_atomically;
 use sinmdm::{Feet, Generated, Request, Stream, StreamOptions, Task};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_eval::{
-    COVERAGE_WINDOW, FeetReport, ModelEvaluation, REPLAY_TOLERANCE, ReplayReport, Report,
-    evaluate_generated, evaluate_model,
+    COVERAGE_WINDOW, FeetReport, KinematicReport, ModelEvaluation, REPLAY_TOLERANCE, ReplayReport,
+    Report, evaluate_generated, evaluate_model,
 };
 
 pub(crate) const EXAMPLES: &str = "Examples:
@@ -105,6 +105,7 @@ struct EvalFile<'a> {
     raw_motion_report: &'a Report,
     planted_report: &'a Report,
     feet: &'a FeetReport,
+    kinematics: &'a KinematicReport,
     replay: &'a ReplayReport,
     #[serde(skip_serializing_if = "Option::is_none")]
     beats: Option<sinmdm_eval::BeatScores>,
@@ -272,6 +273,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         raw_motion_report,
         planted_report,
         feet,
+        kinematics,
         planted,
         replay,
         sampling_seconds,
@@ -341,6 +343,8 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     println!();
     print!("{}", feet.markdown_table());
     println!();
+    print_kinematics(&kinematics);
+    println!();
     print!(
         "replay: the samples' longest verbatim copies of the clip (frames within {} root-mean-square \
          per 6D component) last {:.2} s on average, {:.2} s at most",
@@ -395,6 +399,7 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             raw_motion_report: &raw_motion_report,
             planted_report: &planted_report,
             feet: &feet,
+            kinematics: &kinematics,
             replay: &replay,
             beats,
         };
@@ -404,6 +409,18 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         eprintln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// How the samples move against the clip, and which bounds of the fidelity goals they miss.
+fn print_kinematics(kinematics: &KinematicReport) {
+    print!("{}", kinematics.markdown_table());
+    let misses = kinematics.planted.misses(kinematics.clip.still_share);
+    if misses.is_empty() {
+        println!("the samples move like the clip: every bound of the fidelity goals is met");
+    } else {
+        let list: Vec<String> = misses.iter().map(ToString::to_string).collect();
+        println!("the samples do not move like the clip: {}", list.join("; "));
+    }
 }
 
 /// Share of the samples under which a stretch of the clip counts as rarely made, in percent.

@@ -31,6 +31,7 @@
 
 pub mod beat_align;
 mod feet;
+pub mod kinematics;
 mod model_eval;
 mod patched_nn;
 mod replay;
@@ -50,6 +51,9 @@ pub use beat_align::{BeatScores, beat_scores, mean_beat_scores};
 pub use feet::{
     FeetReference, FeetReport, FeetScores, GROUND_BAND, PENETRATION_TOLERANCE, SKATING_SPEED,
     SPEED_WINDOW, SampleFeet, mean_scores,
+};
+pub use kinematics::{
+    ClipKinematics, KinematicMiss, KinematicReport, KinematicScores, Kinematics, wasserstein_1,
 };
 pub use model_eval::{
     GoalScores, ModelEvalError, ModelEvaluation, evaluate_generated, evaluate_model, goal_scores,

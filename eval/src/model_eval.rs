@@ -10,8 +10,9 @@ use sinmdm::{Denoiser, Generated, ModelMetadata, Request, TaskError};
 use thiserror::Error;
 
 use crate::{
-    COVERAGE_WINDOW, EvalError, FeetReport, REPLAY_TOLERANCE, ReplayReport, Report,
-    body_metric_features, evaluate, metric_features, motion_metric_features,
+    COVERAGE_WINDOW, ClipKinematics, EvalError, FeetReport, KinematicReport, KinematicScores,
+    Kinematics, REPLAY_TOLERANCE, ReplayReport, Report, body_metric_features, evaluate,
+    metric_features, motion_metric_features,
 };
 
 /// Why a model could not be scored.
@@ -46,6 +47,8 @@ pub struct ModelEvaluation {
     pub planted_report: Report,
     /// Their feet and smoothness figures, raw and planted, beside the clip's.
     pub feet: FeetReport,
+    /// How they move against the clip (speeds, stillness), raw and planted.
+    pub kinematics: KinematicReport,
     /// The samples' motion with their feet planted, as `planted_report` scored it (what
     /// `Generated::planted_motion` gives), for further scores without planting again.
     pub planted: Vec<LocalMotion>,
@@ -106,6 +109,10 @@ pub struct GoalScores {
     /// The raw samples' jitter as a multiple of the clip's, as
     /// `ModelEvaluation::feet.raw.jitter_ratio`.
     pub raw_jitter_ratio: f64,
+    /// How the raw samples move against the clip, as `ModelEvaluation::kinematics.raw`.
+    pub kinematics: KinematicScores,
+    /// The clip's own share of nearly still frames (the stillness goal's base).
+    pub clip_still_share: f64,
 }
 
 /// Scores `generated` against `clip` (raw features `[F, N]` in the samples' layout) for the
@@ -123,11 +130,17 @@ pub fn goal_scores(
     let raw = (0..generated.count())
         .map(|i| generated.raw_motion(i))
         .collect::<Result<Vec<_>, _>>()?;
-    let feet = FeetReport::new(layout, &decode(layout, clip)?, &raw, &raw);
+    let clip_motion = decode(layout, clip)?;
+    let feet = FeetReport::new(layout, &clip_motion, &raw, &raw);
+    let height = layout.skeleton_height;
+    let clip_kinematics = Kinematics::of_motion(&clip_motion, height);
+    let clip_figures = ClipKinematics::new(&clip_kinematics);
     Ok(GoalScores {
         report,
         replay,
         raw_jitter_ratio: feet.raw.jitter_ratio,
+        kinematics: clip_figures.score(&clip_kinematics, &Kinematics::of_motions(&raw, height)),
+        clip_still_share: clip_figures.still_share,
     })
 }
 
@@ -183,7 +196,9 @@ pub fn evaluate_generated(
     };
     let raw_motion_report = score_motions(&raw)?;
     let planted_report = score_motions(&planted)?;
-    let feet = FeetReport::new(layout, &decode(layout, clip)?, &raw, &planted);
+    let clip_motion = decode(layout, clip)?;
+    let feet = FeetReport::new(layout, &clip_motion, &raw, &planted);
+    let kinematics = KinematicReport::new(&clip_motion, &raw, &planted, layout.skeleton_height);
     Ok(ModelEvaluation {
         generated,
         report,
@@ -191,6 +206,7 @@ pub fn evaluate_generated(
         raw_motion_report,
         planted_report,
         feet,
+        kinematics,
         planted,
         replay,
         sampling_seconds,

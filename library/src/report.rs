@@ -64,6 +64,12 @@ pub struct Row {
     pub harmonic_mean: Option<f64>,
     /// Mean longest verbatim copy of the clip, in seconds.
     pub replay_seconds: Option<f64>,
+    /// Share (percent) of the planted samples' frames that are nearly still.
+    pub still_percent: Option<f64>,
+    /// The same share of the clip's frames.
+    pub clip_still_percent: Option<f64>,
+    /// The planted samples' median speed over the clip's.
+    pub speed_p50_ratio: Option<f64>,
 }
 
 /// The text of the configuration `entry` trains with.
@@ -127,6 +133,16 @@ pub fn rows(manifest: &Manifest) -> Result<Vec<Row>, LibraryError> {
                 local_diversity: report(&["local_diversity", "mean"]),
                 harmonic_mean: report(&["harmonic_mean"]),
                 replay_seconds: eval.and_then(|e| number(e, &["replay", "mean_seconds"])),
+                still_percent: eval
+                    .and_then(|e| number(e, &["kinematics", "planted", "still_share"]))
+                    .map(|s| 100.0 * s),
+                clip_still_percent: eval
+                    .and_then(|e| number(e, &["kinematics", "clip", "still_share"]))
+                    .map(|s| 100.0 * s),
+                speed_p50_ratio: eval.and_then(|e| {
+                    e.pointer("/kinematics/planted/speed_ratios/1")
+                        .and_then(serde_json::Value::as_f64)
+                }),
             })
         })
         .collect()
@@ -162,11 +178,11 @@ pub fn status_text(rows: &[Row]) -> String {
 /// The table of every model (Markdown).
 pub fn markdown(rows: &[Row]) -> String {
     let mut out = String::from(
-        "| clip | state | coverage (%) | global div. | local div. | harmonic mean | replay (s) | steps | training (min) |\n|---|---|---|---|---|---|---|---|---|\n",
+        "| clip | state | coverage (%) | global div. | local div. | harmonic mean | replay (s) | still (%), clip's | speed p50 (x clip's) | steps | training (min) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         out.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.name,
             r.standing.name(),
             cell(r.coverage, 1),
@@ -174,6 +190,11 @@ pub fn markdown(rows: &[Row]) -> String {
             cell(r.local_diversity, 3),
             cell(r.harmonic_mean, 3),
             cell(r.replay_seconds, 2),
+            match (r.still_percent, r.clip_still_percent) {
+                (Some(s), Some(c)) => format!("{s:.1} ({c:.1})"),
+                _ => String::new(),
+            },
+            cell(r.speed_p50_ratio, 2),
             r.steps.map_or(String::new(), |s| s.to_string()),
             cell(r.training_seconds.map(|s| s / 60.0), 1),
         ));
