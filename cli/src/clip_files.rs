@@ -2,6 +2,7 @@
 //! in and out, `.fbx` in.
 
 use std::path::Path;
+use std::sync::OnceLock;
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -9,9 +10,23 @@ use sinmdm::bvh::to_bvh_string;
 use sinmdm::files::write_atomically;
 use sinmdm::motion::{ChannelClip, LocalMotion, UpAxis};
 use sinmdm_formats::{
-    AnimationChoice, ClipFormat, GltfWriteOptions, ReadOptions, UnitGuess, read_clip,
-    writable_format,
+    AnimationChoice, ClipFormat, FileAccess, GltfWriteOptions, ReadOptions, UnitGuess,
+    read_clip_with_access, writable_format,
 };
+
+/// Which files besides those named the command may read, set once from the command line
+/// (`--allow-outside-folder`) for every clip it reads.
+static FILE_ACCESS: OnceLock<FileAccess> = OnceLock::new();
+
+/// Sets the file access of every clip read from now on; the first call wins.
+pub fn set_file_access(access: FileAccess) {
+    let _ = FILE_ACCESS.set(access);
+}
+
+/// The file access of clips read: set from the command line, else the strict default.
+pub fn file_access() -> FileAccess {
+    FILE_ACCESS.get().copied().unwrap_or_default()
+}
 
 /// Reads a clip from a `.bvh`, `.glb`, `.gltf` or `.fbx` file; `animation` picks one of a glTF
 /// or FBX file's animations by name or index (default: the first), and which one was read is said when the
@@ -36,7 +51,7 @@ pub fn read_motion_file_and_source(
             path.display()
         );
     }
-    let (clip, source) = read_clip(path, &options)?;
+    let (clip, source) = read_clip_with_access(path, &options, file_access())?;
     if let Some(read) = &source.animation
         && source.animations.len() > 1
     {

@@ -25,6 +25,10 @@ pub struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
+    /// Read a .gltf clip's buffer files even where its URIs lead outside the clip's folder
+    /// (`../other/data.bin`); off so that a downloaded file cannot read others on the machine.
+    #[arg(long, global = true)]
+    pub allow_outside_folder: bool,
 }
 
 /// The subcommands.
@@ -90,6 +94,9 @@ pub enum Command {
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
+    clip_files::set_file_access(sinmdm_formats::FileAccess {
+        allow_outside_folder: cli.allow_outside_folder,
+    });
     let result = match cli.command {
         Command::Inspect(args) => inspect::run(&args),
         Command::Generate(args) => tasks::generate(&args),

@@ -59,13 +59,14 @@ impl fmt::Display for Part {
 /// Why a motion file could not be read or written.
 #[derive(Debug, thiserror::Error)]
 pub enum FormatError {
-    /// The file could not be read or written.
-    #[error("{}: {source}", path.display())]
+    /// The file could not be read or written. The reason is said in the message and not
+    /// chained as a source, so a printer of causes (`{:#}`) says it once.
+    #[error("{}: {reason}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
-        /// The system's reason.
-        source: std::io::Error,
+        /// The system's reason, or the limit the file broke.
+        reason: std::io::Error,
     },
     /// The file's extension names no format this reads or writes.
     #[error("{}: {message}", path.display())]

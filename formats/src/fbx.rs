@@ -42,10 +42,7 @@ const SCALE_TOLERANCE: f64 = 1e-4;
 
 /// The scene of `path`, loaded and converted to +Y up, metres.
 fn load(path: &Path) -> Result<ufbx::SceneRoot, FormatError> {
-    let bytes = std::fs::read(path).map_err(|source| FormatError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = crate::files::read_file(path, crate::files::FBX_LIMIT)?;
     let options = ufbx::LoadOpts {
         target_axes: ufbx::CoordinateAxes {
             right: ufbx::CoordinateAxis::PositiveX,

@@ -10,6 +10,7 @@
 pub mod animation;
 pub mod error;
 pub mod fbx;
+pub mod files;
 pub mod gltf;
 mod sampled;
 pub use sinmdm::motion::units;
@@ -22,6 +23,7 @@ pub use animation::{
     AnimationChoice, AnimationInfo, MAX_CLIP_FRAMES, MAX_JOINT_FRAMES, ReadOptions,
 };
 pub use error::{FormatError, Part};
+pub use files::FileAccess;
 pub use gltf::GltfWriteOptions;
 pub use units::UnitGuess;
 
@@ -82,10 +84,20 @@ pub struct ClipSource {
 }
 
 /// Reads a clip from a `.bvh`, `.glb`, `.gltf` or `.fbx` file. `options` choose the animation and the
-/// frame rate of formats that hold keyframes rather than frames (BVH ignores them).
+/// frame rate of formats that hold keyframes rather than frames (BVH ignores them). A `.gltf`
+/// file's side-car buffers are read only from its own folder.
 pub fn read_clip(
     path: &Path,
     options: &ReadOptions,
+) -> Result<(ChannelClip, ClipSource), FormatError> {
+    read_clip_with_access(path, options, FileAccess::default())
+}
+
+/// [`read_clip`], with `access` saying which files besides `path` may be read.
+pub fn read_clip_with_access(
+    path: &Path,
+    options: &ReadOptions,
+    access: FileAccess,
 ) -> Result<(ChannelClip, ClipSource), FormatError> {
     match ClipFormat::of(path)? {
         ClipFormat::Bvh => Ok((
@@ -98,7 +110,7 @@ pub fn read_clip(
             },
         )),
         ClipFormat::Gltf => {
-            let read = gltf::read_gltf(path, options)?;
+            let read = gltf::read_gltf_with_access(path, options, access)?;
             Ok((
                 read.clip,
                 ClipSource {

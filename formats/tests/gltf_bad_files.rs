@@ -8,9 +8,9 @@ use std::path::{Path, PathBuf};
 use serde_json::{Value, json};
 use sinmdm::bvh::read_bvh;
 use sinmdm::motion::UpAxis;
-use sinmdm_formats::ReadOptions;
 use sinmdm_formats::gltf::container::{Asset, glb_bytes, parse_glb};
 use sinmdm_formats::gltf::{GltfWriteOptions, gltf_document, read_gltf};
+use sinmdm_formats::{FileAccess, ReadOptions, read_clip_with_access};
 
 mod common;
 use common::Rng;
@@ -278,4 +278,131 @@ fn two_thousand_mutated_files_give_errors_never_a_panic() {
     for end in 0..small.len() {
         let _: Result<Asset, _> = parse_glb(Path::new("t.glb"), &small[..end]);
     }
+}
+
+/// A folder of its own for one test's files, emptied first.
+fn folder(name: &str) -> PathBuf {
+    let dir = scratch(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The fox as a `.gltf` file in `dir` whose one buffer is `uri` of `byte_length` bytes; the
+/// buffer's true bytes are returned for writing where the URI points.
+fn side_car_gltf(dir: &Path, uri: &str, byte_length: u64) -> (PathBuf, Vec<u8>) {
+    let (mut json, bin) = fox();
+    json["buffers"][0]["uri"] = json!(uri);
+    json["buffers"][0]["byteLength"] = json!(byte_length);
+    let path = dir.join("clip.gltf");
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    (path, bin)
+}
+
+fn gltf_error(path: &Path, access: FileAccess) -> String {
+    match read_clip_with_access(path, &ReadOptions::default(), access) {
+        Ok(_) => panic!("{} was read", path.display()),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn side_car_buffers_must_be_relative_regular_files_in_the_folder() {
+    let dir = folder("side_cars");
+    let open = FileAccess {
+        allow_outside_folder: true,
+    };
+    // Devices: refused before a byte is read, whatever the byteLength.
+    let (path, _) = side_car_gltf(&dir, "/dev/zero", 95_396);
+    let message = gltf_error(&path, open);
+    assert!(
+        message.contains("clip.gltf") && message.contains("'/dev/zero'"),
+        "{message}"
+    );
+    let (path, _) = side_car_gltf(&dir, "/dev/zero", 8_000_000_000);
+    let message = gltf_error(&path, open);
+    assert!(message.contains("MAX_GLTF_BUFFER_BYTES"), "{message}");
+    // Absolute paths, file: and other schemes are refused by name, opted in or not.
+    let secret = folder("secret");
+    let (_, bin) = side_car_gltf(&dir, "x", 0);
+    std::fs::write(secret.join("hidden.bin"), &bin).unwrap();
+    let absolute = secret.join("hidden.bin").display().to_string();
+    for uri in [
+        absolute.clone(),
+        format!("file://{absolute}"),
+        "https://example.com/hidden.bin".into(),
+    ] {
+        let (path, _) = side_car_gltf(&dir, &uri, bin.len() as u64);
+        let message = gltf_error(&path, open);
+        assert!(
+            message.contains(&format!("'{uri}'")) && message.contains("relative"),
+            "{message}"
+        );
+    }
+    // A relative path out of the folder reads only when asked.
+    let (path, _) = side_car_gltf(&dir, "../secret/hidden.bin", bin.len() as u64);
+    let message = gltf_error(&path, FileAccess::default());
+    assert!(
+        message.contains("'../secret/hidden.bin'") && message.contains("--allow-outside-folder"),
+        "{message}"
+    );
+    read_clip_with_access(&path, &ReadOptions::default(), open).unwrap();
+    // And so does a symbolic link in the folder that leads out of it.
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(secret.join("hidden.bin"), dir.join("link.bin")).unwrap();
+        let (path, _) = side_car_gltf(&dir, "link.bin", bin.len() as u64);
+        let message = gltf_error(&path, FileAccess::default());
+        assert!(
+            message.contains("outside the glTF file's folder"),
+            "{message}"
+        );
+        read_clip_with_access(&path, &ReadOptions::default(), open).unwrap();
+    }
+    // In the folder it reads, and no more than byteLength is taken from a longer file.
+    let mut longer = bin.clone();
+    longer.extend_from_slice(&[0; 1000]);
+    std::fs::write(dir.join("fox.bin"), &longer).unwrap();
+    let (path, _) = side_car_gltf(&dir, "fox.bin", bin.len() as u64);
+    read_clip_with_access(&path, &ReadOptions::default(), FileAccess::default()).unwrap();
+    // A file shorter than its byteLength, a huge byteLength and a directory are named.
+    let (path, _) = side_car_gltf(&dir, "fox.bin", longer.len() as u64 + 1);
+    let message = gltf_error(&path, FileAccess::default());
+    assert!(message.contains("truncated"), "{message}");
+    let (path, _) = side_car_gltf(&dir, "fox.bin", 8_000_000_000);
+    let message = gltf_error(&path, FileAccess::default());
+    assert!(
+        message.contains("buffer 0") && message.contains("MAX_GLTF_BUFFER_BYTES"),
+        "{message}"
+    );
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let (path, _) = side_car_gltf(&dir, "sub", 4);
+    let message = gltf_error(&path, FileAccess::default());
+    assert!(message.contains("not a regular file"), "{message}");
+    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(&secret).unwrap();
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_is_refused_without_waiting_for_a_writer() {
+    let dir = folder("fifo");
+    let fifo = dir.join("pipe.bin");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    if !made {
+        eprintln!("mkfifo is not available; skipped");
+        return;
+    }
+    let (path, _) = side_car_gltf(&dir, "pipe.bin", 16);
+    let message = gltf_error(&path, FileAccess::default());
+    assert!(message.contains("not a regular file"), "{message}");
+    // The clip file itself, too.
+    let clip = dir.join("pipe.glb");
+    std::fs::rename(&fifo, &clip).unwrap();
+    let message = gltf_error(&clip, FileAccess::default());
+    assert!(message.contains("not a regular file"), "{message}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,6 +1,7 @@
-//! File output that never leaves a half-written file behind.
+//! File output that never leaves a half-written file behind, and file input that never reads
+//! more than a named limit or from anything but a regular file.
 
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 /// The temporary file beside `path` that a file is written to before it takes its name
@@ -39,6 +40,85 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// The most bytes a reader takes from one kind of file, with the limit's name for messages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FileLimit {
+    /// The most bytes read.
+    pub bytes: u64,
+    /// The constant that sets it (`MAX_BVH_BYTES`), so a message points at the rule.
+    pub name: &'static str,
+    /// What kind of file it bounds (`a BVH file`).
+    pub what: &'static str,
+}
+
+/// The error for a file that is not a regular file, naming what it is.
+fn not_regular(kind: std::fs::FileType) -> std::io::Error {
+    let what = if kind.is_dir() {
+        "a directory"
+    } else {
+        "a device, FIFO or socket"
+    };
+    std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!("is {what}, not a regular file"),
+    )
+}
+
+/// The size of `path` when it is a regular file no larger than `limit`: checked before a byte
+/// is read, so a device (`/dev/zero`), a FIFO or a huge file costs nothing.
+pub fn regular_file_size(path: &Path, limit: FileLimit) -> std::io::Result<u64> {
+    let metadata = std::fs::metadata(path)?;
+    if !metadata.is_file() {
+        return Err(not_regular(metadata.file_type()));
+    }
+    check_size(metadata.len(), limit)?;
+    Ok(metadata.len())
+}
+
+/// `size` bytes against `limit`.
+fn check_size(size: u64, limit: FileLimit) -> std::io::Result<()> {
+    if size > limit.bytes {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "is {size} bytes, more than the {} {} may have ({})",
+                limit.bytes, limit.what, limit.name
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Reads at most `count` bytes from the start of the regular file `path` (all of it when
+/// `count` is `None`), refusing anything that is not a regular file or is larger than `limit`.
+/// Readers of files from strangers use it so a file cannot make them read a device, block on
+/// a FIFO or allocate more than the limit.
+pub fn read_regular_file(
+    path: &Path,
+    limit: FileLimit,
+    count: Option<u64>,
+) -> std::io::Result<Vec<u8>> {
+    // Checked on the path first: opening a FIFO would block until something writes to it.
+    regular_file_size(path, limit)?;
+    let file = std::fs::File::open(path)?;
+    // And again on what was opened, in case the path changed in between.
+    let metadata = file.metadata()?;
+    if !metadata.is_file() {
+        return Err(not_regular(metadata.file_type()));
+    }
+    check_size(metadata.len(), limit)?;
+    let wanted = count.unwrap_or(metadata.len()).min(limit.bytes);
+    let mut bytes = Vec::with_capacity(wanted.min(metadata.len()) as usize);
+    // A file that grows while it is read (or a /proc file that says 0) still stops at the limit.
+    let cap = match count {
+        Some(count) => count.min(limit.bytes),
+        None => limit.bytes.saturating_add(1),
+    };
+    file.take(cap).read_to_end(&mut bytes)?;
+    check_size(bytes.len() as u64, limit)?;
+    Ok(bytes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -60,6 +140,37 @@ mod tests {
             .filter(|e| e.file_name().to_string_lossy().ends_with(".partial"))
             .collect();
         assert!(leftovers.is_empty());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn reads_regular_files_within_their_limit_only() {
+        let dir = std::env::temp_dir().join(format!("sinmdm-read-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("ten.bin");
+        std::fs::write(&file, [7u8; 10]).unwrap();
+        let limit = |bytes| FileLimit {
+            bytes,
+            name: "MAX_TEST_BYTES",
+            what: "a test file",
+        };
+        assert_eq!(read_regular_file(&file, limit(10), None).unwrap().len(), 10);
+        assert_eq!(
+            read_regular_file(&file, limit(10), Some(4)).unwrap(),
+            [7; 4]
+        );
+        let err = read_regular_file(&file, limit(9), None).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "is 10 bytes, more than the 9 a test file may have (MAX_TEST_BYTES)"
+        );
+        let err = read_regular_file(&dir, limit(10), None).unwrap_err();
+        assert!(err.to_string().contains("directory"), "{err}");
+        #[cfg(unix)]
+        {
+            let err = read_regular_file(Path::new("/dev/zero"), limit(10), None).unwrap_err();
+            assert!(err.to_string().contains("not a regular file"), "{err}");
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

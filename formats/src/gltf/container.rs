@@ -4,6 +4,8 @@
 use std::path::Path;
 
 use crate::error::{FormatError, Part};
+use crate::files::{FileAccess, GLTF_BUFFER_LIMIT, GLTF_LIMIT, read_file, side_car_path};
+use sinmdm::files::{read_regular_file, regular_file_size};
 
 /// `glTF` in little-endian ASCII.
 const GLB_MAGIC: u32 = 0x4654_6C67;
@@ -52,18 +54,16 @@ pub fn glb_bytes(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
     out
 }
 
-/// Reads a `.glb` or `.gltf` file (chosen by its first bytes, not its name).
-pub fn read_asset(path: &Path) -> Result<Asset, FormatError> {
-    let bytes = std::fs::read(path).map_err(|source| FormatError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+/// Reads a `.glb` or `.gltf` file (chosen by its first bytes, not its name); `access` says
+/// whether a `.gltf` file's side-car buffers may lie outside its folder.
+pub fn read_asset(path: &Path, access: FileAccess) -> Result<Asset, FormatError> {
+    let bytes = read_file(path, GLTF_LIMIT)?;
     if bytes.len() >= 4 && bytes[..4] == GLB_MAGIC.to_le_bytes() {
         parse_glb(path, &bytes)
     } else {
         let json: serde_json::Value = serde_json::from_slice(&bytes)
             .map_err(|e| FormatError::bad(path, Part::Json, format!("is not JSON: {e}")))?;
-        let buffers = load_buffers(path, &json, None)?;
+        let buffers = load_buffers(path, &json, None, access)?;
         Ok(Asset { json, buffers })
     }
 }
@@ -120,16 +120,19 @@ pub fn parse_glb(path: &Path, bytes: &[u8]) -> Result<Asset, FormatError> {
     let json = json.ok_or_else(|| bad("has no JSON chunk".into()))?;
     let json: serde_json::Value = serde_json::from_slice(json)
         .map_err(|e| FormatError::bad(path, Part::Json, format!("JSON chunk: {e}")))?;
-    let buffers = load_buffers(path, &json, bin)?;
+    // A GLB's buffers are its binary chunk and data URIs; side-car files are for `.gltf`.
+    let buffers = load_buffers(path, &json, bin, FileAccess::default())?;
     Ok(Asset { json, buffers })
 }
 
 /// The bytes of every buffer of `json`: the GLB's binary chunk for a buffer without a URI,
-/// embedded base64 data, or a file beside `path`.
+/// embedded base64 data, or a regular file in `path`'s folder (elsewhere when `access` allows
+/// it), of which no more than its `byteLength` is read.
 fn load_buffers(
     path: &Path,
     json: &serde_json::Value,
     mut bin: Option<Vec<u8>>,
+    access: FileAccess,
 ) -> Result<Vec<Vec<u8>>, FormatError> {
     let Some(buffers) = json.get("buffers") else {
         return Ok(Vec::new());
@@ -138,13 +141,30 @@ fn load_buffers(
         .as_array()
         .ok_or_else(|| FormatError::bad(path, Part::Json, "'buffers' is not an array".into()))?;
     let mut out = Vec::with_capacity(buffers.len());
+    let mut declared = 0u64;
     for (index, buffer) in buffers.iter().enumerate() {
         let part = Part::Buffer(index);
         let length = buffer
             .get("byteLength")
             .and_then(serde_json::Value::as_u64)
-            .ok_or_else(|| FormatError::bad(path, part.clone(), "has no byteLength".into()))?
-            as usize;
+            .ok_or_else(|| FormatError::bad(path, part.clone(), "has no byteLength".into()))?;
+        declared = declared.saturating_add(length);
+        if declared > GLTF_BUFFER_LIMIT.bytes {
+            let total = if declared > length {
+                format!(", {declared} bytes with the buffers before it")
+            } else {
+                String::new()
+            };
+            return Err(FormatError::bad(
+                path,
+                part,
+                format!(
+                    "declares a byteLength of {length}{total}, more than the {} {} may have ({})",
+                    GLTF_BUFFER_LIMIT.bytes, GLTF_BUFFER_LIMIT.what, GLTF_BUFFER_LIMIT.name
+                ),
+            ));
+        }
+        let length = length as usize;
         let bytes = match buffer.get("uri").and_then(serde_json::Value::as_str) {
             None => bin.take().ok_or_else(|| {
                 FormatError::bad(
@@ -165,11 +185,24 @@ fn load_buffers(
                         "holds a data URI that is not base64 binary data".into(),
                     ));
                 } else {
-                    let side = path
-                        .parent()
-                        .unwrap_or(Path::new("."))
-                        .join(percent_decode(uri));
-                    std::fs::read(&side).map_err(|source| FormatError::Io { path: side, source })?
+                    let side = side_car_path(path, uri, access)
+                        .map_err(|message| FormatError::bad(path, part.clone(), message))?;
+                    let io = |reason| FormatError::Io {
+                        path: side.clone(),
+                        reason,
+                    };
+                    let size = regular_file_size(&side, GLTF_BUFFER_LIMIT).map_err(io)?;
+                    if size < length as u64 {
+                        return Err(FormatError::bad(
+                            path,
+                            part,
+                            format!(
+                                "says it has {length} bytes but its file {} has {size} (truncated?)",
+                                side.display()
+                            ),
+                        ));
+                    }
+                    read_regular_file(&side, GLTF_BUFFER_LIMIT, Some(length as u64)).map_err(io)?
                 }
             }
         };
@@ -186,26 +219,6 @@ fn load_buffers(
         out.push(bytes);
     }
     Ok(out)
-}
-
-/// `%20` and the like in a relative URI, decoded.
-fn percent_decode(uri: &str) -> String {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%'
-            && i + 2 < bytes.len()
-            && let Ok(v) = u8::from_str_radix(&uri[i + 1..i + 3], 16)
-        {
-            out.push(v);
-            i += 3;
-            continue;
-        }
-        out.push(bytes[i]);
-        i += 1;
-    }
-    String::from_utf8_lossy(&out).into_owned()
 }
 
 const BASE64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";

@@ -10,7 +10,7 @@ mod splice;
 mod tracks;
 mod write;
 
-pub use read::{GltfClip, list_animations, read_gltf};
+pub use read::{GltfClip, list_animations, read_gltf, read_gltf_with_access};
 pub use splice::{SpliceReport, splice_into_character};
 pub use write::{GltfWriteOptions, gltf_document, write_gltf};
 

@@ -27,6 +27,7 @@ use super::skin::{SkinJoints, node_names, recorded_joints, skin_joints};
 use super::tracks::{MAX_JOINT_FRAMES, Property, Track, frame_rate, read_tracks};
 use crate::animation::{AnimationInfo, ReadOptions, choose_animation};
 use crate::error::{FormatError, Part};
+use crate::files::FileAccess;
 use crate::sampled::{SampledJoints, unique_names};
 
 /// A clip read from a glTF file, with what the file held besides.
@@ -91,7 +92,7 @@ fn animation_infos(asset: &Asset) -> Vec<AnimationInfo> {
 
 /// The animations of a glTF file with their lengths (for `inspect`).
 pub fn list_animations(path: &Path) -> Result<Vec<AnimationInfo>, FormatError> {
-    Ok(animation_infos(&read_asset(path)?))
+    Ok(animation_infos(&read_asset(path, FileAccess::default())?))
 }
 
 /// Each joint's local rotation and translation, frame by frame (`[frames][joints]`), from the
@@ -153,9 +154,19 @@ fn sample_frames(
     Ok((rotations, translations))
 }
 
-/// Reads the clip of one animation of a `.glb` or `.gltf` file.
+/// Reads the clip of one animation of a `.glb` or `.gltf` file, its side-car buffers only from
+/// its own folder.
 pub fn read_gltf(path: &Path, options: &ReadOptions) -> Result<GltfClip, FormatError> {
-    let asset = read_asset(path)?;
+    read_gltf_with_access(path, options, FileAccess::default())
+}
+
+/// [`read_gltf`], with `access` saying which side-car files may be read.
+pub fn read_gltf_with_access(
+    path: &Path,
+    options: &ReadOptions,
+    access: FileAccess,
+) -> Result<GltfClip, FormatError> {
+    let asset = read_asset(path, access)?;
     let nodes: &[Value] = asset
         .json
         .get("nodes")

@@ -107,10 +107,7 @@ pub fn splice_into_character(
     motions: &[(String, &LocalMotion)],
     up_axis: UpAxis,
 ) -> Result<SpliceReport, FormatError> {
-    let bytes = std::fs::read(character).map_err(|source| FormatError::Io {
-        path: character.to_path_buf(),
-        source,
-    })?;
+    let bytes = crate::files::read_file(character, crate::files::GLTF_LIMIT)?;
     let Asset { mut json, buffers } = parse_glb(character, &bytes)?;
     let bad = |part: Part, message: String| FormatError::bad(character, part, message);
     if buffers.len() > 1
@@ -280,9 +277,9 @@ pub fn splice_into_character(
     }
     json["buffers"][0]["byteLength"] = json!(binary.bytes.len());
     let out = glb_bytes(&json, &binary.bytes);
-    sinmdm::files::write_atomically(path, &out).map_err(|source| FormatError::Io {
+    sinmdm::files::write_atomically(path, &out).map_err(|reason| FormatError::Io {
         path: path.to_path_buf(),
-        source,
+        reason,
     })?;
     Ok(SpliceReport {
         kept_animations,

@@ -397,8 +397,8 @@ pub fn write_gltf(
         ));
         serde_json::to_vec_pretty(&document).expect("a JSON value serialises")
     };
-    sinmdm::files::write_atomically(path, &bytes).map_err(|source| FormatError::Io {
+    sinmdm::files::write_atomically(path, &bytes).map_err(|reason| FormatError::Io {
         path: path.to_path_buf(),
-        source,
+        reason,
     })
 }
