@@ -158,6 +158,53 @@ fn missing_file_names_the_path() {
     assert!(e.to_string().starts_with("no/such/clip.bvh: "), "{e}");
 }
 
+/// A chain of `joints` nested joints with two frames, as BVH text.
+fn chain(joints: usize) -> String {
+    let mut text = String::from("HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\n");
+    text += "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n";
+    for j in 1..joints {
+        text +=
+            &format!("JOINT j{j}\n{{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n");
+    }
+    text += "End Site\n{\nOFFSET 0 1 0\n}\n";
+    text += &"}\n".repeat(joints);
+    let frame = vec!["0"; 6 + 3 * (joints - 1)].join(" ");
+    text += &format!("MOTION\nFrames: 2\nFrame Time: 0.0333333\n{frame}\n{frame}\n");
+    text
+}
+
+#[test]
+fn a_chain_of_the_most_joints_reads_and_a_longer_one_is_refused() {
+    use sinmdm::bvh::MAX_BVH_JOINTS;
+    let clip = parse_bvh(&chain(MAX_BVH_JOINTS), "chain.bvh").unwrap();
+    assert_eq!(clip.skeleton.joints.len(), MAX_BVH_JOINTS);
+    let e = parse_bvh(&chain(20_000), "deep.bvh").unwrap_err();
+    assert!(matches!(e.kind, BvhErrorKind::OverLimit { .. }));
+    assert!(
+        e.to_string().contains(
+            "joint 'j4096' is joint 4097: more than the 4096 a BVH file may have (MAX_BVH_JOINTS)"
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn only_regular_files_are_read() {
+    let dir = std::env::temp_dir().join(format!("sinmdm-bvh-dir-{}.bvh", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let e = read_bvh(&dir).unwrap_err();
+    assert!(
+        e.to_string().contains("is a directory, not a regular file"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    #[cfg(unix)]
+    {
+        let e = read_bvh("/dev/zero").unwrap_err();
+        assert!(e.to_string().contains("not a regular file"), "{e}");
+    }
+}
+
 #[test]
 fn bad_encoder_settings_are_errors() {
     use sinmdm::motion::{ContactConfig, EncodeOptions, MotionError, encode};

@@ -124,6 +124,16 @@ pub enum BvhErrorKind {
         /// Frames announced.
         announced: usize,
     },
+    /// More of something (joints, nesting, name bytes) than the reader takes.
+    #[error("{what}: more than the {limit} a BVH file may have ({name})")]
+    OverLimit {
+        /// What is counted (`joint 'j4096'`).
+        what: String,
+        /// The limit.
+        limit: usize,
+        /// The constant that sets it.
+        name: &'static str,
+    },
     /// `Frames: 0`.
     #[error("the clip has zero frames")]
     ZeroFrames,

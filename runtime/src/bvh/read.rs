@@ -6,15 +6,32 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use super::error::{BvhError, BvhErrorKind};
+use crate::files::{FileLimit, read_regular_file};
 use crate::motion::clip::{ChannelClip, fps_from_frame_time};
 use crate::motion::math::Vec3;
 use crate::motion::skeleton::{Channel, Joint, Skeleton};
 
-/// Reads a BVH file.
+/// The largest BVH file read (1 GiB): far beyond a long capture, and a bound on what a file can
+/// make the reader allocate.
+pub const MAX_BVH_BYTES: u64 = 1 << 30;
+/// The most joints a BVH file may have: the most a model's skeleton may have. It bounds the
+/// nesting depth too (the parser keeps open joints on a stack, not the call stack, so a chain
+/// of this many joints is read).
+pub const MAX_BVH_JOINTS: usize = crate::limits::MAX_JOINTS;
+/// The longest joint name, in bytes: the longest a model's skeleton may have.
+pub const MAX_BVH_NAME_BYTES: usize = crate::limits::MAX_NAME_BYTES;
+/// The size limit of BVH files, for [`read_regular_file`].
+pub const BVH_LIMIT: FileLimit = FileLimit {
+    bytes: MAX_BVH_BYTES,
+    name: "MAX_BVH_BYTES",
+    what: "a BVH file",
+};
+
+/// Reads a BVH file: a regular file of at most [`MAX_BVH_BYTES`].
 pub fn read_bvh(path: impl AsRef<Path>) -> Result<ChannelClip, BvhError> {
     let path = path.as_ref();
     let label = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| BvhError {
+    let bytes = read_regular_file(path, BVH_LIMIT, None).map_err(|e| BvhError {
         file: label.clone(),
         line: None,
         kind: BvhErrorKind::Io(e),
@@ -260,6 +277,27 @@ impl<'a> Parser<'a> {
             ));
         }
         let name = words.iter().map(|t| t.text).collect::<Vec<_>>().join(" ");
+        let over = |what: String, limit: usize, name: &'static str| {
+            self.error(
+                Some(keyword.line),
+                BvhErrorKind::OverLimit { what, limit, name },
+            )
+        };
+        if name.len() > MAX_BVH_NAME_BYTES {
+            return Err(over(
+                format!("a joint name of {} bytes", name.len()),
+                MAX_BVH_NAME_BYTES,
+                "MAX_BVH_NAME_BYTES",
+            ));
+        }
+        if joints.len() >= MAX_BVH_JOINTS {
+            return Err(over(
+                format!("joint '{name}' is joint {}", joints.len() + 1),
+                MAX_BVH_JOINTS,
+                "MAX_BVH_JOINTS",
+            ));
+        }
+
         if let Some(&first_line) = first_seen.get(&name) {
             return Err(self.error(
                 Some(keyword.line),

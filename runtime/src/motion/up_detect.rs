@@ -85,10 +85,14 @@ pub const MIN_FRAMES: usize = 10;
 /// Each chain end's weight: the length of the limb that carries it, from the nearest joint where
 /// the skeleton branches (or `top`) to the end (its End Site included). Fingers and toes weigh
 /// little, legs and tails a lot. Only chain ends below `top` count.
-fn limb_weights(skeleton: &Skeleton, top: usize) -> Vec<(usize, f64)> {
-    let children: Vec<usize> = (0..skeleton.len())
-        .map(|j| skeleton.children(j).len())
-        .collect();
+fn limb_weights(skeleton: &Skeleton, top: usize, below: &[bool]) -> Vec<(usize, f64)> {
+    // Counted in one pass: `Skeleton::children` per joint would be quadratic in joints.
+    let mut children = vec![0usize; skeleton.len()];
+    for joint in &skeleton.joints {
+        if let Some(p) = joint.parent {
+            children[p] += 1;
+        }
+    }
     skeleton
         .leaves()
         .into_iter()
@@ -108,22 +112,18 @@ fn limb_weights(skeleton: &Skeleton, top: usize) -> Vec<(usize, f64)> {
             }
             (leaf, length)
         })
-        .filter(|&(leaf, _)| is_below(skeleton, leaf, top))
+        .filter(|&(leaf, _)| below[leaf])
         .collect()
 }
 
-/// Whether `joint` is `top` or below it.
-fn is_below(skeleton: &Skeleton, joint: usize, top: usize) -> bool {
-    let mut j = joint;
-    loop {
-        if j == top {
-            return true;
-        }
-        match skeleton.joints[j].parent {
-            Some(p) => j = p,
-            None => return false,
-        }
+/// Whether each joint is `top` or below it, in one pass: parents precede their children, so
+/// walking each joint up to the root (quadratic in a long chain) is not needed.
+fn below_of(skeleton: &Skeleton, top: usize) -> Vec<bool> {
+    let mut below = vec![false; skeleton.len()];
+    for (j, joint) in skeleton.joints.iter().enumerate() {
+        below[j] = j == top || joint.parent.is_some_and(|p| p < j && below[p]);
     }
+    below
 }
 
 /// Detects the up axis of a clip (in its file's frame) from where its limbs hang; see the module
@@ -133,10 +133,8 @@ pub fn detect_up(motion: &LocalMotion) -> UpDetection {
     let poses = global_poses(motion);
     // A static container above the hips (some rigs) is no part of the body.
     let top = travelling_root(skeleton, &poses);
-    let weights = limb_weights(skeleton, top);
-    let in_body: Vec<bool> = (0..skeleton.len())
-        .map(|j| is_below(skeleton, j, top))
-        .collect();
+    let in_body = below_of(skeleton, top);
+    let weights = limb_weights(skeleton, top, &in_body);
     let total_weight: f64 = weights.iter().map(|(_, w)| w).sum();
     let mut hang = Vec3::ZERO;
     let mut size = 0.0;
@@ -145,10 +143,7 @@ pub fn detect_up(motion: &LocalMotion) -> UpDetection {
         let mut centre = Vec3::ZERO;
         let mut mass = 0.0;
         for (j, joint) in skeleton.joints.iter().enumerate() {
-            if let Some(p) = joint
-                .parent
-                .filter(|_| j != top && is_below(skeleton, j, top))
-            {
+            if let Some(p) = joint.parent.filter(|_| j != top && in_body[j]) {
                 let length = (pose.joints[j] - pose.joints[p]).norm();
                 let mid = (pose.joints[j] + pose.joints[p]) * 0.5;
                 centre += mid * length;
