@@ -7,23 +7,29 @@
  * sinmdm_c.dll, libsinmdm_c.dylib) and a static one.
  *
  * Conventions, the same at every entry point:
+ * - Version: SINMDM_VERSION_MAJOR, _MINOR and _PATCH are this header's, and
+ *   sinmdm_version() gives the loaded library's as "MAJOR.MINOR.PATCH". A host checks at load
+ *   that the library's major is the header's and, while the major is 0, its minor too (each 0.x
+ *   minor may change behaviour, listed under CHANGES below); from 1 on, its minor at least.
  * - Status: every function returns a SinmdmStatus (the _free functions return nothing).
  *   On failure sinmdm_last_error() (per thread, valid until the next call on that thread)
  *   says why, naming the argument, field or file. One kind of mistake gets one status
  *   everywhere: a NULL pointer SINMDM_NULL_ARGUMENT; a value past its bound, an unknown
- *   constant or index, malformed poses, a handle of another model SINMDM_INVALID_ARGUMENT;
- *   a short buffer SINMDM_BUFFER_TOO_SMALL. A panic inside the library is caught and
- *   returned as SINMDM_INTERNAL: nothing unwinds into the caller.
+ *   constant or index, a reserved field that is not 0, malformed poses, a handle of another
+ *   model SINMDM_INVALID_ARGUMENT; a short buffer SINMDM_BUFFER_TOO_SMALL. A panic inside
+ *   the library is caught and returned as SINMDM_INTERNAL: nothing unwinds into the caller.
  * - Bounds: every count and size is checked against the SINMDM_MAX_* constants below before
  *   anything is read or allocated, and every size is computed in checked arithmetic.
  * - Handles are opaque and freed with their _free function (NULL is accepted there). A
  *   function that gives a handle through out sets *out to NULL first, so on failure it
- *   holds NULL, never a stale pointer.
+ *   holds NULL, never a stale pointer. A run or stream takes the very model handle it was made
+ *   with: another handle, even of the same file, is another model (SINMDM_INVALID_ARGUMENT).
  * - Buffers belong to the caller, with their capacity in elements. Strings are UTF-8 and
- *   NUL-terminated. Where a function takes a needed pointer (joint names, parents, rest
- *   offsets, contact joints), a NULL buffer asks for the size only and needed gets it; a
- *   buffer too small writes nothing and gives SINMDM_BUFFER_TOO_SMALL (with needed set).
- *   Pose buffers are sized from sinmdm_result_frames and SinmdmModelInfo::joints.
+ *   NUL-terminated. An input array with a count of 0 is not read and may be NULL. Where a
+ *   function takes a needed pointer (joint names, parents, rest offsets, contact joints), a
+ *   NULL buffer asks for the size only and needed gets it; a buffer too small writes nothing
+ *   and gives SINMDM_BUFFER_TOO_SMALL (with needed set). Pose buffers are sized from
+ *   sinmdm_result_frames and SinmdmModelInfo::joints, and checked even for 0 frames.
  * - Memory handed in is read during the call only: sinmdm_model_open_bytes copies the
  *   bytes, reference poses are copied, nothing is kept.
  * - Runs in a game's frame: sinmdm_TASK_begin checks a request and gives an owned run;
@@ -33,16 +39,22 @@
  *   prepared ahead with sinmdm_stream_step so sinmdm_stream_next never waits. Stepping a
  *   run any number of steps at a time gives the bits of the one-call task.
  * - Progress and cancel on a worker thread: sinmdm_model_set_progress sets a callback
- *   (userdata first) called after each step of a blocking task; returning
- *   SINMDM_PROGRESS_CANCEL stops it with SINMDM_CANCELLED and the model stays usable.
+ *   (userdata first) called after each step of a blocking task, the last included (never by
+ *   sinmdm_run_step); returning SINMDM_PROGRESS_CANCEL after any step makes the call return
+ *   SINMDM_CANCELLED with no result, and the model stays usable.
  * - Threads: a handle may move between threads but must be used by one thread at a time; a
  *   model and the runs and streams that run on it count as one. Different models may run at
  *   once on different threads. sinmdm_load_onnxruntime and sinmdm_last_error may be
- *   called from any thread. The library starts these threads: for each run or stream block
- *   in progress, one that draws the next step's noise (it ends with the run); for a batch of
- *   several samples on a model opened with threads > 1, up to threads - 1 that each run
- *   samples during a denoising call and are joined before it returns. onnxruntime itself runs
- *   on the calling thread (one intra-op thread, no pool).
+ *   called from any thread. These are all the threads the library starts or has started:
+ *   when onnxruntime is loaded (sinmdm_load_onnxruntime, or the first model opened),
+ *   onnxruntime's environment starts threads of its own (one with onnxruntime 1.31.1, which
+ *   waits on a timer), and they live until the process ends, since the environment is made
+ *   once per process and never freed; for each run or stream block in progress, one that
+ *   draws the next step's noise (it ends on its own soon after the run is finished or freed,
+ *   or the block is done); for a batch of several samples on a model opened with threads >
+ *   1, up to threads - 1 that each run samples during a denoising call and are joined
+ *   before it returns. onnxruntime runs the network on the calling thread (one intra-op
+ *   thread, no pool).
  * - The same bits on every machine: the same model file, seed and arguments give the same
  *   poses whatever threads is and wherever a sample sits in its batch (each sample is its
  *   own onnxruntime call on one intra-op thread), through this ABI, the Rust API and the
@@ -50,18 +62,44 @@
  *   onnxruntime's choice of CPU kernels by instruction set (AVX2, AVX-512, NEON): machines
  *   with the same set agree (onnxruntime 1.17.0, 1.19.2, 1.20.1 and 1.31.1 gave the same bits
  *   on AVX2).
+ * - Which sample is which: a batch's noise is one stream of the seed laid out sample after
+ *   sample, so sample k of a batch is the same bits in every batch of more than k samples
+ *   with the same seed and arguments, and a batch of count = 1 gives sample 0. To make crowd
+ *   member k again alone, ask for count = k + 1 and read sample k (no seed gives member k
+ *   in a batch of 1; another seed is another crowd).
  * - onnxruntime is loaded at run time, release 1.17 or later (tested with 1.17.0, 1.19.2,
  *   1.20.1 and 1.31.1). sinmdm_load_onnxruntime(path) names it;
  *   otherwise the first model opened looks, in order: ORT_DYLIB_PATH, next to the
  *   executable, next to this library, the system loader's search path, a developer
- *   checkout's .venv. On Windows the loader's path reaches System32, where Windows may keep
- *   an onnxruntime.dll of its own and of another release: ship yours next to the executable
- *   (or the plugin) so it is found first. A release older than 1.17 is refused.
+ *   checkout's .venv; when none loads, SINMDM_RUNTIME_LIBRARY's message names these
+ *   five places in this order with what each gave. On Windows the loader's path reaches
+ *   System32, where Windows may keep an onnxruntime.dll of its own and of another release:
+ *   ship yours next to the executable (or the plugin) so it is found first. A release older
+ *   than 1.17 is refused.
  * - Poses are in the model file's frame: right-handed, its up axis (sinmdm_model_info) and
  *   its units; quaternions are x, y, z, w. See the README's Embedding section for Unity and
  *   Unreal.
+ * - Memory checkers: valgrind --leak-check=full --error-exitcode=1
+ *   --suppressions=capi/tests/c/onnxruntime.supp HOST ARGS exits 0 on the project's C checks
+ *   (the C ABI's tests run exactly that). The file suppresses only reports that are not the
+ *   project's: glibc's loader reading a word at a time, onnxruntime 1.31.1 at start-up and its
+ *   own thread reading freed memory as the process exits, and the 48-byte handle Rust's
+ *   standard library keeps for each live thread that has called in ("possibly lost" at exit,
+ *   freed when the thread ends).
  * - Compatibility: the layout of the structs here does not change; new abilities come as new
  *   functions.
+ *
+ * CHANGES (behaviour a host can notice; version 0.1.0 against earlier builds of this ABI):
+ * - sinmdm_stream_next checks its buffers for 0 frames too: NULL gives
+ *   SINMDM_NULL_ARGUMENT (it gave SINMDM_OK).
+ * - A run or stream given another handle of the same model file gives
+ *   SINMDM_INVALID_ARGUMENT (it worked); it takes the handle it was made with.
+ * - A progress callback that cancels at the last step gives SINMDM_CANCELLED and no result
+ *   (it gave SINMDM_OK and the result).
+ * - SinmdmSteerFrame's and SinmdmSteerCommand's reserved other than 0, and more steering
+ *   commands than frames, give SINMDM_INVALID_ARGUMENT (they were ignored).
+ * - New: the SINMDM_VERSION_* macros and sinmdm_model_values_per_frame (the factor of
+ *   SINMDM_MAX_RUN_VALUES); the onnxruntime-not-found message names every place searched.
  */
 
 #ifndef SINMDM_H
@@ -135,8 +173,10 @@
 #define SINMDM_MAX_SAMPLES 1024
 
 /*
- The largest working set one run may need, in f32 values (1 GiB): `count x frames x` the
- larger of `F + 8 C` and `12 x joints`; a bigger request is refused before anything runs.
+ The largest working set one run may need, in f32 values (1 GiB): a request is refused
+ before anything runs when `count x frames x values` passes it, `values` being what
+ `sinmdm_model_values_per_frame` gives for the model: `max(F + 8 C, 12 x joints)`, with F
+ `SinmdmModelInfo::features` and C the network's channels (64 in the shipped models).
  */
 #define SINMDM_MAX_RUN_VALUES (1 << 28)
 
@@ -172,6 +212,22 @@
  A progress callback's answer: stop the run (any value but 0 does the same).
  */
 #define SINMDM_PROGRESS_CANCEL 1
+
+/*
+ The major version of this header: a library of another major may break it.
+ */
+#define SINMDM_VERSION_MAJOR 0
+
+/*
+ The minor version of this header: a newer minor adds (and, while the major is 0, may change
+ what the header's CHANGES list).
+ */
+#define SINMDM_VERSION_MINOR 1
+
+/*
+ The patch version of this header: fixes only.
+ */
+#define SINMDM_VERSION_PATCH 0
 
 /*
  Respaced sampling steps of the command line (the library's `DEFAULT_STEPS`); what a `steps`
@@ -293,7 +349,9 @@ typedef enum SinmdmStatus {
    */
   SINMDM_INTERNAL = 9,
   /*
-   The progress callback asked to stop; the model (and a stepped run) can be used on.
+   A blocking task's progress callback asked to stop, after any step, the last included: the
+   call gives no result and the model can be used on. Only blocking tasks call the callback,
+   so a stepped run (`sinmdm_run_step`) never gives this; a host stops one by freeing it.
    */
   SINMDM_CANCELLED = 10,
 } SinmdmStatus;
@@ -532,8 +590,9 @@ typedef struct SinmdmSteerFrame {
    */
   uint32_t kind;
   /*
-   Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
-   included, so the struct is 48 bytes everywhere).
+   Set to 0; anything else gives `SINMDM_INVALID_ARGUMENT` (it keeps the numbers below
+   8-byte aligned on every platform, 32-bit ones included, so the struct is 48 bytes
+   everywhere, and stays free for later use).
    */
   uint32_t reserved;
   /*
@@ -561,8 +620,9 @@ typedef struct SinmdmSteerCommand {
    */
   uint32_t kind;
   /*
-   Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
-   included, so the struct is 72 bytes everywhere).
+   Set to 0; anything else gives `SINMDM_INVALID_ARGUMENT` (it keeps the numbers below
+   8-byte aligned on every platform, 32-bit ones included, so the struct is 72 bytes
+   everywhere, and stays free for later use).
    */
   uint32_t reserved;
   /*
@@ -705,7 +765,9 @@ enum SinmdmStatus sinmdm_dance(struct SinmdmModel *model,
                                struct SinmdmResult **out);
 
 /*
- The library's version, a static NUL-terminated string.
+ The loaded library's version, `"MAJOR.MINOR.PATCH"`, a static NUL-terminated string. A host
+ checks it at load against `SINMDM_VERSION_MAJOR` and `_MINOR` (see the introduction's
+ Version), since the header it was built with may not be the library's.
  */
 const char *sinmdm_version(void);
 
@@ -774,6 +836,18 @@ void sinmdm_model_free(struct SinmdmModel *model);
  `model` is a live handle; `info` is writable.
  */
 enum SinmdmStatus sinmdm_model_info(const struct SinmdmModel *model, struct SinmdmModelInfo *info);
+
+/*
+ Writes to `values` the f32 values one frame of one sample needs while a run is made on
+ `model`: `max(F + 8 C, 12 x joints)`, with F `SinmdmModelInfo::features` and C the
+ network's channels. A request of `count` samples of `frames` frames is refused with
+ `SINMDM_INVALID_ARGUMENT` when `count x frames x values` passes `SINMDM_MAX_RUN_VALUES`; a
+ function rather than a field, since the layout of `SinmdmModelInfo` does not change.
+
+ # Safety
+ `model` is a live handle; `values` is writable.
+ */
+enum SinmdmStatus sinmdm_model_values_per_frame(const struct SinmdmModel *model, size_t *values);
 
 /*
  Copies the name of joint `joint` into `buffer` of `capacity` bytes; `needed` (if not NULL)
@@ -891,6 +965,9 @@ void sinmdm_result_free(struct SinmdmResult *result);
  Takes up to `max_steps` denoising steps of `run` on `model` (the model it was begun on),
  and writes the steps taken so far and in all to `done` and `total` (each may be NULL). One
  step costs about a 50th of the whole run at the default step count; 0 steps only reports.
+ `model` is the very handle the run was begun on: another handle, even of the same file,
+ gives `SINMDM_INVALID_ARGUMENT` (a handle and its runs are one for the threading rule). The
+ progress callback is not called here: a stepped run is never cancelled, only freed.
 
  # Safety
  `run` and `model` are live handles; `done` and `total` NULL or writable.
@@ -905,7 +982,10 @@ enum SinmdmStatus sinmdm_run_step(struct SinmdmRun *run,
  Finishes `run` and writes its batch to `out`: the motion once every step is taken, or,
  before that, the network's latest prediction of the clean motion (a preview; a run that has
  taken no step has none and gives `SINMDM_INVALID_ARGUMENT`). The run is spent afterwards:
- free it with `sinmdm_run_free`.
+ free it with `sinmdm_run_free`. Which failures spend it: the refusals (`SINMDM_NULL_ARGUMENT`
+ for a NULL `run` or `out`; `SINMDM_INVALID_ARGUMENT` for a spent run or one with no step
+ taken) leave it as it was, to be stepped and finished again; only `SINMDM_INTERNAL` (a
+ caught panic while the batch is made) spends it without a result.
 
  # Safety
  `run` is a live handle; `out` writable.
@@ -955,7 +1035,8 @@ enum SinmdmStatus sinmdm_steer_begin(struct SinmdmModel *model,
  New motion of `frames` frames whose root goes where `commands` say (one per frame from
  frame 0; frames past them are free), from the model's start position and facing, soft over
  `ramp` frames where commands start and stop (the same motion as `sinmdm steer` for the same
- commands, seed and settings). Needs a heading-relative model.
+ commands, seed and settings). Needs a heading-relative model. More commands than `frames`,
+ or a `reserved` that is not 0, give `SINMDM_INVALID_ARGUMENT`.
 
  # Safety
  Pointers as their types' documentation says; `commands` readable for `command_count`
@@ -976,7 +1057,8 @@ enum SinmdmStatus sinmdm_steer(struct SinmdmModel *model,
  has been handed out (`block`: the stream's block frames, the training clip's length by
  default), plus whatever `sinmdm_stream_step` prepared ahead; commands for frames a block
  has already started on are not used. `SINMDM_INVALID_ARGUMENT` for a model without a
- heading-relative root or a value that is not finite.
+ heading-relative root, a value that is not finite or a `reserved` that is not 0. A `count`
+ of 0 adds nothing and succeeds (`commands` may then be NULL), as any empty array does.
 
  # Safety
  `stream` is a live handle; `commands` readable for `count` values.
@@ -1066,7 +1148,10 @@ enum SinmdmStatus sinmdm_stream_supply(struct SinmdmStream *stream,
  Makes the next `frames` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) on `model` (the model
  the stream was made with) and writes their poses into `buffers`. The motion is the same
  whatever chunk sizes are asked for. It runs the network only for frames not yet prepared
- by `sinmdm_stream_step`.
+ by `sinmdm_stream_step`. `buffers` is checked as for any other `frames`, 0 included: NULL
+ (or a NULL array but `translations`) gives `SINMDM_NULL_ARGUMENT` and hands out nothing. A
+ stream is advanced on the very handle it was made with: another handle, even of the same
+ file, gives `SINMDM_INVALID_ARGUMENT`, as in `sinmdm_stream_step` and `sinmdm_stream_supply`.
 
  # Safety
  `stream` and `model` are live handles; `buffers` as its documentation says.

@@ -10,8 +10,10 @@ pub const SINMDM_MAX_SAMPLE_FRAMES: usize = 100_000;
 pub const SINMDM_MAX_RAMP_FRAMES: usize = 100_000;
 /// The largest crowd one run makes (`SinmdmSampling.count`).
 pub const SINMDM_MAX_SAMPLES: usize = 1024;
-/// The largest working set one run may need, in f32 values (1 GiB): `count x frames x` the
-/// larger of `F + 8 C` and `12 x joints`; a bigger request is refused before anything runs.
+/// The largest working set one run may need, in f32 values (1 GiB): a request is refused
+/// before anything runs when `count x frames x values` passes it, `values` being what
+/// `sinmdm_model_values_per_frame` gives for the model: `max(F + 8 C, 12 x joints)`, with F
+/// `SinmdmModelInfo::features` and C the network's channels (64 in the shipped models).
 pub const SINMDM_MAX_RUN_VALUES: usize = 1 << 28;
 /// The most threads a model runs samples on (`threads` of `sinmdm_model_open*`; 0 = every core).
 pub const SINMDM_MAX_THREADS: usize = 1024;

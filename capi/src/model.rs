@@ -105,7 +105,17 @@ pub struct SinmdmModelInfo {
     pub diffusion_steps: usize,
 }
 
-/// The library's version, a static NUL-terminated string.
+/// The major version of this header: a library of another major may break it.
+pub const SINMDM_VERSION_MAJOR: u32 = 0;
+/// The minor version of this header: a newer minor adds (and, while the major is 0, may change
+/// what the header's CHANGES list).
+pub const SINMDM_VERSION_MINOR: u32 = 1;
+/// The patch version of this header: fixes only.
+pub const SINMDM_VERSION_PATCH: u32 = 0;
+
+/// The loaded library's version, `"MAJOR.MINOR.PATCH"`, a static NUL-terminated string. A host
+/// checks it at load against `SINMDM_VERSION_MAJOR` and `_MINOR` (see the introduction's
+/// Version), since the header it was built with may not be the library's.
 #[unsafe(no_mangle)]
 pub extern "C" fn sinmdm_version() -> *const c_char {
     concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
@@ -249,6 +259,27 @@ pub unsafe extern "C" fn sinmdm_model_info(
     })
 }
 
+/// Writes to `values` the f32 values one frame of one sample needs while a run is made on
+/// `model`: `max(F + 8 C, 12 x joints)`, with F `SinmdmModelInfo::features` and C the
+/// network's channels. A request of `count` samples of `frames` frames is refused with
+/// `SINMDM_INVALID_ARGUMENT` when `count x frames x values` passes `SINMDM_MAX_RUN_VALUES`; a
+/// function rather than a field, since the layout of `SinmdmModelInfo` does not change.
+///
+/// # Safety
+/// `model` is a live handle; `values` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sinmdm_model_values_per_frame(
+    model: *const SinmdmModel,
+    values: *mut usize,
+) -> SinmdmStatus {
+    guard(|| {
+        let model = unsafe { model_arg(model) }?;
+        let values = unsafe { handle(values, "values") }?;
+        *values = sinmdm::tasks::run_values_per_frame(model.metadata());
+        Ok(())
+    })
+}
+
 /// Copies the name of joint `joint` into `buffer` of `capacity` bytes; `needed` (if not NULL)
 /// gets its size with the NUL, also when the buffer is NULL (a size query) or too small.
 ///
@@ -382,4 +413,26 @@ pub unsafe extern "C" fn sinmdm_model_contact_joints(
         let contacts = &model.metadata().layout.contact_joints;
         unsafe { copy_array(contacts, joints, capacity, needed, "joints") }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_version_macros_are_the_crates() {
+        let number = |text: &str| text.parse::<u32>().unwrap();
+        assert_eq!(
+            SINMDM_VERSION_MAJOR,
+            number(env!("CARGO_PKG_VERSION_MAJOR"))
+        );
+        assert_eq!(
+            SINMDM_VERSION_MINOR,
+            number(env!("CARGO_PKG_VERSION_MINOR"))
+        );
+        assert_eq!(
+            SINMDM_VERSION_PATCH,
+            number(env!("CARGO_PKG_VERSION_PATCH"))
+        );
+    }
 }

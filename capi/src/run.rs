@@ -55,7 +55,8 @@ pub(crate) unsafe fn begin(
 }
 
 /// Runs a task to the end in one call: `begin_task` begins it; each step reports to the
-/// model's progress callback, which may cancel (`SINMDM_CANCELLED`, no result).
+/// model's progress callback, which may cancel after any step, the last included
+/// (`SINMDM_CANCELLED`, no result), as the header promises a host.
 ///
 /// # Safety
 /// `model` is a live handle; `out` writable; `begin_task` is a `sinmdm_*_begin` call.
@@ -80,13 +81,24 @@ pub(crate) unsafe fn blocking(
             let model = handle(model, "model")?;
             let progress = model.progress;
             let mut run = owned.run.expect("a run just begun is live");
+            let mut stopped = false;
             run.complete(&mut model.model, &mut |done, total| {
                 if progress.go_on(done, total) {
                     ControlFlow::Continue(())
                 } else {
+                    stopped = true;
                     ControlFlow::Break(())
                 }
             })?;
+            // The engine finishes a run cancelled at its last step; the C ABI gives no result
+            // for any cancel, so a host reads one answer one way.
+            if stopped {
+                let sinmdm::Progress { done, total } = run.progress();
+                return Err(Failure::from(sinmdm::TaskError::Cancelled {
+                    done,
+                    steps: total,
+                }));
+            }
             give(
                 out,
                 SinmdmResult {
@@ -101,6 +113,9 @@ pub(crate) unsafe fn blocking(
 /// Takes up to `max_steps` denoising steps of `run` on `model` (the model it was begun on),
 /// and writes the steps taken so far and in all to `done` and `total` (each may be NULL). One
 /// step costs about a 50th of the whole run at the default step count; 0 steps only reports.
+/// `model` is the very handle the run was begun on: another handle, even of the same file,
+/// gives `SINMDM_INVALID_ARGUMENT` (a handle and its runs are one for the threading rule). The
+/// progress callback is not called here: a stepped run is never cancelled, only freed.
 ///
 /// # Safety
 /// `run` and `model` are live handles; `done` and `total` NULL or writable.
@@ -130,7 +145,10 @@ pub unsafe extern "C" fn sinmdm_run_step(
 /// Finishes `run` and writes its batch to `out`: the motion once every step is taken, or,
 /// before that, the network's latest prediction of the clean motion (a preview; a run that has
 /// taken no step has none and gives `SINMDM_INVALID_ARGUMENT`). The run is spent afterwards:
-/// free it with `sinmdm_run_free`.
+/// free it with `sinmdm_run_free`. Which failures spend it: the refusals (`SINMDM_NULL_ARGUMENT`
+/// for a NULL `run` or `out`; `SINMDM_INVALID_ARGUMENT` for a spent run or one with no step
+/// taken) leave it as it was, to be stepped and finished again; only `SINMDM_INTERNAL` (a
+/// caught panic while the batch is made) spends it without a result.
 ///
 /// # Safety
 /// `run` is a live handle; `out` writable.

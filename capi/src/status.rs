@@ -35,7 +35,9 @@ pub enum SinmdmStatus {
     SinmdmIo = 8,
     /// A bug in the library (a caught panic); the handle involved should be freed.
     SinmdmInternal = 9,
-    /// The progress callback asked to stop; the model (and a stepped run) can be used on.
+    /// A blocking task's progress callback asked to stop, after any step, the last included: the
+    /// call gives no result and the model can be used on. Only blocking tasks call the callback,
+    /// so a stepped run (`sinmdm_run_step`) never gives this; a host stops one by freeing it.
     SinmdmCancelled = 10,
 }
 

@@ -38,8 +38,9 @@ pub const SINMDM_STEER_POSITION_FACING: u32 = 4;
 pub struct SinmdmSteerFrame {
     /// `SINMDM_STEER_FREE`, `SINMDM_STEER_VELOCITY` or `SINMDM_STEER_POSITION`.
     pub kind: u32,
-    /// Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
-    /// included, so the struct is 48 bytes everywhere).
+    /// Set to 0; anything else gives `SINMDM_INVALID_ARGUMENT` (it keeps the numbers below
+    /// 8-byte aligned on every platform, 32-bit ones included, so the struct is 48 bytes
+    /// everywhere, and stays free for later use).
     pub reserved: u32,
     /// `SINMDM_STEER_VELOCITY`: forward speed, file units per second.
     pub forward: f64,
@@ -72,8 +73,9 @@ pub struct SinmdmSteerLimits {
 pub struct SinmdmSteerCommand {
     /// `SINMDM_STEER_FREE`, `_VELOCITY`, `_POSITION`, `_FACING` or `_POSITION_FACING`.
     pub kind: u32,
-    /// Set to 0 (it keeps the numbers below 8-byte aligned on every platform, 32-bit ones
-    /// included, so the struct is 72 bytes everywhere).
+    /// Set to 0; anything else gives `SINMDM_INVALID_ARGUMENT` (it keeps the numbers below
+    /// 8-byte aligned on every platform, 32-bit ones included, so the struct is 72 bytes
+    /// everywhere, and stays free for later use).
     pub reserved: u32,
     /// `SINMDM_STEER_VELOCITY`: forward speed, file units per second.
     pub forward: f64,
@@ -139,6 +141,12 @@ where
         .enumerate()
         .map(|(i, f)| {
             let f: SinmdmSteerCommand = f.into();
+            if f.reserved != 0 {
+                return Err(Failure::invalid(format!(
+                    "commands[{i}].reserved must be 0, got {} (it is kept for later use)",
+                    f.reserved
+                )));
+            }
             let finite = |values: &[f64], what: &str| {
                 if values.iter().all(|v| v.is_finite()) {
                     Ok(())
@@ -220,6 +228,11 @@ where
     unsafe {
         begin(model, out, |_| {
             let sampling = sampling_arg(sampling)?;
+            if command_count > frames {
+                return Err(Failure::invalid(format!(
+                    "command_count is {command_count} for {frames} frames: one command per frame at most (more would be ignored)"
+                )));
+            }
             let commands = commands_arg(commands, command_count, last_kind)?;
             request(
                 &sampling,
@@ -313,7 +326,8 @@ pub unsafe extern "C" fn sinmdm_steer_begin(
 /// New motion of `frames` frames whose root goes where `commands` say (one per frame from
 /// frame 0; frames past them are free), from the model's start position and facing, soft over
 /// `ramp` frames where commands start and stop (the same motion as `sinmdm steer` for the same
-/// commands, seed and settings). Needs a heading-relative model.
+/// commands, seed and settings). Needs a heading-relative model. More commands than `frames`,
+/// or a `reserved` that is not 0, give `SINMDM_INVALID_ARGUMENT`.
 ///
 /// # Safety
 /// Pointers as their types' documentation says; `commands` readable for `command_count`
@@ -341,7 +355,8 @@ pub unsafe extern "C" fn sinmdm_steer(
 /// has been handed out (`block`: the stream's block frames, the training clip's length by
 /// default), plus whatever `sinmdm_stream_step` prepared ahead; commands for frames a block
 /// has already started on are not used. `SINMDM_INVALID_ARGUMENT` for a model without a
-/// heading-relative root or a value that is not finite.
+/// heading-relative root, a value that is not finite or a `reserved` that is not 0. A `count`
+/// of 0 adds nothing and succeeds (`commands` may then be NULL), as any empty array does.
 ///
 /// # Safety
 /// `stream` is a live handle; `commands` readable for `count` values.

@@ -124,7 +124,10 @@ pub unsafe extern "C" fn sinmdm_stream_supply(
 /// Makes the next `frames` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) on `model` (the model
 /// the stream was made with) and writes their poses into `buffers`. The motion is the same
 /// whatever chunk sizes are asked for. It runs the network only for frames not yet prepared
-/// by `sinmdm_stream_step`.
+/// by `sinmdm_stream_step`. `buffers` is checked as for any other `frames`, 0 included: NULL
+/// (or a NULL array but `translations`) gives `SINMDM_NULL_ARGUMENT` and hands out nothing. A
+/// stream is advanced on the very handle it was made with: another handle, even of the same
+/// file, gives `SINMDM_INVALID_ARGUMENT`, as in `sinmdm_stream_step` and `sinmdm_stream_supply`.
 ///
 /// # Safety
 /// `stream` and `model` are live handles; `buffers` as its documentation says.

@@ -12,7 +12,8 @@ pub const MAX_RAMP_FRAMES: usize = MAX_SAMPLE_FRAMES;
 /// The largest crowd one run makes.
 pub const MAX_SAMPLES: usize = 1024;
 /// The largest working set one run may need, in f32 values (1 GiB): `samples x frames x` the
-/// larger of `F + 8 C` (the network's layers) and `12 x joints` (the decoded motion).
+/// larger of `F + 8 C` (the network's layers: F feature rows, C channels) and `12 x joints`
+/// (the decoded motion); `tasks::run_values_per_frame` gives the per-frame factor of a model.
 pub const MAX_RUN_VALUES: usize = 1 << 28;
 /// The longest feature sequence encoding a clip makes, after resampling to the model's frame
 /// rate (over nine hours at 30 fps): clips are read whole, so this only stops a frame rate

@@ -14,9 +14,10 @@
 //! 6. a developer checkout's `.venv` (made by the project's set-up script), above the working
 //!    directory or the executable.
 //!
-//! A library older than [`ONNXRUNTIME_OLDEST`] is refused and the search goes on. Nothing of the
-//! machine the crate was built on is searched. A failed attempt is not remembered: the next one
-//! searches (or loads) again.
+//! A library older than [`ONNXRUNTIME_OLDEST`] is refused and the search goes on. When nothing
+//! loads, the error names every place of steps 2 to 6 in order, with what each gave, so a host
+//! can tell which it meant to use. Nothing of the machine the crate was built on is searched. A
+//! failed attempt is not remembered: the next one searches (or loads) again.
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -38,7 +39,7 @@ pub enum RuntimeLibraryError {
     #[error(
         "onnxruntime (release {ONNXRUNTIME_OLDEST} or later, tested with {ONNXRUNTIME_VERSION}) was not found; \
          ship {file} next to the program's executable, or set ORT_DYLIB_PATH to the library file. \
-         Tried: {searched}"
+         Tried, in order: {searched}"
     )]
     NotFound {
         /// The usual file name on this platform.
@@ -154,7 +155,7 @@ impl std::fmt::Display for Candidate {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Candidate::File(p) => write!(f, "{}", p.display()),
-            Candidate::System(name) => write!(f, "{name} on the system's library path"),
+            Candidate::System(name) => write!(f, "{name}"),
         }
     }
 }
@@ -188,39 +189,111 @@ fn system_names() -> &'static [&'static str] {
     }
 }
 
-/// The search order of the module documentation, steps 2 to 6: the candidates to try in turn,
-/// or the error when `ORT_DYLIB_PATH` names a missing file.
+/// One place the search looks, steps 2 to 6 of the module documentation, with the libraries
+/// found there; a place with none is still named when nothing loads, so that the message
+/// lists every place tried.
+struct Place {
+    /// The place in words ("next to the executable"), with why it gave nothing when it did.
+    what: String,
+    /// The libraries to try there, in order.
+    found: Vec<Candidate>,
+}
+
+/// The place of a program's own folder (`None` when it cannot be known), searched unless it
+/// is `searched_before` (the library's folder when it is the executable's).
+fn folder_place(what: &str, folder: Option<&Path>, searched_before: Option<&Path>) -> Place {
+    let Some(folder) = folder else {
+        return Place {
+            what: format!("{what}: its folder is unknown here"),
+            found: Vec::new(),
+        };
+    };
+    if searched_before == Some(folder) {
+        return Place {
+            what: format!("{what}: the executable's folder, {}", folder.display()),
+            found: Vec::new(),
+        };
+    }
+    let found: Vec<Candidate> = in_folder(folder).into_iter().map(Candidate::File).collect();
+    Place {
+        what: if found.is_empty() {
+            format!("{what}: no {} in {}", usual_name(), folder.display())
+        } else {
+            what.to_string()
+        },
+        found,
+    }
+}
+
+/// The places of the module documentation's steps 2 to 6, in order, or the error when
+/// `ORT_DYLIB_PATH` names a missing file (then nothing else is tried).
+fn places(
+    env_path: Option<OsString>,
+    folders: &Folders,
+    roots: &[PathBuf],
+) -> Result<Vec<Place>, RuntimeLibraryError> {
+    if let Some(path) = env_path.filter(|p| !p.is_empty()) {
+        let path = PathBuf::from(path);
+        return if path.is_file() {
+            Ok(vec![Place {
+                what: "ORT_DYLIB_PATH".into(),
+                found: vec![Candidate::File(path)],
+            }])
+        } else {
+            Err(RuntimeLibraryError::EnvPathMissing(path))
+        };
+    }
+    let venvs: Vec<Candidate> = roots
+        .iter()
+        .filter_map(|r| in_venv(&r.join(".venv")))
+        .map(Candidate::File)
+        .collect();
+    Ok(vec![
+        Place {
+            what: "ORT_DYLIB_PATH: not set".into(),
+            found: Vec::new(),
+        },
+        folder_place(
+            "next to the executable",
+            folders.executable.as_deref(),
+            None,
+        ),
+        folder_place(
+            "next to this library",
+            folders.library.as_deref(),
+            folders.executable.as_deref(),
+        ),
+        Place {
+            what: "the system loader's search path".into(),
+            found: system_names()
+                .iter()
+                .map(|n| Candidate::System(n))
+                .collect(),
+        },
+        Place {
+            what: if venvs.is_empty() {
+                "a developer checkout's .venv: none in the working folder, the executable's \
+                 or a folder above them"
+                    .into()
+            } else {
+                "a developer checkout's .venv".into()
+            },
+            found: venvs,
+        },
+    ])
+}
+
+/// The libraries of [`places`] to try in turn, each once (what `load` tries, for the tests).
+#[cfg(test)]
 fn candidates(
     env_path: Option<OsString>,
     folders: &Folders,
     roots: &[PathBuf],
 ) -> Result<Vec<Candidate>, RuntimeLibraryError> {
-    if let Some(path) = env_path.filter(|p| !p.is_empty()) {
-        let path = PathBuf::from(path);
-        return if path.is_file() {
-            Ok(vec![Candidate::File(path)])
-        } else {
-            Err(RuntimeLibraryError::EnvPathMissing(path))
-        };
-    }
-    let mut list = Vec::new();
-    let mut folders_seen = Vec::new();
-    for folder in [&folders.executable, &folders.library]
+    let mut list: Vec<Candidate> = places(env_path, folders, roots)?
         .into_iter()
-        .flatten()
-    {
-        if !folders_seen.contains(folder) {
-            folders_seen.push(folder.clone());
-            list.extend(in_folder(folder).into_iter().map(Candidate::File));
-        }
-    }
-    list.extend(system_names().iter().map(|n| Candidate::System(n)));
-    list.extend(
-        roots
-            .iter()
-            .filter_map(|r| in_venv(&r.join(".venv")))
-            .map(Candidate::File),
-    );
+        .flat_map(|p| p.found)
+        .collect();
     let mut seen = std::collections::HashSet::new();
     list.retain(|c| seen.insert(c.clone()));
     Ok(list)
@@ -368,49 +441,61 @@ fn load(asked: Option<&Path>) -> Result<&'static OnnxRuntime, RuntimeLibraryErro
     if let Some(runtime) = LOADED.get() {
         return check(runtime);
     }
-    let list = match asked {
-        Some(p) if p.is_file() => vec![Candidate::File(
-            std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()),
-        )],
+    let places = match asked {
+        Some(p) if p.is_file() => vec![Place {
+            what: "the library asked for".into(),
+            found: vec![Candidate::File(
+                std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()),
+            )],
+        }],
         Some(p) => {
             return Err(RuntimeLibraryError::LoadFailed {
                 path: p.to_path_buf(),
                 message: "no such file".into(),
             });
         }
-        None => candidates(
+        None => places(
             std::env::var_os("ORT_DYLIB_PATH"),
             &Folders::of_this_process(),
             &checkout_roots(),
         )?,
     };
-    let (mut tried, mut messages) = (Vec::new(), Vec::new());
-    for candidate in &list {
-        let path = match candidate {
-            Candidate::File(p) => p.clone(),
-            Candidate::System(name) => PathBuf::from(name),
-        };
-        match start_environment(&path) {
-            Ok(environment) => {
-                return Ok(LOADED.get_or_init(|| OnnxRuntime { path, environment }));
-            }
-            Err(Attempt::NotLoaded(message)) => {
-                tried.push(format!("{candidate} ({message})"));
-                messages.push(message);
-            }
-            // The library loaded (and stays loaded: one per process) but would not start:
-            // trying another would only reuse it.
-            Err(Attempt::Failed(message)) => {
-                return Err(RuntimeLibraryError::LoadFailed { path, message });
+    let (mut tried, mut messages, mut seen) =
+        (Vec::new(), Vec::new(), std::collections::HashSet::new());
+    for place in &places {
+        if place.found.is_empty() {
+            tried.push(place.what.clone());
+        }
+        for candidate in place.found.iter().filter(|c| seen.insert(*c)) {
+            let path = match candidate {
+                Candidate::File(p) => p.clone(),
+                Candidate::System(name) => PathBuf::from(name),
+            };
+            match start_environment(&path) {
+                Ok(environment) => {
+                    return Ok(LOADED.get_or_init(|| OnnxRuntime { path, environment }));
+                }
+                Err(Attempt::NotLoaded(message)) => {
+                    tried.push(format!("{}: {candidate} ({message})", place.what));
+                    messages.push(message);
+                }
+                // The library loaded (and stays loaded: one per process) but would not start:
+                // trying another would only reuse it.
+                Err(Attempt::Failed(message)) => {
+                    return Err(RuntimeLibraryError::LoadFailed { path, message });
+                }
             }
         }
     }
+    let list: Vec<&Candidate> = places.iter().flat_map(|p| &p.found).collect();
     match (asked, list.as_slice()) {
         (Some(p), _) => Err(RuntimeLibraryError::LoadFailed {
             path: p.to_path_buf(),
             message: messages.join("; "),
         }),
-        (None, [Candidate::File(p)]) if std::env::var_os("ORT_DYLIB_PATH").is_some() => {
+        (None, [Candidate::File(p)])
+            if std::env::var_os("ORT_DYLIB_PATH").is_some_and(|v| !v.is_empty()) =>
+        {
             Err(RuntimeLibraryError::LoadFailed {
                 path: p.clone(),
                 message: messages.join("; "),
@@ -519,6 +604,60 @@ mod tests {
             "the system loader comes after both folders: {list:?}"
         );
         assert!(matches!(list.last(), Some(Candidate::File(p)) if p == &capi.join(name)));
+        std::fs::remove_dir_all(root).unwrap();
+    }
+
+    #[test]
+    fn a_search_that_finds_nothing_names_every_place_in_order() {
+        let root = temp_root("nothing");
+        let (exe, lib) = (root.join("game"), root.join("plugins"));
+        for dir in [&exe, &lib] {
+            std::fs::create_dir_all(dir).unwrap();
+        }
+        let folders = Folders {
+            executable: Some(exe.clone()),
+            library: Some(lib.clone()),
+        };
+        let list = places(None, &folders, std::slice::from_ref(&root)).unwrap();
+        let what: Vec<&str> = list.iter().map(|p| p.what.as_str()).collect();
+        assert_eq!(what.len(), 5, "{what:?}");
+        assert_eq!(what[0], "ORT_DYLIB_PATH: not set");
+        assert_eq!(
+            what[1],
+            format!(
+                "next to the executable: no {} in {}",
+                usual_name(),
+                exe.display()
+            )
+        );
+        assert_eq!(
+            what[2],
+            format!(
+                "next to this library: no {} in {}",
+                usual_name(),
+                lib.display()
+            )
+        );
+        assert_eq!(what[3], "the system loader's search path");
+        assert!(
+            what[4].starts_with("a developer checkout's .venv: none"),
+            "{what:?}"
+        );
+        let with_libraries: Vec<usize> = (0..5).filter(|&i| !list[i].found.is_empty()).collect();
+        assert_eq!(with_libraries, vec![3], "only the system loader is asked");
+        // The executable's folder is searched once, and named again as this library's.
+        let shared = Folders {
+            executable: Some(exe.clone()),
+            library: Some(exe.clone()),
+        };
+        let list = places(None, &shared, &[]).unwrap();
+        assert_eq!(
+            list[2].what,
+            format!(
+                "next to this library: the executable's folder, {}",
+                exe.display()
+            )
+        );
         std::fs::remove_dir_all(root).unwrap();
     }
 

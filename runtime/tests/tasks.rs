@@ -395,6 +395,31 @@ fn bad_requests_are_refused_with_what_is_wrong() {
 }
 
 #[test]
+fn the_run_size_bound_is_count_frames_and_the_values_per_frame() {
+    let m = model();
+    let values = tasks::run_values_per_frame(m.metadata());
+    let network = &m.metadata().network;
+    let joints = m.skeleton().len();
+    assert_eq!(
+        values,
+        (network.features + 8 * network.channels).max(12 * joints)
+    );
+    let count = tasks::MAX_SAMPLES;
+    let longest = tasks::MAX_RUN_VALUES / (count * values);
+    let request = |frames: usize| Request {
+        task: Task::Generate { frames },
+        count,
+        seed: 0,
+        steps: Some(2),
+        feet: sinmdm::Feet::default(),
+        method: Default::default(),
+    };
+    assert!(tasks::plan(m.metadata(), &request(longest)).is_ok());
+    let e = tasks::plan(m.metadata(), &request(longest + 1)).unwrap_err();
+    assert!(matches!(e, TaskError::TooLarge { .. }), "{e:?}");
+}
+
+#[test]
 fn asking_a_batch_for_a_sample_it_lacks_is_an_error() {
     let mut m = model();
     let out = run(&mut m, Task::Generate { frames: 20 }, 2, 3);

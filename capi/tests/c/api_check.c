@@ -1,19 +1,35 @@
 /* The C ABI from C: a shipped model opened, a crowd generated, an in-between of it, a stream in
  * two uneven chunks and a BVH written, every value printed as the bits of its float so the
- * Rust test can compare them with the Rust API's exactly; then every entry point fed bad
- * arguments, each of which must give its status code and a message, never a crash.
+ * Rust test can compare them with the Rust API's exactly; then what the header says of
+ * versions, threads, batches, bounds, cancels, steering arrays and handles, each checked; then
+ * every entry point fed bad arguments, each of which must give its status code and a message,
+ * never a crash.
  *
  * Usage: api_check MODEL.onnx NOT_A_MODEL_FILE OUT.bvh STEERABLE_MODEL.onnx WORLD_ROOT_MODEL.onnx
  * (a heading-relative model, for the steering checks, and one with the world root, which refuses
  * steering)
- * Prints "<label> <hex> <hex> ..." lines, then "bad arguments: N checks" on success. */
+ * Prints "<label> <hex> <hex> ..." lines, then "bad arguments: N checks" on success.
+ *
+ * Or: api_check --not-found, run where no onnxruntime can be found: the refusal must name every
+ * place the header says is searched, in its order; prints "not found: N places" on success. */
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#ifdef __linux__
+#include <dirent.h>
+#endif
 
 #include "sinmdm.h"
+
+/* The threads onnxruntime's environment starts (the header's Threads): one with the 1.31.1
+   the tests load. */
+#ifndef ONNXRUNTIME_THREADS
+#define ONNXRUNTIME_THREADS 1
+#endif
 
 static int failures = 0;
 static int checks = 0;
@@ -126,9 +142,57 @@ static int same_poses(const Poses *a, const Poses *b) {
 static void expect_true(int ok, const char *what) {
   checks++;
   if (!ok) {
-    fprintf(stderr, "stepping: %s\n", what);
+    fprintf(stderr, "check failed: %s\n", what);
     failures++;
   }
+}
+
+/* Threads of this process now (Linux: /proc/self/task), or 0 where that cannot be read. */
+static size_t threads_now(void) {
+#ifdef __linux__
+  DIR *dir = opendir("/proc/self/task");
+  if (dir == NULL) return 0;
+  size_t n = 0;
+  struct dirent *entry;
+  while ((entry = readdir(dir)) != NULL) {
+    if (entry->d_name[0] != '.') n++;
+  }
+  closedir(dir);
+  return n;
+#else
+  return 0;
+#endif
+}
+
+/* The thread count once it is `want`, or after 5 s of waiting for it: a thread the library
+   lets go (a run's noise thread) ends on its own just after. */
+static size_t threads_settled(size_t want) {
+  size_t n = threads_now();
+  for (int i = 0; i < 500 && n != want; i++) {
+    struct timespec pause = {0, 10 * 1000 * 1000};
+    nanosleep(&pause, NULL);
+    n = threads_now();
+  }
+  return n;
+}
+
+/* A progress callback that counts its calls in `*userdata` and asks to stop. */
+static int32_t count_calls(void *userdata, size_t done, size_t total) {
+  (void)done;
+  (void)total;
+  (*(size_t *)userdata)++;
+  return SINMDM_PROGRESS_CANCEL;
+}
+
+/* A progress callback that counts in `userdata[1]` the steps after which the thread count is
+   not `userdata[0]` (the threads that stay and the run's own), and goes on. */
+static int32_t watch_threads(void *userdata, size_t done, size_t total) {
+  (void)done;
+  (void)total;
+  size_t *watch = userdata;
+  size_t n = threads_settled(watch[0]);
+  if (n != 0 && n != watch[0]) watch[1]++;
+  return SINMDM_PROGRESS_CONTINUE;
 }
 
 /* The poses of sample 0 of a finished run (freed), into `out`. */
@@ -206,10 +270,27 @@ static void check_stepping(SinmdmModel *model, size_t joints, const SinmdmPoses 
   SinmdmResult *cancelled = (SinmdmResult *)&stop_at;
   EXPECT(SINMDM_CANCELLED, sinmdm_generate(model, &sampling, 40, &cancelled));
   expect_true(cancelled == NULL, "a cancelled call gives no result");
+  /* At the last step (done == total) too: CANCELLED and no result, as at any other. */
+  stop_at = 7;
+  cancelled = (SinmdmResult *)&stop_at;
+  EXPECT(SINMDM_CANCELLED, sinmdm_generate(model, &sampling, 40, &cancelled));
+  expect_true(cancelled == NULL, "a call cancelled at its last step gives no result");
   stop_at = SIZE_MAX;
   Poses after = poses_alloc(40, joints);
   generate_into(model, &sampling, &after);
   expect_true(same_poses(&after, &once), "the model after a cancel gives the same motion");
+  /* A stepped run never calls the callback, so it is never cancelled. */
+  size_t calls = 0;
+  CHECK_OK(sinmdm_model_set_progress(model, count_calls, &calls));
+  CHECK_OK(sinmdm_generate_begin(model, &sampling, 40, &run));
+  CHECK_OK(sinmdm_run_step(run, model, SIZE_MAX, NULL, NULL));
+  expect_true(calls == 0, "sinmdm_run_step does not call the progress callback");
+  /* Refusals of run_finish leave the run as it was; the finish after them works. */
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_run_finish(run, NULL));
+  Poses stepped_on = poses_alloc(40, joints);
+  finish_into(run, &stepped_on);
+  expect_true(same_poses(&stepped_on, &once), "a run finished after a refused finish is whole");
+  poses_free(&stepped_on);
   CHECK_OK(sinmdm_model_set_progress(model, NULL, NULL));
   poses_free(&after);
 
@@ -324,7 +405,22 @@ static void check_steering(const char *path, const char *world_path) {
   commands[3].position[1] = NAN;
   EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_steer(zombie, &once, 40, commands, 10, 5, &unused));
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_stream_steer(stream, NULL, 3));
+  /* An empty array (NULL with a count of 0) adds nothing and succeeds. */
   CHECK_OK(sinmdm_stream_steer(stream, NULL, 0));
+  CHECK_OK(sinmdm_stream_steer_commands(stream, NULL, 0));
+  /* A reserved field that is not 0, and more commands than frames, are refused. */
+  steer_velocity(commands, 40, 12.0, 0.3);
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_steer(zombie, &once, 30, commands, 40, 5, &unused));
+  SinmdmRun *not_begun = NULL;
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_steer_begin(zombie, &once, 30, commands, 31, 5, &not_begun));
+  commands[2].reserved = 7;
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_steer(zombie, &once, 40, commands, 40, 5, &unused));
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_stream_steer(stream, commands, 10));
+  SinmdmSteerCommand reserved_command = {SINMDM_STEER_FACING, 7, 0.0, 0.0, {0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}};
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_stream_steer_commands(stream, &reserved_command, 1));
+  EXPECT(SINMDM_INVALID_ARGUMENT,
+         sinmdm_steer_commands(zombie, &once, 40, &reserved_command, 1, 5, &unused));
+  expect_true(unused == NULL && not_begun == NULL, "a refused steer gives no handle");
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_steer_limits(NULL, &limits));
   EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_steer_limits(zombie, NULL));
   sinmdm_stream_free(stream);
@@ -332,15 +428,150 @@ static void check_steering(const char *path, const char *world_path) {
   sinmdm_model_free(world);
 }
 
+/* The library's version is the header's: "MAJOR.MINOR.PATCH" of the SINMDM_VERSION_* macros. */
+static void check_version(void) {
+  unsigned major = 999, minor = 999, patch = 999;
+  int parsed = sscanf(sinmdm_version(), "%u.%u.%u", &major, &minor, &patch);
+  expect_true(parsed == 3 && major == SINMDM_VERSION_MAJOR && minor == SINMDM_VERSION_MINOR &&
+                  patch == SINMDM_VERSION_PATCH,
+              "sinmdm_version() reads SINMDM_VERSION_MAJOR.MINOR.PATCH");
+}
+
+/* What the header says of batches, bounds, threads and handles: sample k of a crowd is sample k
+   of any crowd of more than k samples (count 1 gives sample 0); a request past
+   SINMDM_MAX_RUN_VALUES by sinmdm_model_values_per_frame is refused; a run has one thread of
+   its own, gone once it is freed, and a crowd's threads are joined before a call returns; a
+   run or stream takes only the handle it was made with; stream_next checks its buffers for 0
+   frames too. */
+static void check_header_word(SinmdmModel *model, const char *model_path, const SinmdmModelInfo *info,
+                              const Poses *sample0, const Poses *sample1, size_t threads_loaded,
+                              SinmdmStream *stream, SinmdmPoseBuffers *chunk_buffers) {
+  size_t joints = info->joints;
+  /* Batches: sample 0 alone (count 1) and samples 0 and 1 of a crowd of 3 are the crowd of
+     2's, bit for bit. */
+  SinmdmSampling alone = {7, 1, 4, SINMDM_FEET_PLANTED, SINMDM_METHOD_ANCESTRAL, 0.0};
+  Poses first = poses_alloc(40, joints);
+  generate_into(model, &alone, &first);
+  expect_true(same_poses(&first, sample0), "count 1 gives sample 0 of a crowd with its seed");
+  SinmdmSampling three = alone;
+  three.count = 3;
+  SinmdmResult *crowd = NULL;
+  CHECK_OK(sinmdm_generate(model, &three, 40, &crowd));
+  Poses again0 = poses_alloc(40, joints), again1 = poses_alloc(40, joints);
+  SinmdmPoseBuffers b0 = buffers_of(&again0), b1 = buffers_of(&again1);
+  CHECK_OK(sinmdm_result_poses(crowd, 0, &b0));
+  CHECK_OK(sinmdm_result_poses(crowd, 1, &b1));
+  expect_true(same_poses(&again0, sample0) && same_poses(&again1, sample1),
+              "samples 0 and 1 of a crowd of 3 are those of a crowd of 2");
+  expect_true(!same_poses(&first, &again1), "sample 1 is not sample 0");
+  sinmdm_result_free(crowd);
+  poses_free(&first);
+  poses_free(&again0);
+  poses_free(&again1);
+
+  /* The run-size bound in terms a host has. */
+  size_t values = 0;
+  CHECK_OK(sinmdm_model_values_per_frame(model, &values));
+  expect_true(values >= info->features + 8 && values >= 12 * joints,
+              "values per frame is max(F + 8 C, 12 x joints)");
+  size_t crowd_size = SINMDM_MAX_SAMPLES;
+  size_t too_long = (size_t)SINMDM_MAX_RUN_VALUES / (crowd_size * values) + 1;
+  SinmdmSampling big = {1, (uint32_t)crowd_size, 2, SINMDM_FEET_RAW, SINMDM_METHOD_ANCESTRAL, 0.0};
+  SinmdmRun *run = NULL;
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_generate_begin(model, &big, too_long, &run));
+  expect_true(strstr(sinmdm_last_error(), "GiB") != NULL, "the first refused length is the size bound's");
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_model_values_per_frame(NULL, &values));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_model_values_per_frame(model, NULL));
+
+  /* Threads: a run begun has its noise thread, gone once the run is freed. */
+  SinmdmSampling small = {3, 1, 3, SINMDM_FEET_RAW, SINMDM_METHOD_ANCESTRAL, 0.0};
+  expect_true(threads_settled(threads_loaded) == threads_loaded, "no thread is left before a run");
+  CHECK_OK(sinmdm_generate_begin(model, &small, 40, &run));
+  CHECK_OK(sinmdm_run_step(run, model, 1, NULL, NULL));
+  size_t during = threads_now();
+  expect_true(during == 0 || during == threads_loaded + 1, "a run in progress has one thread of its own");
+
+  /* Handles: a second handle of the same file is another model to a run and a stream. */
+  SinmdmModel *twin = NULL;
+  CHECK_OK(sinmdm_model_open(model_path, 1, &twin));
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_run_step(run, twin, 1, NULL, NULL));
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_stream_next(stream, twin, 1, chunk_buffers));
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_stream_step(stream, twin, 1, 1, NULL, NULL, NULL));
+  sinmdm_model_free(twin);
+  sinmdm_run_free(run);
+  size_t after = threads_settled(threads_loaded);
+  expect_true(after == 0 || after == threads_loaded, "a freed run's thread ends");
+
+  /* A crowd on a model of 2 threads: after each step (in the callback) the run's noise thread
+     is the only one besides the loaded ones, the denoising thread having been joined. */
+  SinmdmModel *pair = NULL;
+  CHECK_OK(sinmdm_model_open(model_path, 2, &pair));
+  size_t watch[2] = {threads_loaded + 1, 0};
+  CHECK_OK(sinmdm_model_set_progress(pair, watch_threads, watch));
+  SinmdmSampling two = small;
+  two.count = 2;
+  SinmdmResult *pair_result = NULL;
+  CHECK_OK(sinmdm_generate(pair, &two, 40, &pair_result));
+  expect_true(watch[1] == 0, "a crowd's denoising threads are joined before each step ends");
+  sinmdm_result_free(pair_result);
+  sinmdm_model_free(pair);
+  after = threads_settled(threads_loaded);
+  expect_true(after == 0 || after == threads_loaded, "a crowd's run thread ends with it");
+
+  /* stream_next checks its buffers whatever the frames: NULL is refused for 0 frames too. */
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_stream_next(stream, model, 0, NULL));
+  CHECK_OK(sinmdm_stream_next(stream, model, 0, chunk_buffers));
+}
+
+/* Where no onnxruntime can be found: the refusal names every place the header lists, in its
+   order, and a model open refuses alike. */
+static int check_not_found(void) {
+  const char *places[5] = {"ORT_DYLIB_PATH", "next to the executable", "next to this library",
+                           "the system loader's search path", "a developer checkout's .venv"};
+  SinmdmStatus status = sinmdm_load_onnxruntime(NULL);
+  const char *message = sinmdm_last_error();
+  const char *at = strstr(message, "Tried, in order:");
+  if (status != SINMDM_RUNTIME_LIBRARY || at == NULL) {
+    fprintf(stderr, "no onnxruntime gave %d: '%s'\n", (int)status, message);
+    return 1;
+  }
+  for (int i = 0; i < 5; i++) {
+    const char *found = strstr(at, places[i]);
+    if (found == NULL) {
+      fprintf(stderr, "the refusal does not name '%s' after the places before it: '%s'\n", places[i], message);
+      return 1;
+    }
+    at = found + strlen(places[i]);
+  }
+  printf("%s\n", message);
+  const uint8_t junk[8] = {0x08, 0x01, 0x12, 0x04, 'j', 'u', 'n', 'k'};
+  SinmdmModel *none = NULL;
+  status = sinmdm_model_open_bytes(junk, sizeof junk, 1, &none);
+  if (status != SINMDM_RUNTIME_LIBRARY || strstr(sinmdm_last_error(), places[4]) == NULL) {
+    fprintf(stderr, "a model open without onnxruntime gave %d: '%s'\n", (int)status, sinmdm_last_error());
+    return 1;
+  }
+  printf("not found: 5 places\n");
+  return 0;
+}
+
 int main(int argc, char **argv) {
+  if (argc == 2 && strcmp(argv[1], "--not-found") == 0) return check_not_found();
   if (argc != 6) {
     fprintf(stderr,
             "usage: api_check MODEL.onnx NOT_A_MODEL OUT.bvh STEERABLE_MODEL.onnx WORLD_ROOT_MODEL.onnx\n");
     return 2;
   }
+  check_version();
+  /* Loading onnxruntime starts the threads the header lists for it, which stay. */
+  size_t threads_at_start = threads_now();
   CHECK_OK(sinmdm_load_onnxruntime(NULL));
+  size_t threads_loaded = threads_now();
+  expect_true(threads_at_start == 0 || threads_loaded == threads_at_start + ONNXRUNTIME_THREADS,
+              "loading onnxruntime starts the threads the header lists");
   SinmdmModel *model = NULL;
   CHECK_OK(sinmdm_model_open(argv[1], 1, &model));
+  expect_true(threads_at_start == 0 || threads_now() == threads_loaded, "opening a model starts no thread");
   SinmdmModelInfo info;
   CHECK_OK(sinmdm_model_info(model, &info));
   printf("info joints=%zu features=%zu fps=%g up=%g,%g,%g\n", info.joints, info.features,
@@ -436,6 +667,8 @@ int main(int argc, char **argv) {
   CHECK_OK(sinmdm_write_bvh(model, &reference, argv[3]));
 
   check_stepping(model, joints, &reference);
+
+  check_header_word(model, argv[1], &info, &sample0, &sample1, threads_loaded, stream, &ba);
 
   /* Bad arguments: a status code and a message each, never a crash. */
   int32_t one_parent_early[1];

@@ -433,8 +433,12 @@ static void one_case(const char *model_a, const char *work) {
          the bound, NULL arrays, either model (only model B can be steered). */
       static SinmdmSteerFrame commands[16];
       static SinmdmSteerCommand full[16];
+      /* One command in four calls has a reserved field that is not 0 (refused), so the rest
+         reach the steering itself. */
+      size_t odd_reserved = pick(4) ? 16 : pick(16);
       for (size_t i = 0; i < 16; i++) {
-        SinmdmSteerFrame f = {pick(4) ? (uint32_t)pick(5) : any_u32(), coin() ? 0 : any_u32(), coin() ? 12.0 : any_double(),
+        SinmdmSteerFrame f = {pick(4) ? (uint32_t)pick(5) : any_u32(), i == odd_reserved ? any_u32() : 0,
+                              coin() ? 12.0 : any_double(),
                               coin() ? 0.2 : any_double(),
                               {coin() ? 1.0 * i : any_double(), any_double(), coin() ? -2.0 * i : any_double()}};
         commands[i] = f;

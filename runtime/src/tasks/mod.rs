@@ -29,7 +29,7 @@ pub use dance::{
 pub use generated::Generated;
 pub use joints::{joints_by_name, subtree};
 pub use mask::Span;
-pub use plan::{Plan, plan, run};
+pub use plan::{Plan, plan, run, run_values_per_frame};
 pub use run::{Progress, Run};
 
 pub use crate::limits::{MAX_RUN_VALUES, MAX_SAMPLE_FRAMES, MAX_SAMPLES};

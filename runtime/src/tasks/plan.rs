@@ -262,6 +262,19 @@ fn frame_mask(features: usize, weights: &[f32], rows: Option<&[usize]>) -> Array
     m
 }
 
+/// The f32 values one frame of one sample needs while a run is made: the larger of the
+/// network's working set (the features and about eight layers' worth of channels: hidden state,
+/// residual, concatenation, attention) and the decoded motion's transforms per joint, that is
+/// `max(F + 8 C, 12 x joints)`. A request of `count x frames x` this over
+/// [`MAX_RUN_VALUES`] is refused, so a host can size its requests from it.
+pub fn run_values_per_frame(metadata: &ModelMetadata) -> usize {
+    metadata
+        .network
+        .features
+        .saturating_add(8usize.saturating_mul(metadata.network.channels))
+        .max(12usize.saturating_mul(metadata.layout.skeleton.len()))
+}
+
 /// Checks a request against a model and builds its sampling plan.
 pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskError> {
     let f = metadata.network.features;
@@ -491,15 +504,9 @@ pub fn plan(metadata: &ModelMetadata, request: &Request) -> Result<Plan, TaskErr
         }
     };
     check_length(frames)?;
-    // The network's working set per frame of each sample: the features and about eight layers'
-    // worth of channels (hidden state, residual, concatenation, attention), and the decoded
-    // motion's transforms per joint.
-    let per_frame = f
-        .saturating_add(8usize.saturating_mul(metadata.network.channels))
-        .max(12usize.saturating_mul(metadata.layout.skeleton.len()));
     let values = request
         .count
-        .saturating_mul(per_frame)
+        .saturating_mul(run_values_per_frame(metadata))
         .saturating_mul(frames);
     if values > MAX_RUN_VALUES {
         return Err(TaskError::TooLarge {
