@@ -205,7 +205,7 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
             out.training.steps = steps;
             out.training.warmup_steps = calm_warmup_steps(steps);
             format!(
-                "chosen by the step ladder when training starts: short runs of {} steps (warm-up a third), each sampled {} times and scored, and the one that meets coverage >= {}, replay <= {} s and jitter within {}x of the clip's either way with the widest margin (where none meets them all, the one that misses them by least in all) trains the model (a calm clip is covered within a few hundred steps, and replays the longer it trains)",
+                "chosen by the step ladder when training starts: short runs of {} steps (warm-up a third), each sampled {} times and scored, and the one that meets coverage >= {}, replay <= {} s (or the clip's own backwards score), jitter within {}x of the clip's either way and moves like the clip (still frames, speeds) with the widest margin (where none meets them all, the one that moves most like the clip, then misses the rest by least in all) trains the model (a calm clip is covered within a few hundred steps, and replays the longer it trains)",
                 ladder_list(),
                 crate::ladder_settings::CHECK_SAMPLES,
                 crate::ladder_settings::goals::COVERAGE,

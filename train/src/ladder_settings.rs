@@ -31,4 +31,13 @@ pub mod goals {
     /// Jitter (times the clip's) under [`LEAST_JITTER_RATIO`] that counts as one goal's worth of
     /// margin: the mirror of [`JITTER_UNIT`], from 1 / 1.5 down to 1 / (1.5 + 0.5).
     pub const LEAST_JITTER_UNIT: f64 = LEAST_JITTER_RATIO - 1.0 / (JITTER_RATIO + JITTER_UNIT);
+    /// A speed ratio off by this factor (above 1.25x or below 0.8x the clip's) counts as one
+    /// goal's worth of margin.
+    pub const SPEED_RATIO_UNIT: f64 = 1.25;
+    /// Nearly still share (0..=1) over the clip's + 5 points that counts as one goal's worth.
+    pub const STILL_SHARE_UNIT: f64 = 0.05;
+    /// Speed distance over its bound that counts as one goal's worth.
+    pub const SPEED_DISTANCE_UNIT: f64 = 0.1;
+    /// Acceleration distance over its bound that counts as one goal's worth.
+    pub const ACCELERATION_DISTANCE_UNIT: f64 = 0.25;
 }

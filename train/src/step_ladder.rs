@@ -27,6 +27,7 @@ use burn::tensor::Device;
 use serde::{Deserialize, Serialize};
 
 use sinmdm::motion::encode_for_model;
+use sinmdm_eval::KinematicScores;
 use sinmdm_formats::{AnimationChoice, ReadOptions, read_clip};
 
 pub use crate::ladder_settings::{CHECK_SAMPLES, CHECK_SEED, LADDER_STEPS, goals};
@@ -55,6 +56,16 @@ pub struct RungCheck {
     pub replay_seconds: f64,
     /// The samples' jitter as a multiple of the clip's (raw feet).
     pub jitter_ratio: f64,
+    /// What the clip played backwards scores on the replay measure, seconds: motion that is no
+    /// copy, so a replay no longer than it meets the replay goal however long it is.
+    #[serde(default)]
+    pub replay_floor_seconds: f64,
+    /// How the samples (raw feet) move against the clip: stillness, speeds, accelerations.
+    #[serde(default)]
+    pub kinematics: KinematicScores,
+    /// The clip's own share of nearly still frames.
+    #[serde(default)]
+    pub clip_still_share: f64,
     /// Seconds the rung trained.
     pub train_seconds: f64,
     /// Seconds its samples took to make and score.
@@ -71,20 +82,64 @@ impl RungCheck {
     pub fn margins(&self) -> [f64; 4] {
         [
             (self.coverage - goals::COVERAGE) / goals::COVERAGE_UNIT,
-            (goals::REPLAY_SECONDS - self.replay_seconds) / goals::REPLAY_UNIT,
+            (self.replay_goal() - self.replay_seconds) / goals::REPLAY_UNIT,
             (goals::JITTER_RATIO - self.jitter_ratio) / goals::JITTER_UNIT,
             (self.jitter_ratio - goals::LEAST_JITTER_RATIO) / goals::LEAST_JITTER_UNIT,
         ]
     }
 
-    /// The smallest margin: how far the rung is from missing a goal (negative: how far it misses
-    /// the goal it misses most).
-    pub fn worst_margin(&self) -> f64 {
-        self.margins().into_iter().fold(f64::INFINITY, f64::min)
+    /// The longest mean verbatim run that meets the replay goal: [`goals::REPLAY_SECONDS`], or
+    /// the clip's backwards score where that is longer (a replay no longer than motion that is
+    /// no copy is no evidence of copying).
+    pub fn replay_goal(&self) -> f64 {
+        goals::REPLAY_SECONDS.max(self.replay_floor_seconds)
     }
 
-    /// The goals' shortfalls summed (0 where every goal is met), in the margins' units: how far
-    /// the rung misses the goals it misses, all of them.
+    /// Each kinematic goal's margin (nearly still share, speed p25, p50 and p90, speed and
+    /// acceleration distance; `sinmdm_eval::kinematics::goals`), in units of about one goal's
+    /// worth: positive where met, negative where missed.
+    pub fn kinematic_margins(&self) -> [f64; 6] {
+        use sinmdm_eval::kinematics::goals as moves;
+        let k = &self.kinematics;
+        let ratio = |r: f64| {
+            let r = r.max(f64::MIN_POSITIVE);
+            (r / moves::LEAST_SPEED_RATIO)
+                .ln()
+                .min((moves::MOST_SPEED_RATIO / r).ln())
+                / goals::SPEED_RATIO_UNIT.ln()
+        };
+        [
+            (self.clip_still_share + moves::STILL_SHARE_MARGIN - k.still_share)
+                / goals::STILL_SHARE_UNIT,
+            ratio(k.speed_ratios[0]),
+            ratio(k.speed_ratios[1]),
+            ratio(k.speed_ratios[2]),
+            (moves::SPEED_DISTANCE - k.speed_distance) / goals::SPEED_DISTANCE_UNIT,
+            (moves::ACCELERATION_DISTANCE - k.acceleration_distance)
+                / goals::ACCELERATION_DISTANCE_UNIT,
+        ]
+    }
+
+    /// The smallest margin of every goal, the kinematic ones included: how far the rung is from
+    /// missing a goal (negative: how far it misses the goal it misses most).
+    pub fn worst_margin(&self) -> f64 {
+        self.margins()
+            .into_iter()
+            .chain(self.kinematic_margins())
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The kinematic goals' shortfalls summed (0 where the samples move like the clip), in the
+    /// margins' units.
+    pub fn kinematic_shortfall(&self) -> f64 {
+        self.kinematic_margins()
+            .into_iter()
+            .map(|m| (-m).max(0.0))
+            .sum()
+    }
+
+    /// The other goals' shortfalls summed (0 where every one is met), in the margins' units: how
+    /// far the rung misses the goals it misses, all of them.
     pub fn shortfall(&self) -> f64 {
         self.margins().into_iter().map(|m| (-m).max(0.0)).sum()
     }
@@ -102,12 +157,19 @@ impl RungCheck {
     /// One line of the ladder's table.
     pub fn line(&self) -> String {
         format!(
-            "{:>4} steps: coverage {:.1}, replay {:.2} s, jitter {:.2}x the clip's, global diversity {:.3}{} ({:.0} s + {:.0} s check)",
+            "{:>4} steps: coverage {:.1}, replay {:.2} s, jitter {:.2}x the clip's, global diversity {:.3}, still {:.0}% (clip {:.0}%), speed p25/p50/p90 {:.2}/{:.2}/{:.2}x, distances {:.2}/{:.2}{} ({:.0} s + {:.0} s check)",
             self.steps,
             self.coverage,
             self.replay_seconds,
             self.jitter_ratio,
             self.global_diversity,
+            100.0 * self.kinematics.still_share,
+            100.0 * self.clip_still_share,
+            self.kinematics.speed_ratios[0],
+            self.kinematics.speed_ratios[1],
+            self.kinematics.speed_ratios[2],
+            self.kinematics.speed_distance,
+            self.kinematics.acceleration_distance,
             if self.meets_goals() {
                 ", every goal met"
             } else {
@@ -120,20 +182,21 @@ impl RungCheck {
 }
 
 /// Which rung the main run trains: of those that meet every goal, the one whose worst margin
-/// is widest; where none does, the one whose shortfalls sum least ([`RungCheck::shortfall`]), so
-/// that a rung a hair under one goal beats one that misses another by far, and a clip with a
-/// goal no rung meets does not give up a second goal for it (the fox's idle replays whatever
-/// the steps, 1.66-2.06 s; its 75-step rung replayed 0.15 s less than the 50-step one at 2.28x
-/// the clip's jitter against 1.42x). Fewer steps on a tie. `None` when no rung covers the clip
-/// (it is not calm after all); where one does, the rung chosen may still be one a hair under
-/// coverage, when the covering rungs miss the other goals by more.
+/// is widest. Where none does, moving like the clip comes first: the rung whose kinematic
+/// shortfalls sum least ([`RungCheck::kinematic_shortfall`]), so that a frozen or shaking rung
+/// is never taken for a moving one; then the one whose other shortfalls sum least
+/// ([`RungCheck::shortfall`]), so that a rung a hair under one goal beats one that misses another
+/// by far. Fewer steps on a tie. `None` when no rung covers the clip (it is not calm after
+/// all); where one does, the rung chosen may still be one under coverage, when the covering
+/// rungs move less like the clip or miss the other goals by more.
 pub fn choose(rungs: &[RungCheck]) -> Option<&RungCheck> {
     if !rungs.iter().any(RungCheck::covers) {
         return None;
     }
     rungs.iter().min_by(|a, b| {
-        a.shortfall()
-            .total_cmp(&b.shortfall())
+        a.kinematic_shortfall()
+            .total_cmp(&b.kinematic_shortfall())
+            .then(a.shortfall().total_cmp(&b.shortfall()))
             .then(b.worst_margin().total_cmp(&a.worst_margin()))
             .then(a.steps.cmp(&b.steps))
     })
@@ -244,7 +307,9 @@ impl Ladder {
     pub fn rung_fingerprint(&self, clip_sha256: &str, config: &TrainConfig, steps: u64) -> String {
         let rung = serde_json::to_string(&Self::rung_config(config, steps))
             .expect("a configuration serialises");
-        let check = format!("{} samples, seed {}", self.samples, self.seed);
+        // The check's version names what a rung's scores hold: version 2 added the backwards
+        // floor and the kinematic figures, which a rung scored before does not have.
+        let check = format!("{} samples, seed {}, check 2", self.samples, self.seed);
         sinmdm_library::fingerprint::sha256_of_parts(&[
             env!("CARGO_PKG_VERSION").as_bytes(),
             clip_sha256.as_bytes(),
@@ -337,6 +402,9 @@ impl Ladder {
             global_diversity: scores.report.global_diversity.mean,
             replay_seconds: scores.replay.mean_seconds,
             jitter_ratio: scores.raw_jitter_ratio,
+            replay_floor_seconds: scores.replay.clip_backwards_seconds,
+            kinematics: scores.kinematics,
+            clip_still_share: scores.clip_still_share,
             train_seconds: 0.0,
             check_seconds: started.elapsed().as_secs_f64(),
             made_from: String::new(),
@@ -389,7 +457,7 @@ pub fn start_run(
             let why = if best.meets_goals() {
                 "the rung of the step ladder that meets every goal with the widest margin"
             } else {
-                "no rung of the step ladder meets every goal; this one misses them by least in all"
+                "no rung of the step ladder meets every goal; this one moves most like the clip, then misses the rest by least in all"
             };
             let mut lines = choice.lines;
             for line in lines.iter_mut().filter(|l| l.starts_with("steps ")) {
@@ -455,6 +523,14 @@ pub fn folder(run: &Path) -> PathBuf {
 mod tests {
     use super::*;
 
+    /// Kinematic scores of samples that move exactly like their clip.
+    fn moving_like_the_clip() -> KinematicScores {
+        KinematicScores {
+            speed_ratios: [1.0; 3],
+            ..KinematicScores::default()
+        }
+    }
+
     fn rung(steps: u64, coverage: f64, replay_seconds: f64, jitter_ratio: f64) -> RungCheck {
         RungCheck {
             steps,
@@ -462,6 +538,9 @@ mod tests {
             global_diversity: 1.0,
             replay_seconds,
             jitter_ratio,
+            replay_floor_seconds: 0.0,
+            kinematics: moving_like_the_clip(),
+            clip_still_share: 0.0,
             train_seconds: 1.0,
             check_seconds: 1.0,
             made_from: String::new(),
@@ -491,6 +570,72 @@ mod tests {
             "{:?}",
             smooth.margins()
         );
+    }
+
+    #[test]
+    fn kinematic_margins_are_in_units_of_one_goal() {
+        let mut r = rung(100, 100.0, 0.5, 1.0);
+        assert_eq!(r.kinematic_margins()[4..], [2.0, 2.0]);
+        assert!(r.meets_goals());
+        // A quarter of the clip's still share over its bound (clip 10 %, samples 20 %): one
+        // unit short. p50 at 1.25 x 1.25 the clip's: one unit over; p25 at 0.8: just met.
+        r.clip_still_share = 0.1;
+        r.kinematics.still_share = 0.2;
+        r.kinematics.speed_ratios = [0.8, 1.25 * 1.25, 1.0];
+        let m = r.kinematic_margins();
+        assert!((m[0] + 1.0).abs() < 1e-12 && m[1].abs() < 1e-12, "{m:?}");
+        assert!((m[2] + 1.0).abs() < 1e-12, "{m:?}");
+        assert!((r.kinematic_shortfall() - 2.0).abs() < 1e-12);
+        assert!(!r.meets_goals());
+    }
+
+    #[test]
+    fn moving_like_the_clip_comes_before_every_other_goal() {
+        // The fox's ladder: 50 steps stand still in 69 % of the frames (its clip: none) and meet
+        // the other goals; 1 000 steps move at the clip's median speed but shake (acceleration
+        // distance 4.1) and jitter 4.4x. Moving more like the clip wins.
+        let mut frozen = rung(50, 100.0, 1.89, 1.42);
+        frozen.replay_floor_seconds = 2.0;
+        frozen.kinematics = KinematicScores {
+            still_share: 0.69,
+            speed_ratios: [0.02, 0.06, 1.39],
+            speed_distance: 0.78,
+            acceleration_distance: 0.78,
+            ..KinematicScores::default()
+        };
+        let mut shaking = rung(1000, 100.0, 2.06, 4.44);
+        shaking.replay_floor_seconds = 2.0;
+        shaking.kinematics = KinematicScores {
+            still_share: 0.03,
+            speed_ratios: [0.71, 1.01, 1.49],
+            speed_distance: 0.32,
+            acceleration_distance: 4.12,
+            ..KinematicScores::default()
+        };
+        assert!(frozen.shortfall() < shaking.shortfall());
+        assert!(shaking.kinematic_shortfall() < frozen.kinematic_shortfall());
+        let rungs = [frozen, shaking];
+        assert_eq!(choose(&rungs).map(|r| r.steps), Some(1000));
+    }
+
+    #[test]
+    fn a_replay_no_longer_than_the_clip_played_backwards_meets_the_replay_goal() {
+        // The fox's idle: its samples replay 1.97 s, the clip backwards scores 2.00 s.
+        let mut fox = rung(50, 100.0, 1.97, 1.4);
+        assert!(!fox.meets_goals());
+        fox.replay_floor_seconds = 2.0;
+        assert_eq!(fox.replay_goal(), 2.0);
+        assert!(fox.meets_goals(), "{:?}", fox.margins());
+        // Over the floor misses it by as much as over the one second would.
+        fox.replay_seconds = 2.5;
+        assert!(
+            (fox.margins()[1] + 1.0).abs() < 1e-12,
+            "{:?}",
+            fox.margins()
+        );
+        // A floor under a second leaves the goal at one second.
+        fox.replay_floor_seconds = 0.4;
+        assert_eq!(fox.replay_goal(), goals::REPLAY_SECONDS);
     }
 
     #[test]

@@ -175,6 +175,12 @@ fn scored(steps: u64, coverage: f64, replay_seconds: f64, jitter_ratio: f64) -> 
         global_diversity: 0.5,
         replay_seconds,
         jitter_ratio,
+        replay_floor_seconds: 0.0,
+        kinematics: sinmdm_eval::KinematicScores {
+            speed_ratios: [1.0; 3],
+            ..Default::default()
+        },
+        clip_still_share: 0.0,
         train_seconds: 1.0,
         check_seconds: 1.0,
         made_from: String::new(),
