@@ -68,10 +68,7 @@ pub fn read_motion_file_and_source(
 
 /// `'Walk' (#0)` or `#0`.
 pub fn describe_animation(info: &sinmdm_formats::AnimationInfo) -> String {
-    match &info.name {
-        Some(name) => format!("'{name}' (#{})", info.index),
-        None => format!("#{}", info.index),
-    }
+    info.describe()
 }
 
 /// Whether `path` names a glTF file, which holds every sample of a run as one animation each.
@@ -181,7 +178,7 @@ pub struct ClipUpArg {
     #[arg(long, value_name = "AXIS")]
     pub up: Option<UpAxis>,
     /// The animation of a glTF clip (or stack of an FBX clip) to read, by name or index (default:
-    /// the first).
+    /// the first that moves).
     #[arg(long, value_name = "NAME|INDEX")]
     pub clip_anim: Option<String>,
 }

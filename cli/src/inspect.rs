@@ -74,8 +74,12 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     if !animations.is_empty() {
         println!("animations {}", animations.len());
         for a in animations {
+            let still = match a.still {
+                Some(true) => " (still: nothing moves)",
+                _ => "",
+            };
             println!(
-                "  {} {:.2} s",
+                "  {} {:.2} s{still}",
                 crate::clip_files::describe_animation(a),
                 a.seconds
             );

@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+use sinmdm::motion::ChannelClip;
+
 use crate::error::{FormatError, Part};
 
 /// The most frames a clip read from keyframes (glTF, FBX) may have: 14 minutes at 120 fps, far beyond a
@@ -11,6 +13,26 @@ use crate::error::{FormatError, Part};
 pub const MAX_CLIP_FRAMES: usize = 100_000;
 /// The most joint transforms (frames x joints) a clip read from keyframes (glTF, FBX) may have: about 1 GB.
 pub const MAX_JOINT_FRAMES: usize = 10_000_000;
+
+/// A clip moves when some channel's standard deviation over its frames is above this (degrees
+/// for rotations, file units for positions): far below any motion a person could see, far above
+/// the rounding noise of an exporter's still take (Mixamo's `Take 001`: 4e-16).
+pub const STILL_TOLERANCE: f64 = 1e-6;
+
+/// Whether some channel of `clip` moves (its standard deviation is above [`STILL_TOLERANCE`]).
+pub fn clip_moves(clip: &ChannelClip) -> bool {
+    let width = clip.skeleton.channel_count();
+    let frames = clip.frame_count();
+    if width == 0 || frames < 2 {
+        return false;
+    }
+    (0..width).any(|c| {
+        let column = || clip.values.iter().skip(c).step_by(width);
+        let mean = column().sum::<f64>() / frames as f64;
+        let variance = column().map(|v| (v - mean).powi(2)).sum::<f64>() / frames as f64;
+        variance.sqrt() > STILL_TOLERANCE
+    })
+}
 
 /// Which animation of a file is the clip.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -34,7 +56,7 @@ impl AnimationChoice {
 /// What a reader is asked to do beyond the defaults.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ReadOptions {
-    /// The animation to read (default: the first).
+    /// The animation to read (default: the first that moves, else the first).
     pub animation: Option<AnimationChoice>,
     /// The frame rate to sample at (default: the file's, or for glTF the key spacing).
     pub fps: Option<f64>,
@@ -49,6 +71,63 @@ pub struct AnimationInfo {
     pub name: Option<String>,
     /// From its first key to its last, in seconds.
     pub seconds: f64,
+    /// Whether nothing in it moves (no channel's standard deviation above [`STILL_TOLERANCE`]);
+    /// `None` where it could not be sampled.
+    pub still: Option<bool>,
+}
+
+impl AnimationInfo {
+    /// `'Walk' (#0)` or `#0`, as messages name it.
+    pub fn describe(&self) -> String {
+        match &self.name {
+            Some(name) => format!("'{name}' (#{})", self.index),
+            None => format!("#{}", self.index),
+        }
+    }
+}
+
+/// The animation `options` ask for, or by default the first that moves (the first of all when
+/// none does), sampled by `sample`; every animation's `still` is filled in on the way. A file
+/// such as a Mixamo download holds a still `Take 001` before its motion, and the default is the
+/// motion.
+pub(crate) fn choose_and_sample(
+    path: &Path,
+    animations: &mut [AnimationInfo],
+    options: &ReadOptions,
+    (part, what): (Part, &str),
+    mut sample: impl FnMut(usize) -> Result<ChannelClip, FormatError>,
+) -> Result<(usize, ChannelClip), FormatError> {
+    let asked = match options.animation {
+        Some(_) => Some(choose_animation(path, animations, options, (part, what))?),
+        None => {
+            choose_animation(path, animations, options, (part, what))?;
+            None
+        }
+    };
+    // The asked one's result, or by default the first's and the first moving one's.
+    let mut first = None;
+    let mut chosen = None;
+    for (index, animation) in animations.iter_mut().enumerate() {
+        let result = sample(index);
+        animation.still = result.as_ref().ok().map(|clip| !clip_moves(clip));
+        match asked {
+            Some(a) if a == index => chosen = Some((index, result)),
+            Some(_) => {}
+            None if index == 0 => first = Some(result),
+            None => {
+                if chosen.is_none() && animation.still == Some(false) {
+                    chosen = Some((index, result));
+                }
+            }
+        }
+    }
+    if asked.is_none() && animations[0].still == Some(false) {
+        chosen = first.take().map(|r| (0, r));
+    }
+    let (index, result) = chosen
+        .or_else(|| first.map(|r| (0, r)))
+        .expect("a file with animations has a chosen one");
+    Ok((index, result?))
 }
 
 /// The index of the animation `options` ask for (default: the first); `what` is the format's

@@ -7,7 +7,8 @@
 //!   bones are folded in: each joint's transform is taken from world transforms, so pre- and
 //!   post-rotations, pivots and inherit modes are all as the file means them.
 //! - Names lose their namespace (`mixamorig:Hips` is `Hips`), then are made unique.
-//! - The clip is one animation stack (`--clip-anim NAME|INDEX`, default the first), sampled at
+//! - The clip is one animation stack (`--clip-anim NAME|INDEX`, default the first that moves,
+//!   so a Mixamo download's still `Take 001` is passed over), sampled at
 //!   the file's frame rate (`--fps` overrides) from the stack's start to its end (or, for a
 //!   stack that declares no range, from its first key to its last).
 //! - A leaf bone that never moves (Mixamo's `_End` bones, Blender's leaf bones) becomes its
@@ -19,7 +20,7 @@ use sinmdm::motion::math::{Mat3, Vec3};
 use sinmdm::motion::{ChannelClip, fps_from_frame_time};
 
 use crate::animation::{
-    AnimationInfo, MAX_CLIP_FRAMES, MAX_JOINT_FRAMES, ReadOptions, choose_animation,
+    AnimationInfo, MAX_CLIP_FRAMES, MAX_JOINT_FRAMES, ReadOptions, choose_and_sample,
 };
 use crate::error::{FormatError, Part};
 use crate::sampled::{Recorded, SampledJoints, unique_names, without_namespace};
@@ -107,6 +108,7 @@ fn stack_infos(scene: &ufbx::Scene) -> Vec<AnimationInfo> {
                 index,
                 name: Some(stack.element.name.to_string()).filter(|n| !n.is_empty()),
                 seconds: (end - begin).max(0.0),
+                still: None,
             }
         })
         .collect()
@@ -289,13 +291,17 @@ fn local_transforms(
     Ok(local)
 }
 
-/// Reads the clip of one animation stack of an `.fbx` file.
-pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatError> {
-    let scene = load(path)?;
-    let animations = stack_infos(&scene);
-    let chosen = choose_animation(path, &animations, options, (Part::Fbx, "animation stack"))?;
+/// The clip of animation stack `chosen` (with its name) of `scene`, whose skeleton is `order`
+/// with `parents`.
+fn sample_stack(
+    path: &Path,
+    scene: &ufbx::Scene,
+    (chosen, name): (usize, Option<String>),
+    (order, parents): (&[usize], &[Option<usize>]),
+    options: &ReadOptions,
+) -> Result<ChannelClip, FormatError> {
     let stack = &scene.anim_stacks[chosen];
-    let part = || Part::Animation(chosen, animations[chosen].name.clone());
+    let part = || Part::Animation(chosen, name.clone());
     let bad = |part: Part, message: String| FormatError::bad(path, part, message);
     // Frames are sampled at the file's own rate, on its keys, and the clip reports it snapped
     // to a whole rate when within a hair of one (a BVH's 0.0333333 s frames, imported into a
@@ -322,7 +328,6 @@ pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatErr
         ));
     }
     let frames = span as usize + 1;
-    let (order, parents) = skeleton_nodes(path, &scene)?;
     let joints = order.len();
     if frames.saturating_mul(joints) > MAX_JOINT_FRAMES {
         return Err(bad(
@@ -336,7 +341,7 @@ pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatErr
     let mut translations = Vec::with_capacity(frames * joints);
     for f in 0..frames {
         let t = begin + f as f64 / fps;
-        let posed = ufbx::evaluate_scene(&scene, &stack.anim, t, ufbx::EvaluateOpts::default())
+        let posed = ufbx::evaluate_scene(scene, &stack.anim, t, ufbx::EvaluateOpts::default())
             .map_err(|error| {
                 bad(
                     part(),
@@ -346,8 +351,8 @@ pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatErr
         for (rotation, translation) in local_transforms(
             path,
             (&posed, &|n| posed.nodes[n].node_to_world),
-            &order,
-            &parents,
+            order,
+            parents,
             &format!("at {t:.3} s"),
         )? {
             rotations.push(rotation);
@@ -355,7 +360,7 @@ pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatErr
         }
     }
     let rest = |n: usize| rest_to_world(&scene.nodes[n]);
-    let rest_rotations = local_transforms(path, (&scene, &rest), &order, &parents, "at rest")?
+    let rest_rotations = local_transforms(path, (scene, &rest), order, parents, "at rest")?
         .into_iter()
         .map(|(rotation, _)| rotation)
         .collect();
@@ -366,7 +371,7 @@ pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatErr
     }));
     let motion = SampledJoints {
         names,
-        parents,
+        parents: parents.to_vec(),
         recorded: vec![Recorded::default(); joints],
         fps: clip_fps,
         frames,
@@ -375,8 +380,27 @@ pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatErr
         rest_rotations,
     }
     .into_motion();
+    Ok(motion.to_channels())
+}
+
+/// Reads the clip of one animation stack of an `.fbx` file.
+pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatError> {
+    let scene = load(path)?;
+    let mut animations = stack_infos(&scene);
+    let (order, parents) = skeleton_nodes(path, &scene)?;
+    let names: Vec<Option<String>> = animations.iter().map(|a| a.name.clone()).collect();
+    let (chosen, clip) = choose_and_sample(
+        path,
+        &mut animations,
+        options,
+        (Part::Fbx, "animation stack"),
+        |chosen| {
+            let name = (chosen, names[chosen].clone());
+            sample_stack(path, &scene, name, (&order, &parents), options)
+        },
+    )?;
     Ok(FbxClip {
-        clip: motion.to_channels(),
+        clip,
         animation: animations[chosen].clone(),
         animations,
         file_unit_meters: scene.settings.original_unit_meters,

@@ -21,6 +21,7 @@ use sinmdm::motion::ChannelClip;
 
 pub use animation::{
     AnimationChoice, AnimationInfo, MAX_CLIP_FRAMES, MAX_JOINT_FRAMES, ReadOptions,
+    STILL_TOLERANCE, clip_moves,
 };
 pub use error::{FormatError, Part};
 pub use files::FileAccess;
@@ -64,6 +65,17 @@ impl ClipFormat {
                 path: path.to_path_buf(),
                 message: "is not a motion file this reads (.bvh, .glb, .gltf, .fbx)".into(),
             }),
+        }
+    }
+}
+
+impl ClipFormat {
+    /// The size limit of a file of this format, checked before it is read.
+    pub fn file_limit(self) -> sinmdm::files::FileLimit {
+        match self {
+            ClipFormat::Bvh => sinmdm::bvh::BVH_LIMIT,
+            ClipFormat::Gltf => files::GLTF_LIMIT,
+            ClipFormat::Fbx => files::FBX_LIMIT,
         }
     }
 }

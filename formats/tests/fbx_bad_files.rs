@@ -209,3 +209,38 @@ fn random_mutations_give_errors_never_panics() {
         "{read_fine} read, {refused} refused"
     );
 }
+
+#[test]
+fn a_still_first_stack_is_passed_over_and_marked() {
+    // As Mixamo serves a download: a still 'Take 001' before the motion.
+    let text = mixamo_text().replacen(
+        "\tAnimationStack: 100001,",
+        "\tAnimationStack: 900001, \"AnimStack::Take 001\", \"\" {\n\t}\n\tAnimationLayer: 900002, \"AnimLayer::BaseLayer\", \"\" {\n\t}\n\tAnimationStack: 100001,",
+        1,
+    );
+    let text = text.replacen(
+        "\tC: \"OO\",100002,100001",
+        "\tC: \"OO\",900002,900001\n\tC: \"OO\",100002,100001",
+        1,
+    );
+    let path = scratch("take_001_first.fbx");
+    std::fs::write(&path, &text).unwrap();
+    let read = read_fbx(&path, &ReadOptions::default()).unwrap();
+    let names: Vec<_> = read.animations.iter().map(|a| a.name.clone()).collect();
+    assert_eq!(
+        names,
+        [Some("Take 001".to_string()), Some("mixamo.com".to_string())]
+    );
+    assert_eq!(read.animation.name.as_deref(), Some("mixamo.com"));
+    let still: Vec<_> = read.animations.iter().map(|a| a.still).collect();
+    assert_eq!(still, [Some(true), Some(false)]);
+    // Asked for by name, the still stack is read, and says it is still.
+    let take = ReadOptions {
+        animation: Some(AnimationChoice::Name("Take 001".into())),
+        fps: None,
+    };
+    let read = read_fbx(&path, &take).unwrap();
+    assert_eq!(read.animation.still, Some(true));
+    assert!(!sinmdm_formats::clip_moves(&read.clip));
+    std::fs::remove_file(&path).unwrap();
+}

@@ -406,3 +406,31 @@ fn a_fifo_is_refused_without_waiting_for_a_writer() {
     assert!(message.contains("not a regular file"), "{message}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_default_animation_is_the_first_that_moves() {
+    let motion = read_bvh(root().join("tests/data/bvh/fox_survey_khronos.bvh"))
+        .unwrap()
+        .to_local();
+    let joints = motion.skeleton.len();
+    let mut still = motion.clone();
+    still.rotations = still.rotations[..joints].repeat(4);
+    still.translations = still.translations[..joints].repeat(4);
+    let options = GltfWriteOptions {
+        up: UpAxis::PosY,
+        metres_per_unit: 0.01,
+        proxy_mesh: false,
+    };
+    let (json, bin) = gltf_document(
+        &[("Take 001".into(), &still), ("mixamo.com".into(), &motion)],
+        &options,
+    )
+    .unwrap();
+    let path = scratch("still_first.glb");
+    std::fs::write(&path, glb_bytes(&json, &bin)).unwrap();
+    let read = read_gltf(&path, &ReadOptions::default()).unwrap();
+    assert_eq!(read.animation.name.as_deref(), Some("mixamo.com"));
+    assert_eq!(read.animations[0].still, Some(true));
+    assert_eq!(read.animations[1].still, Some(false));
+    std::fs::remove_file(&path).unwrap();
+}

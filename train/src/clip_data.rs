@@ -8,7 +8,9 @@ use sha2::{Digest, Sha256};
 
 use sinmdm::model_file::ClipSourceFacts;
 use sinmdm::motion::{ContactConfig, EncodeOptions, FeatureLayout, Normalizer, RootLayout, encode};
-use sinmdm_formats::{AnimationChoice, ClipFormat, ReadOptions, read_clip};
+use sinmdm_formats::{
+    AnimationChoice, ClipFormat, ReadOptions, STILL_TOLERANCE, clip_moves, read_clip,
+};
 
 use crate::config::{DataConfig, ModelConfig};
 use crate::error::TrainError;
@@ -76,16 +78,19 @@ impl ClipData {
         data: &DataConfig,
         model: &ModelConfig,
     ) -> Result<ClipData, TrainError> {
-        let bytes = std::fs::read(path).map_err(|source| TrainError::Io {
-            what: "read the clip",
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let format = ClipFormat::of(path)?;
+        let bytes = sinmdm::files::read_regular_file(path, format.file_limit(), None).map_err(
+            |source| TrainError::Io {
+                what: "read the clip",
+                path: path.to_path_buf(),
+                source,
+            },
+        )?;
         let read_options = ReadOptions {
             animation: data.animation.as_deref().map(AnimationChoice::parse),
             fps: None,
         };
-        let (clip, source) = match ClipFormat::of(path)? {
+        let (clip, source) = match format {
             ClipFormat::Bvh => {
                 if data.animation.is_some() {
                     return Err(TrainError::Config {
@@ -104,6 +109,13 @@ impl ClipData {
                 let read = source
                     .animation
                     .expect("a glTF or FBX clip names its animation");
+                if read.still == Some(true) {
+                    return Err(TrainError::StillClip {
+                        path: path.to_path_buf(),
+                        what: format!("animation {}", read.describe()),
+                        tolerance: STILL_TOLERANCE,
+                    });
+                }
                 let facts = ClipSourceFacts {
                     format: format.name().into(),
                     animation: Some(read.name.unwrap_or_else(|| format!("#{}", read.index))),
@@ -113,6 +125,13 @@ impl ClipData {
                 (clip, Some(facts))
             }
         };
+        if !clip_moves(&clip) {
+            return Err(TrainError::StillClip {
+                path: path.to_path_buf(),
+                what: "the clip".into(),
+                tolerance: STILL_TOLERANCE,
+            });
+        }
         let options = EncodeOptions {
             fps: data.fps,
             contacts: ContactConfig {

@@ -29,6 +29,19 @@ pub enum TrainError {
     /// A clip in another format could not be read.
     #[error(transparent)]
     Format(#[from] sinmdm_formats::FormatError),
+    /// The clip (or the animation of it read) does not move, so there is nothing to learn.
+    #[error(
+        "{}: {what} does not move (no channel's standard deviation is above {tolerance}); pick one that does (data.animation, --clip-anim)",
+        path.display()
+    )]
+    StillClip {
+        /// The clip.
+        path: PathBuf,
+        /// What was read (`animation 'Take 001' (#0)`, or `the clip`).
+        what: String,
+        /// The tolerance it is held to.
+        tolerance: f64,
+    },
     /// The clip could not be turned into features.
     #[error("{}: {source}", path.display())]
     Motion {

@@ -25,7 +25,7 @@ use super::container::{Asset, read_asset};
 use super::nodes::{Similarity, Trs, node_name, node_trs, parents, rotation_of, unit_scale};
 use super::skin::{SkinJoints, node_names, recorded_joints, skin_joints};
 use super::tracks::{MAX_JOINT_FRAMES, Property, Track, frame_rate, read_tracks};
-use crate::animation::{AnimationInfo, ReadOptions, choose_animation};
+use crate::animation::{AnimationInfo, ReadOptions, choose_and_sample};
 use crate::error::{FormatError, Part};
 use crate::files::FileAccess;
 use crate::sampled::{SampledJoints, unique_names};
@@ -85,6 +85,7 @@ fn animation_infos(asset: &Asset) -> Vec<AnimationInfo> {
                 index,
                 name: node_name(animation),
                 seconds: if last >= first { last - first } else { 0.0 },
+                still: None,
             }
         })
         .collect()
@@ -178,43 +179,52 @@ pub fn read_gltf_with_access(
         .map(|n| node_trs(path, nodes, n))
         .collect::<Result<_, _>>()?;
     let skin = skin_joints(path, &asset.json, nodes, &parent, &rest)?;
-    let animations = animation_infos(&asset);
-    let chosen = choose_animation(path, &animations, options, (Part::Json, "animation"))?;
-    let part = Part::Animation(chosen, node_name(&asset.json["animations"][chosen]));
-    let tracks = read_tracks(path, &asset, chosen, |n| skin.joint_of(n))?;
-    let timing = frame_rate(path, part, &tracks, options.fps)?;
-    let (_, fps, frames) = timing;
-    if frames.saturating_mul(skin.order.len()) > MAX_JOINT_FRAMES {
-        return Err(FormatError::bad(
-            path,
-            Part::Skeleton,
-            format!(
-                "{} joints x {frames} frames are more transforms than the {MAX_JOINT_FRAMES} a clip may have",
-                skin.order.len()
-            ),
-        ));
-    }
-    let (rotations, translations) = sample_frames(path, nodes, &rest, &skin, &tracks, timing)?;
-    // The joints' own transforms, with the nodes above each folded in.
-    let rest_rotations = skin
-        .order
-        .iter()
-        .zip(&skin.pre)
-        .map(|(&n, pre)| pre.rotation * rest[n].rotation)
-        .collect();
-    let motion = SampledJoints {
-        names: unique_names(node_names(nodes, &skin.order)),
-        parents: skin.parents.clone(),
-        recorded: recorded_joints(nodes, &skin),
-        fps,
-        frames,
-        rotations,
-        translations,
-        rest_rotations,
-    }
-    .into_motion();
+    let mut animations = animation_infos(&asset);
+    let sample = |chosen: usize| -> Result<ChannelClip, FormatError> {
+        let part = Part::Animation(chosen, node_name(&asset.json["animations"][chosen]));
+        let tracks = read_tracks(path, &asset, chosen, |n| skin.joint_of(n))?;
+        let timing = frame_rate(path, part, &tracks, options.fps)?;
+        let (_, fps, frames) = timing;
+        if frames.saturating_mul(skin.order.len()) > MAX_JOINT_FRAMES {
+            return Err(FormatError::bad(
+                path,
+                Part::Skeleton,
+                format!(
+                    "{} joints x {frames} frames are more transforms than the {MAX_JOINT_FRAMES} a clip may have",
+                    skin.order.len()
+                ),
+            ));
+        }
+        let (rotations, translations) = sample_frames(path, nodes, &rest, &skin, &tracks, timing)?;
+        // The joints' own transforms, with the nodes above each folded in.
+        let rest_rotations = skin
+            .order
+            .iter()
+            .zip(&skin.pre)
+            .map(|(&n, pre)| pre.rotation * rest[n].rotation)
+            .collect();
+        let motion = SampledJoints {
+            names: unique_names(node_names(nodes, &skin.order)),
+            parents: skin.parents.clone(),
+            recorded: recorded_joints(nodes, &skin),
+            fps,
+            frames,
+            rotations,
+            translations,
+            rest_rotations,
+        }
+        .into_motion();
+        Ok(motion.to_channels())
+    };
+    let (chosen, clip) = choose_and_sample(
+        path,
+        &mut animations,
+        options,
+        (Part::Json, "animation"),
+        sample,
+    )?;
     Ok(GltfClip {
-        clip: motion.to_channels(),
+        clip,
         animation: animations[chosen].clone(),
         animations,
     })
