@@ -203,3 +203,28 @@ fn a_namespaced_character_takes_a_model_without_the_namespace() {
     );
     assert!(worst <= 1e-5 * height, "{worst} > 1e-5 x {height}");
 }
+
+#[test]
+fn a_gltf_character_is_refused_naming_the_way_round() {
+    let dir = std::env::temp_dir().join(format!("sinmdm-splice-gltf-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let gltf = dir.join("character.gltf");
+    std::fs::write(&gltf, r#"{"asset": {"version": "2.0"}}"#).unwrap();
+    let walk = read_gltf(&character(), &ReadOptions::default())
+        .unwrap()
+        .clip
+        .to_local();
+    let err = splice_into_character(
+        &gltf,
+        &dir.join("out.glb"),
+        &[("walk".into(), &walk)],
+        UpAxis::PosY,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("is not a .glb") && err.contains("glTF Binary"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -58,7 +58,7 @@ pub fn glb_bytes(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
 /// whether a `.gltf` file's side-car buffers may lie outside its folder.
 pub fn read_asset(path: &Path, access: FileAccess) -> Result<Asset, FormatError> {
     let bytes = read_file(path, GLTF_LIMIT)?;
-    if bytes.len() >= 4 && bytes[..4] == GLB_MAGIC.to_le_bytes() {
+    if is_glb(&bytes) {
         parse_glb(path, &bytes)
     } else {
         let json: serde_json::Value = serde_json::from_slice(&bytes)
@@ -66,6 +66,11 @@ pub fn read_asset(path: &Path, access: FileAccess) -> Result<Asset, FormatError>
         let buffers = load_buffers(path, &json, None, access)?;
         Ok(Asset { json, buffers })
     }
+}
+
+/// Whether `bytes` start as a GLB container does (`glTF`).
+pub fn is_glb(bytes: &[u8]) -> bool {
+    bytes.len() >= 4 && bytes[..4] == GLB_MAGIC.to_le_bytes()
 }
 
 /// Parses a GLB container.

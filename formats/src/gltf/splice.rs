@@ -108,6 +108,12 @@ pub fn splice_into_character(
     up_axis: UpAxis,
 ) -> Result<SpliceReport, FormatError> {
     let bytes = crate::files::read_file(character, crate::files::GLTF_LIMIT)?;
+    if !super::container::is_glb(&bytes) {
+        return Err(FormatError::Unsupported {
+            path: character.to_path_buf(),
+            message: "is not a .glb: the character file is read as binary glTF (.glb), whose mesh and skin travel in one file; export it as glTF Binary (.glb), e.g. from Blender (File > Export > glTF 2.0, Format: glTF Binary)".into(),
+        });
+    }
     let Asset { mut json, buffers } = parse_glb(character, &bytes)?;
     let bad = |part: Part, message: String| FormatError::bad(character, part, message);
     if buffers.len() > 1
