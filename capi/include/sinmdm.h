@@ -47,9 +47,10 @@
  *   once on different threads. sinmdm_load_onnxruntime and sinmdm_last_error may be
  *   called from any thread. These are all the threads the library starts or has started:
  *   when onnxruntime is loaded (sinmdm_load_onnxruntime, or the first model opened),
- *   onnxruntime's environment starts threads of its own (one with onnxruntime 1.31.1, which
- *   waits on a timer), and they live until the process ends, since the environment is made
- *   once per process and never freed; for each run or stream block in progress, one that
+ *   onnxruntime's environment may start threads of its own (at most one with onnxruntime
+ *   1.31.1, which waits on a timer, and none where the environment variable CI is set), and
+ *   they live until the process ends, since the environment is made once per process and never
+ *   freed; for each run or stream block in progress, one that
  *   draws the next step's noise (it ends on its own soon after the run is finished or freed,
  *   or the block is done); for a batch of several samples on a model opened with threads >
  *   1, up to threads - 1 that each run samples during a denoising call and are joined

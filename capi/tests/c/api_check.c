@@ -566,15 +566,18 @@ int main(int argc, char **argv) {
   /* Loading onnxruntime starts the threads the header lists for it, which stay. */
   size_t threads_at_start = threads_now();
   CHECK_OK(sinmdm_load_onnxruntime(NULL));
-  /* Settled: a thread onnxruntime starts may show a moment late, or a helper of its start-up
-     end a moment after the call returns, on a loaded machine. */
+  /* At most the header's count: onnxruntime 1.31.1 starts its timer thread, except where the
+     environment variable CI is set (as on the project's CI), where it starts none. Settled, as
+     a thread may show a moment late on a loaded machine. */
   size_t threads_loaded = threads_settled(threads_at_start + ONNXRUNTIME_THREADS);
-  if (threads_at_start != 0 && threads_loaded != threads_at_start + ONNXRUNTIME_THREADS) {
-    fprintf(stderr, "threads: %zu before loading onnxruntime, %zu after (expected +%d)\n",
+  if (threads_at_start != 0 && (threads_loaded < threads_at_start ||
+                                threads_loaded > threads_at_start + ONNXRUNTIME_THREADS)) {
+    fprintf(stderr, "threads: %zu before loading onnxruntime, %zu after (at most +%d)\n",
             threads_at_start, threads_loaded, ONNXRUNTIME_THREADS);
   }
-  expect_true(threads_at_start == 0 || threads_loaded == threads_at_start + ONNXRUNTIME_THREADS,
-              "loading onnxruntime starts the threads the header lists");
+  expect_true(threads_at_start == 0 || (threads_loaded >= threads_at_start &&
+                                        threads_loaded <= threads_at_start + ONNXRUNTIME_THREADS),
+              "loading onnxruntime starts at most the threads the header lists");
   SinmdmModel *model = NULL;
   CHECK_OK(sinmdm_model_open(argv[1], 1, &model));
   expect_true(threads_at_start == 0 || threads_now() == threads_loaded, "opening a model starts no thread");
