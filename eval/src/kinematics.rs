@@ -155,11 +155,6 @@ pub fn wasserstein_1(a: &[f64], b: &[f64]) -> f64 {
     if a.is_empty() || b.is_empty() {
         return 0.0;
     }
-    let sorted = |v: &[f64]| {
-        let mut s = v.to_vec();
-        s.sort_by(f64::total_cmp);
-        s
-    };
     let (a, b) = (sorted(a), sorted(b));
     let (mut i, mut j) = (0usize, 0usize);
     let mut area = 0.0;
