@@ -31,6 +31,7 @@
 
 pub mod beat_align;
 mod feet;
+mod kinematic_report;
 pub mod kinematics;
 mod model_eval;
 mod patched_nn;
@@ -52,9 +53,8 @@ pub use feet::{
     FeetReference, FeetReport, FeetScores, GROUND_BAND, PENETRATION_TOLERANCE, SKATING_SPEED,
     SPEED_WINDOW, SampleFeet, mean_scores,
 };
-pub use kinematics::{
-    ClipKinematics, KinematicMiss, KinematicReport, KinematicScores, Kinematics, wasserstein_1,
-};
+pub use kinematic_report::KinematicReport;
+pub use kinematics::{ClipKinematics, KinematicMiss, KinematicScores, Kinematics, wasserstein_1};
 pub use model_eval::{
     GoalScores, ModelEvalError, ModelEvaluation, evaluate_generated, evaluate_model, goal_scores,
 };
