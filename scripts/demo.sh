@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The main job on the shipped models: sets the project up if needed, then
+# The main job on the shipped models: builds the sinmdm command line and finds (or fetches) an
+# onnxruntime for it if needed (scripts/setup.sh: not the tests' set-up, no root), then
 #  - three new walks of twice the clip's length from the walk model (with a GIF of them),
 #  - an in-between (the clip's first 3 s and its last part kept, the gap generated),
 #  - a style transfer: the CMU walk in the style of the model trained on the CMU hop,

@@ -4,6 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
+scripts/setup_tests.sh
 cargo test --release --workspace
 # burn's ONNX importer on an exported model: a crate with its own lockfile (burn-onnx needs
 # protobuf 3.7, the export crate pins 3.4.0), built into its own target folder.

@@ -126,7 +126,7 @@ def onnxruntime_library():
     found += sorted(glob.glob(os.path.join(REPO, ".venv/lib/python3*/site-packages/onnxruntime/capi/libonnxruntime.*.dylib")))
     found += sorted(glob.glob(os.path.join(REPO, ".venv/Lib/site-packages/onnxruntime/capi/onnxruntime.dll")))
     if not found:
-        raise SystemExit("no onnxruntime library in .venv: run scripts/setup.sh first")
+        raise SystemExit("no onnxruntime library in .venv: run scripts/setup_tests.sh first")
     return found[0]
 
 

@@ -29,7 +29,7 @@ fn compile(source: &Path, out: &Path) {
         .arg("-o")
         .arg(out)
         .status()
-        .expect("no C compiler: run scripts/setup.sh (it installs the test tools)");
+        .expect("no C compiler: run scripts/setup_tests.sh (it installs the test tools)");
     assert!(status.success(), "cc failed on {}", source.display());
 }
 
@@ -140,7 +140,7 @@ fn run_check(valgrind: bool) -> String {
         .arg(world_root_model_path())
         .env("ORT_DYLIB_PATH", onnxruntime_path())
         .output()
-        .expect("could not start the check program (valgrind missing? run scripts/setup.sh)");
+        .expect("could not start the check program (valgrind missing? run scripts/setup_tests.sh)");
     let stdout = String::from_utf8_lossy(&output.stdout).to_string();
     if valgrind && !output.status.success() {
         let text = std::fs::read_to_string(&log).unwrap_or_default();

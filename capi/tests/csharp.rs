@@ -33,7 +33,7 @@ fn the_csharp_binding_gets_the_rust_values_under_mono() {
         .args(binding_sources())
         .arg(repo().join("examples/csharp/Example.cs"))
         .status()
-        .expect("no C# compiler (mcs): run scripts/setup.sh, which installs mono-mcs");
+        .expect("no C# compiler (mcs): run scripts/setup_tests.sh, which installs mono-mcs");
     assert!(status.success(), "mcs failed");
     let bvh = dir.join("out.bvh");
     let output = Command::new("mono")
@@ -44,7 +44,7 @@ fn the_csharp_binding_gets_the_rust_values_under_mono() {
         .env("LD_LIBRARY_PATH", library_dir())
         .env("ORT_DYLIB_PATH", onnxruntime_path())
         .output()
-        .expect("no Mono runtime: run scripts/setup.sh, which installs mono-runtime");
+        .expect("no Mono runtime: run scripts/setup_tests.sh, which installs mono-runtime");
     let stdout = String::from_utf8_lossy(&output.stdout).to_string();
     assert!(
         output.status.success(),
@@ -81,7 +81,7 @@ fn compile_csharp(sources: &[std::path::PathBuf], exe: &std::path::Path) {
         .arg(format!("-out:{}", exe.display()))
         .args(sources)
         .status()
-        .expect("no C# compiler (mcs): run scripts/setup.sh, which installs mono-mcs");
+        .expect("no C# compiler (mcs): run scripts/setup_tests.sh, which installs mono-mcs");
     assert!(status.success(), "mcs failed on {sources:?}");
 }
 
@@ -103,7 +103,7 @@ fn the_csharp_binding_steps_cancels_and_finalizes_under_mono() {
         .env("LD_LIBRARY_PATH", library_dir())
         .env("ORT_DYLIB_PATH", onnxruntime_path())
         .output()
-        .expect("no Mono runtime: run scripts/setup.sh, which installs mono-runtime");
+        .expect("no Mono runtime: run scripts/setup_tests.sh, which installs mono-runtime");
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(
         output.status.success() && stdout.contains(" passed, 0 failed"),

@@ -5,6 +5,7 @@ mod beats;
 mod clip_files;
 mod convert;
 mod dance;
+mod doctor;
 mod eval;
 mod info;
 mod inspect;
@@ -86,6 +87,10 @@ pub enum Command {
     /// Write a clip's features in a model's layout as JSON (input of the Python reference).
     #[command(after_help = info::ENCODE_EXAMPLES)]
     Encode(info::EncodeArgs),
+    /// Which onnxruntime this program loads (file, release, where it was found) and what each
+    /// feature still lacks.
+    #[command(after_help = doctor::EXAMPLES)]
+    Doctor(doctor::DoctorArgs),
     /// A motion library trained as an array job (`sinmdm-train --manifest`): status, report,
     /// batch generation.
     #[command(after_help = library::EXAMPLES)]
@@ -115,6 +120,7 @@ fn main() -> std::process::ExitCode {
         Command::Convert(args) => convert::run(&args),
         Command::Encode(args) => info::encode(&args),
         Command::Library(args) => library::run(&args),
+        Command::Doctor(args) => doctor::run(&args),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -58,6 +58,7 @@ pub mod motion;
 #[doc(hidden)]
 pub mod network;
 mod onnxruntime;
+mod onnxruntime_version;
 #[doc(hidden)]
 pub mod soft_border;
 #[doc(hidden)]

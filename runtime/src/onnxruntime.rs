@@ -383,6 +383,11 @@ mod own_library {
 pub struct OnnxRuntime {
     /// The shared library that was loaded.
     pub path: PathBuf,
+    /// Its release as the library reports it (`"1.31.1"`); `None` where it could not be asked.
+    pub version: Option<String>,
+    /// The place of the search that gave it (`"next to the executable"`, `"ORT_DYLIB_PATH"`, ...),
+    /// so a host can tell which of several copies it runs.
+    pub found_in: String,
     /// The onnxruntime environment (one per process); kept private so that `ort`'s release
     /// candidate stays out of the engine API.
     pub(crate) environment: ort::environment::Environment,
@@ -473,7 +478,14 @@ fn load(asked: Option<&Path>) -> Result<&'static OnnxRuntime, RuntimeLibraryErro
             };
             match start_environment(&path) {
                 Ok(environment) => {
-                    return Ok(LOADED.get_or_init(|| OnnxRuntime { path, environment }));
+                    let version = crate::onnxruntime_version::library_version(&path);
+                    let found_in = place.what.clone();
+                    return Ok(LOADED.get_or_init(|| OnnxRuntime {
+                        path,
+                        version,
+                        found_in,
+                        environment,
+                    }));
                 }
                 Err(Attempt::NotLoaded(message)) => {
                     tried.push(format!("{}: {candidate} ({message})", place.what));

@@ -24,7 +24,7 @@ fail() {
 }
 if pgrep -x sinmdm-train >/dev/null; then fail "another sinmdm-train is running; the figures would not compare"; fi
 for tool in munged slurmctld slurmd sbatch squeue; do
-  command -v "$tool" >/dev/null || fail "$tool is not installed (scripts/setup.sh installs it)"
+  command -v "$tool" >/dev/null || fail "$tool is not installed (scripts/setup_tests.sh installs it)"
 done
 (cd "$repo" && cargo build --release -q -p sinmdm-train -p sinmdm-cli)
 export ORT_DYLIB_PATH=${ORT_DYLIB_PATH:-$(ls "$repo"/.venv/lib/python3*/site-packages/onnxruntime/capi/libonnxruntime.so.1* | head -n 1)}

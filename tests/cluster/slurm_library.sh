@@ -15,7 +15,7 @@ set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 for tool in munged slurmctld slurmd sbatch squeue scancel; do
   if ! command -v "$tool" >/dev/null; then
-    echo "SKIP: $tool is not installed (scripts/setup.sh installs slurmctld slurmd slurm-client munge)"
+    echo "SKIP: $tool is not installed (scripts/setup_tests.sh installs slurmctld slurmd slurm-client munge)"
     exit 0
   fi
 done

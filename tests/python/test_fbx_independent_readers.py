@@ -24,7 +24,7 @@ THREE_UNITS_PER_METRE = 100.0
 @pytest.fixture(scope="module", autouse=True)
 def node_packages():
     if shutil.which("node") is None or not (NODE_DIR / "node_modules" / "three").is_dir():
-        pytest.fail("node and tests/node/node_modules are needed: run scripts/setup.sh")
+        pytest.fail("node and tests/node/node_modules are needed: run scripts/setup_tests.sh")
 
 
 def fixture(name, tmp_path):

@@ -26,7 +26,7 @@ Z_UP_TO_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 @pytest.fixture(scope="module", autouse=True)
 def node_packages():
     if shutil.which("node") is None or not (NODE_DIR / "node_modules" / "three").is_dir():
-        pytest.fail("node and tests/node/node_modules are needed: run scripts/setup.sh")
+        pytest.fail("node and tests/node/node_modules are needed: run scripts/setup_tests.sh")
 
 
 def run(*args):

@@ -76,7 +76,7 @@ def test_native_libraries_are_plugins_for_their_platform(package):
 
 def test_npm_pack_takes_the_package(package, tmp_path):
     if shutil.which("npm") is None:
-        pytest.skip("npm is not installed (scripts/setup.sh needs node and npm)")
+        pytest.skip("npm is not installed (scripts/setup_tests.sh needs node and npm)")
     done = subprocess.run(["npm", "pack", str(package), "--pack-destination", str(tmp_path), "--silent"],
                           capture_output=True, text=True, cwd=tmp_path)
     assert done.returncode == 0, done.stderr
