@@ -3,7 +3,22 @@
 
 use std::path::Path;
 
+use sinmdm::files::{FileLimit, regular_file_size};
+
 use crate::BeatsError;
+
+/// The largest audio file read (1 GiB): hours of uncompressed CD audio.
+pub const MAX_AUDIO_BYTES: u64 = 1 << 30;
+/// The most mono samples a piece of music may have once decoded (2^26: 23 minutes at 48 kHz,
+/// 256 MiB of floats): beyond any dance a model makes, and a bound on what a compressed file
+/// (or a WAV header) can make the reader allocate.
+pub const MAX_AUDIO_SAMPLES: usize = 1 << 26;
+/// The size limit of audio files.
+const AUDIO_LIMIT: FileLimit = FileLimit {
+    bytes: MAX_AUDIO_BYTES,
+    name: "MAX_AUDIO_BYTES",
+    what: "an audio file",
+};
 
 /// Mono audio: samples in -1..1 at `rate` samples per second.
 #[derive(Debug, Clone, PartialEq)]
@@ -21,8 +36,14 @@ impl Audio {
     }
 }
 
-/// Reads an audio file as mono: WAV always, MP3/OGG/FLAC with the `compressed` feature.
+/// Reads an audio file as mono: WAV always, MP3/OGG/FLAC with the `compressed` feature. Only a
+/// regular file of at most [`MAX_AUDIO_BYTES`] is opened (a FIFO would block the reader), and
+/// decoding stops with an error past [`MAX_AUDIO_SAMPLES`].
 pub fn read_audio(path: &Path) -> Result<Audio, BeatsError> {
+    regular_file_size(path, AUDIO_LIMIT).map_err(|source| BeatsError::Io {
+        path: path.to_path_buf(),
+        reason: source,
+    })?;
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
@@ -38,7 +59,7 @@ fn read_wav(path: &Path) -> Result<Audio, BeatsError> {
     let decode = |e: hound::Error| match e {
         hound::Error::IoError(source) => BeatsError::Io {
             path: path.to_path_buf(),
-            source,
+            reason: source,
         },
         other => BeatsError::Decode {
             path: path.to_path_buf(),
@@ -47,24 +68,51 @@ fn read_wav(path: &Path) -> Result<Audio, BeatsError> {
     };
     let reader = hound::WavReader::open(path).map_err(decode)?;
     let spec = reader.spec();
-    let interleaved: Vec<f32> = match spec.sample_format {
-        hound::SampleFormat::Float => reader
-            .into_samples::<f32>()
-            .collect::<Result<_, _>>()
-            .map_err(decode)?,
-        hound::SampleFormat::Int => {
-            let scale = 1.0 / (1u64 << (spec.bits_per_sample.max(1) - 1)) as f32;
-            reader
-                .into_samples::<i32>()
-                .map(|s| s.map(|v| v as f32 * scale))
-                .collect::<Result<_, _>>()
-                .map_err(decode)?
+    // The header's own count first, so a long file is refused before it is decoded.
+    too_long(path, reader.duration() as usize)?;
+    let channels = usize::from(spec.channels.max(1));
+    let mut samples = Vec::with_capacity(reader.duration() as usize);
+    let mut frame = Vec::with_capacity(channels);
+    let mut push = |value: f32| -> Result<(), BeatsError> {
+        frame.push(value);
+        if frame.len() == channels {
+            samples.push(frame.iter().sum::<f32>() / channels as f32);
+            frame.clear();
+            too_long(path, samples.len())?;
         }
+        Ok(())
     };
+    match spec.sample_format {
+        hound::SampleFormat::Float => {
+            for value in reader.into_samples::<f32>() {
+                push(value.map_err(decode)?)?;
+            }
+        }
+        hound::SampleFormat::Int => {
+            let scale = 1.0 / (1u64 << (spec.bits_per_sample.clamp(1, 32) - 1)) as f32;
+            for value in reader.into_samples::<i32>() {
+                push(value.map_err(decode)? as f32 * scale)?;
+            }
+        }
+    }
     Ok(Audio {
-        samples: mono(&interleaved, spec.channels as usize),
+        samples,
         rate: spec.sample_rate,
     })
+}
+
+/// Refuses a piece of music of more than [`MAX_AUDIO_SAMPLES`] mono samples.
+fn too_long(path: &Path, samples: usize) -> Result<(), BeatsError> {
+    if samples > MAX_AUDIO_SAMPLES {
+        return Err(BeatsError::Decode {
+            path: path.to_path_buf(),
+            reason: format!(
+                "more than {MAX_AUDIO_SAMPLES} samples (MAX_AUDIO_SAMPLES, 23 minutes at 48 kHz); \
+                 cut the music to the part to dance to"
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// The mean of each frame's `channels` interleaved samples.
@@ -98,7 +146,7 @@ fn read_compressed(path: &Path) -> Result<Audio, BeatsError> {
     };
     let file = std::fs::File::open(path).map_err(|source| BeatsError::Io {
         path: path.to_path_buf(),
-        source,
+        reason: source,
     })?;
     let stream = MediaSourceStream::new(Box::new(file), Default::default());
     let mut hint = Hint::new();
@@ -142,6 +190,7 @@ fn read_compressed(path: &Path) -> Result<Audio, BeatsError> {
         let mut buffer = SampleBuffer::<f32>::new(decoded.capacity() as u64, spec);
         buffer.copy_interleaved_ref(decoded);
         samples.extend(mono(buffer.samples(), spec.channels.count()));
+        too_long(path, samples.len())?;
     }
     if rate == 0 {
         return Err(fail("no sample rate".into()));

@@ -50,7 +50,7 @@ pub fn write_click_track(path: &Path, song: &Audio, beats: &[f64]) -> Result<(),
 pub fn write_wav(path: &Path, audio: &Audio) -> Result<(), BeatsError> {
     let io = |source: std::io::Error| BeatsError::Io {
         path: path.to_path_buf(),
-        source,
+        reason: source,
     };
     let partial = path.with_extension("wav.partial");
     let spec = hound::WavSpec {

@@ -5,13 +5,14 @@ use thiserror::Error;
 /// Why beats could not be read, found or written.
 #[derive(Debug, Error)]
 pub enum BeatsError {
-    /// A file that could not be opened, read or written.
-    #[error("{path}: {source}")]
+    /// A file that could not be opened, read or written. The reason is said in the message and
+    /// not chained as a source, so a printer of causes (`{:#}`) says it once.
+    #[error("{path}: {reason}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// What went wrong.
-        source: std::io::Error,
+        /// The system's reason, or the limit the file broke.
+        reason: std::io::Error,
     },
     /// An audio file that could not be decoded.
     #[error("{path}: {reason}")]

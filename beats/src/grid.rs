@@ -13,10 +13,11 @@ pub const MAX_BEATS: usize = 2_000_000;
 /// first column is the time reads as it is, after an optional header line that is not a
 /// number). Times must increase.
 pub fn read_beat_file(path: &Path) -> Result<Vec<f64>, BeatsError> {
-    let text = std::fs::read_to_string(path).map_err(|source| BeatsError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text =
+        sinmdm::files::read_text_file(path, "a beat list").map_err(|source| BeatsError::Io {
+            path: path.to_path_buf(),
+            reason: source,
+        })?;
     let mut times: Vec<f64> = Vec::new();
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let mut seen_data = false;

@@ -24,7 +24,7 @@ pub mod tempo;
 pub mod track;
 mod window;
 
-pub use audio::{Audio, read_audio};
+pub use audio::{Audio, MAX_AUDIO_BYTES, MAX_AUDIO_SAMPLES, read_audio};
 pub use error::BeatsError;
 
 /// Tempo and beats of a piece of music.

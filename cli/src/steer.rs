@@ -244,8 +244,8 @@ pub fn print_following(generated: &Generated, metadata: &ModelMetadata, commands
 /// them), each with its line number, every row as wide as one of `widths`; a first line that is
 /// not numbers is a header. `what` names the columns in errors.
 fn numbers(file: &Path, widths: &[usize], what: &str) -> Result<Vec<(usize, Vec<f64>)>> {
-    let text =
-        std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
+    let text = sinmdm::files::read_text_file(file, "a steering file")
+        .with_context(|| format!("cannot read {}", file.display()))?;
     let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let fields: Vec<&str> = line

@@ -94,7 +94,8 @@ impl Manifest {
     /// Reads and checks a manifest: at least one clip, every name valid and unique (two tasks
     /// never share a folder), every clip file present.
     pub fn load(path: &Path) -> Result<Manifest, LibraryError> {
-        let text = std::fs::read_to_string(path).map_err(|e| LibraryError::io(path, e))?;
+        let text = sinmdm::files::read_text_file(path, "a manifest")
+            .map_err(|e| LibraryError::io(path, e))?;
         let bad = |message: String| LibraryError::Manifest {
             path: path.to_path_buf(),
             message,

@@ -25,13 +25,14 @@ pub const VERSION: u32 = 1;
 /// A features file that could not be read or written.
 #[derive(Debug, Error)]
 pub enum FeaturesFileError {
-    /// Reading or writing failed.
-    #[error("{path}: {source}")]
+    /// Reading or writing failed. The reason is said in the message and not chained as a
+    /// source, so a printer of causes (`{:#}`) says it once.
+    #[error("{path}: {reason}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// What the system said.
-        source: std::io::Error,
+        /// What the system said, or the limit the file broke.
+        reason: std::io::Error,
     },
     /// Not a features file of this version, or ragged arrays.
     #[error("{path}: {message}")]
@@ -41,6 +42,21 @@ pub enum FeaturesFileError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// The largest features file read (1 GiB): a long clip's features as text stay far below it.
+pub const MAX_FEATURES_FILE_BYTES: u64 = 1 << 30;
+
+/// The text of a features file: a regular UTF-8 file of at most [`MAX_FEATURES_FILE_BYTES`].
+fn read_features_text(path: &Path) -> std::io::Result<String> {
+    let limit = crate::files::FileLimit {
+        bytes: MAX_FEATURES_FILE_BYTES,
+        name: "MAX_FEATURES_FILE_BYTES",
+        what: "a features file",
+    };
+    let bytes = crate::files::read_regular_file(path, limit, None)?;
+    String::from_utf8(bytes)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.utf8_error()))
 }
 
 #[derive(Serialize, Deserialize)]
@@ -79,7 +95,7 @@ pub fn write_features(
     })?;
     write_atomically(path, text.as_bytes()).map_err(|source| FeaturesFileError::Io {
         path: path.to_path_buf(),
-        source,
+        reason: source,
     })
 }
 
@@ -89,9 +105,9 @@ pub fn read_features(path: &Path) -> Result<(Array3<f32>, f64), FeaturesFileErro
         path: path.to_path_buf(),
         message,
     };
-    let text = std::fs::read_to_string(path).map_err(|source| FeaturesFileError::Io {
+    let text = read_features_text(path).map_err(|source| FeaturesFileError::Io {
         path: path.to_path_buf(),
-        source,
+        reason: source,
     })?;
     let doc: FeaturesJson = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
     if doc.format != FORMAT || doc.version != VERSION {

@@ -119,6 +119,26 @@ pub fn read_regular_file(
     Ok(bytes)
 }
 
+/// The largest text file read (16 MiB): configurations, manifests, steering paths and beat
+/// lists are written by hand or by a tool, and stay far below it.
+pub const MAX_TEXT_BYTES: u64 = 16 << 20;
+
+/// Reads the regular UTF-8 text file `path` of at most [`MAX_TEXT_BYTES`]; `what` names its
+/// kind in the message (`"a training configuration"`).
+pub fn read_text_file(path: &Path, what: &'static str) -> std::io::Result<String> {
+    let limit = FileLimit {
+        bytes: MAX_TEXT_BYTES,
+        name: "MAX_TEXT_BYTES",
+        what,
+    };
+    String::from_utf8(read_regular_file(path, limit, None)?).map_err(|e| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("is not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -171,6 +191,31 @@ mod tests {
             let err = read_regular_file(Path::new("/dev/zero"), limit(10), None).unwrap_err();
             assert!(err.to_string().contains("not a regular file"), "{err}");
         }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn text_files_are_bounded_and_must_be_utf8() {
+        let dir = std::env::temp_dir().join(format!("sinmdm-text-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let good = dir.join("good.yaml");
+        std::fs::write(&good, "steps: 3\n").unwrap();
+        assert_eq!(read_text_file(&good, "a config").unwrap(), "steps: 3\n");
+        let latin1 = dir.join("latin1.yaml");
+        std::fs::write(&latin1, b"name: caf\xe9\n").unwrap();
+        let err = read_text_file(&latin1, "a config").unwrap_err();
+        assert_eq!(err.to_string(), "is not UTF-8 text (byte 9)");
+        let huge = dir.join("huge.yaml");
+        std::fs::File::create(&huge)
+            .unwrap()
+            .set_len(MAX_TEXT_BYTES + 1)
+            .unwrap();
+        let err = read_text_file(&huge, "a config").unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("a config may have (MAX_TEXT_BYTES)"),
+            "{err}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

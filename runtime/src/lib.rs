@@ -69,7 +69,7 @@ pub mod stream;
 pub mod tasks;
 
 pub use diffusion::{DEFAULT_STEPS, Denoiser, Method, Sampler, SamplerError, StepError};
-pub use model::{Model, ModelError, ModelOptions};
+pub use model::{MAX_MODEL_BYTES, MODEL_LIMIT, Model, ModelError, ModelOptions};
 pub use model_file::ModelMetadata;
 pub use motion::{
     Channel, FeatureLayout, Feet, Joint, LocalMotion, Pose, Quaternion, Skeleton, UpAxis,

@@ -23,13 +23,14 @@ pub enum ModelError {
     /// No file at the path.
     #[error("model file '{0}' does not exist")]
     Missing(PathBuf),
-    /// The file exists but could not be read.
-    #[error("could not read model file '{path}': {source}")]
+    /// The file exists but could not be read (or is not a regular file, or is larger than
+    /// [`MAX_MODEL_BYTES`]). The reason is said in the message, not chained, so it is said once.
+    #[error("could not read model file '{path}': {reason}")]
     Read {
         /// The model file.
         path: PathBuf,
-        /// What the system said.
-        source: std::io::Error,
+        /// What the system said, or the limit the file broke.
+        reason: std::io::Error,
     },
     /// onnxruntime would not load the bytes as a model (truncated, not ONNX, unsupported op).
     #[error("'{path}' is not a loadable ONNX model: {message}")]
@@ -175,18 +176,28 @@ fn open_session(environment: &ort::environment::Environment, bytes: &[u8]) -> or
         .commit_from_memory(bytes)
 }
 
+/// The largest model file read (2 GiB): protobuf's own ceiling, so no valid self-contained
+/// ONNX file is larger, and a bound on what a file can make the runtime allocate.
+pub const MAX_MODEL_BYTES: u64 = 1 << 31;
+/// The size limit of model files, for [`crate::files::read_regular_file`].
+pub const MODEL_LIMIT: crate::files::FileLimit = crate::files::FileLimit {
+    bytes: MAX_MODEL_BYTES,
+    name: "MAX_MODEL_BYTES",
+    what: "a model file",
+};
+
 impl Model {
-    /// Opens a model file: loads onnxruntime if needed, reads the file, checks the metadata and
-    /// the graph's interface.
+    /// Opens a model file: loads onnxruntime if needed, reads the file (a regular file of at
+    /// most [`MAX_MODEL_BYTES`]), checks the metadata and the graph's interface.
     pub fn open(path: impl AsRef<Path>, options: &ModelOptions) -> Result<Model, ModelError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|source| {
+        let bytes = crate::files::read_regular_file(path, MODEL_LIMIT, None).map_err(|source| {
             if source.kind() == std::io::ErrorKind::NotFound {
                 ModelError::Missing(path.to_path_buf())
             } else {
                 ModelError::Read {
                     path: path.to_path_buf(),
-                    source,
+                    reason: source,
                 }
             }
         })?;

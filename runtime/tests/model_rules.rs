@@ -216,3 +216,43 @@ fn sizes_are_bounded_and_agree_with_each_other() {
         &["normalizer.mean[7]", "NaN"],
     );
 }
+
+/// A model path that is a folder, a FIFO or a file over [`sinmdm::MAX_MODEL_BYTES`] is refused
+/// before a byte is read, and the message says why once.
+#[test]
+fn a_model_path_that_is_no_regular_file_or_too_large_is_refused_by_name() {
+    let dir = std::env::temp_dir().join(format!("sinmdm-model-files-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let refused = |path: &std::path::Path, reason: &str| {
+        let e = Model::open(path, &ModelOptions { threads: Some(1) }).unwrap_err();
+        let message = e.to_string();
+        assert!(
+            message.contains(&path.display().to_string()) && message.matches(reason).count() == 1,
+            "{message}"
+        );
+        assert!(std::error::Error::source(&e).is_none(), "{message}");
+    };
+    let folder = dir.join("walk.onnx");
+    std::fs::create_dir_all(&folder).unwrap();
+    refused(&folder, "is a directory, not a regular file");
+    // A sparse file: its size is what is checked, and nothing of it is read.
+    let huge = dir.join("huge.onnx");
+    std::fs::File::create(&huge)
+        .unwrap()
+        .set_len(sinmdm::MAX_MODEL_BYTES + 1)
+        .unwrap();
+    refused(&huge, "MAX_MODEL_BYTES");
+    #[cfg(unix)]
+    {
+        let fifo = dir.join("pipe.onnx");
+        assert!(
+            std::process::Command::new("mkfifo")
+                .arg(&fifo)
+                .status()
+                .unwrap()
+                .success()
+        );
+        refused(&fifo, "a device, FIFO or socket, not a regular file");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -162,7 +162,7 @@ pub fn latest(run: &Path) -> Result<Option<PathBuf>, TrainError> {
         Err(source) => Err(TrainError::Io {
             what: "read",
             path: file,
-            source,
+            reason: source,
         }),
     }
 }

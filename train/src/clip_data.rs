@@ -9,7 +9,8 @@ use sha2::{Digest, Sha256};
 use sinmdm::model_file::ClipSourceFacts;
 use sinmdm::motion::{ContactConfig, EncodeOptions, FeatureLayout, Normalizer, RootLayout, encode};
 use sinmdm_formats::{
-    AnimationChoice, ClipFormat, ReadOptions, STILL_TOLERANCE, clip_moves, read_clip,
+    AnimationChoice, ClipFormat, FileAccess, ReadOptions, STILL_TOLERANCE, clip_moves,
+    read_clip_with_access,
 };
 
 use crate::config::{DataConfig, ModelConfig};
@@ -83,7 +84,7 @@ impl ClipData {
             |source| TrainError::Io {
                 what: "read the clip",
                 path: path.to_path_buf(),
-                source,
+                reason: source,
             },
         )?;
         let read_options = ReadOptions {
@@ -105,7 +106,10 @@ impl ClipData {
                 )
             }
             format @ (ClipFormat::Gltf | ClipFormat::Fbx) => {
-                let (clip, source) = read_clip(path, &read_options)?;
+                let access = FileAccess {
+                    allow_outside_folder: data.allow_outside_folder,
+                };
+                let (clip, source) = read_clip_with_access(path, &read_options, access)?;
                 let read = source
                     .animation
                     .expect("a glTF or FBX clip names its animation");
@@ -144,7 +148,7 @@ impl ClipData {
         };
         let encoded = encode(&clip, &options).map_err(|source| TrainError::Motion {
             path: path.to_path_buf(),
-            source,
+            reason: source,
         })?;
         let frames = encoded.features.ncols();
         let receptive_field = model.at_fps(encoded.layout.fps).receptive_field();

@@ -5,15 +5,16 @@ use std::path::PathBuf;
 /// Everything that can stop a training run.
 #[derive(Debug, thiserror::Error)]
 pub enum TrainError {
-    /// A file could not be read or written.
-    #[error("could not {what} '{}': {source}", path.display())]
+    /// A file could not be read or written. The reasons of this and the other file errors are
+    /// said in the message and not chained as sources, so a printer of causes says them once.
+    #[error("could not {what} '{}': {reason}", path.display())]
     Io {
         /// What was being done.
         what: &'static str,
         /// The file or folder.
         path: PathBuf,
-        /// The system's reason.
-        source: std::io::Error,
+        /// The system's reason, or the limit the file broke.
+        reason: std::io::Error,
     },
     /// The configuration is malformed or holds a bad value.
     #[error("{}: {message}", path.display())]
@@ -43,12 +44,12 @@ pub enum TrainError {
         tolerance: f64,
     },
     /// The clip could not be turned into features.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {reason}", path.display())]
     Motion {
         /// The clip.
         path: PathBuf,
         /// The reason.
-        source: sinmdm::motion::MotionError,
+        reason: sinmdm::motion::MotionError,
     },
     /// The clip is shorter than what the network sees at once.
     #[error(
@@ -110,6 +111,6 @@ pub(crate) fn io<'a>(
     move |source| TrainError::Io {
         what,
         path: path.to_path_buf(),
-        source,
+        reason: source,
     }
 }

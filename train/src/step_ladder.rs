@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 
 use sinmdm::motion::encode_for_model;
 use sinmdm_eval::KinematicScores;
-use sinmdm_formats::{AnimationChoice, ReadOptions, read_clip};
+use sinmdm_formats::{AnimationChoice, FileAccess, ReadOptions, read_clip_with_access};
 
 pub use crate::ladder_settings::{CHECK_SAMPLES, CHECK_SEED, LADDER_STEPS, goals};
 
@@ -333,7 +333,7 @@ impl Ladder {
             std::fs::remove_dir_all(dir).map_err(|source| TrainError::Io {
                 what: "clear an unfinished rung of the step ladder",
                 path: dir.to_path_buf(),
-                source,
+                reason: source,
             })?;
         }
         let rung = Self::rung_config(config, steps);
@@ -346,8 +346,12 @@ impl Ladder {
         let train_seconds = started.elapsed().as_secs_f64();
         let model = dir.join("model.onnx");
         crate::export::export_checkpoint(&checkpoint, &model)?;
-        let animation = trainer.state().config.data.animation.clone();
-        let mut check = self.score(&model, clip, animation.as_deref())?;
+        let data = &trainer.state().config.data;
+        let access = FileAccess {
+            allow_outside_folder: data.allow_outside_folder,
+        };
+        let animation = data.animation.clone();
+        let mut check = self.score(&model, clip, animation.as_deref(), access)?;
         check.steps = steps;
         check.train_seconds = train_seconds;
         Ok(Some(check))
@@ -361,6 +365,7 @@ impl Ladder {
         model: &Path,
         clip: &Path,
         animation: Option<&str>,
+        access: FileAccess,
     ) -> Result<RungCheck, TrainError> {
         let failed = |message: String| TrainError::Check {
             model: model.to_path_buf(),
@@ -374,7 +379,7 @@ impl Ladder {
             animation: animation.map(AnimationChoice::parse),
             fps: None,
         };
-        let (channels, _) = read_clip(clip, &options)?;
+        let (channels, _) = read_clip_with_access(clip, &options, access)?;
         let clip = encode_for_model(&channels, &metadata.layout, None)
             .map_err(|e| failed(e.to_string()))?
             .features;
@@ -500,7 +505,7 @@ fn write_check(dir: &Path, check: &RungCheck) -> Result<(), TrainError> {
         TrainError::Io {
             what: "write a rung's scores",
             path: dir.join(CHECK_FILE),
-            source,
+            reason: source,
         }
     })
 }

@@ -298,3 +298,44 @@ fn a_clip_with_a_one_axis_hinge_trains_exports_and_opens() {
     std::fs::remove_dir_all(&run).unwrap();
     std::fs::remove_file(&file).unwrap();
 }
+
+/// A `.gltf` clip whose buffer lies in the folder above is read only when the run allows it
+/// (`data.allow_outside_folder`, what `sinmdm-train --allow-outside-folder` sets), and then
+/// gives the features of the same clip as a GLB.
+#[test]
+fn a_gltf_clip_reads_a_buffer_outside_its_folder_only_when_allowed() {
+    let mut config = tiny();
+    let glb = as_gltf("fox_survey_khronos.bvh", 0.01, "glb", "outside_folder");
+    let bytes = std::fs::read(&glb).unwrap();
+    // The GLB's two chunks: its JSON, then its binary buffer.
+    let chunk = |at: usize| {
+        let length = u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        (&bytes[at + 8..at + 8 + length], at + 8 + length)
+    };
+    let (json, next) = chunk(12);
+    let (bin, _) = chunk(next);
+    let mut json: serde_json::Value = serde_json::from_slice(json).unwrap();
+    json["buffers"][0] =
+        serde_json::json!({ "uri": "../buffers/clip.bin", "byteLength": bin.len() });
+    let top = glb.with_extension("split");
+    std::fs::create_dir_all(top.join("buffers")).unwrap();
+    std::fs::create_dir_all(top.join("clips")).unwrap();
+    std::fs::write(top.join("buffers/clip.bin"), bin).unwrap();
+    let gltf = top.join("clips/clip.gltf");
+    std::fs::write(&gltf, serde_json::to_vec(&json).unwrap()).unwrap();
+
+    let refused = match ClipData::load(&gltf, &config.data, &config.model) {
+        Ok(_) => panic!("the buffer outside the clip's folder was read"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        refused.contains("'../buffers/clip.bin'") && refused.contains("--allow-outside-folder"),
+        "{refused}"
+    );
+    config.data.allow_outside_folder = true;
+    let split = ClipData::load(&gltf, &config.data, &config.model).unwrap();
+    let whole = ClipData::load(&glb, &config.data, &config.model).unwrap();
+    assert_eq!(split.features, whole.features);
+    std::fs::remove_dir_all(&top).unwrap();
+    std::fs::remove_file(&glb).unwrap();
+}

@@ -37,6 +37,10 @@ struct Args {
     /// replacing the config's data.animation.
     #[arg(long, value_name = "NAME|INDEX")]
     clip_anim: Option<String>,
+    /// Read a .gltf clip's buffer files even where its URIs lead outside the clip's folder
+    /// (`../other/data.bin`); off so that a downloaded file cannot read others on the machine.
+    #[arg(long)]
+    allow_outside_folder: bool,
     /// Training configuration (YAML). Without it a new run uses the default (configs/default.yaml,
     /// built in) and a resumed run its own.
     #[arg(long)]
@@ -179,6 +183,7 @@ fn new_run_config(args: &Args) -> Result<TrainConfig> {
     if let Some(animation) = &args.clip_anim {
         config.data.animation = Some(animation.clone());
     }
+    config.data.allow_outside_folder = args.allow_outside_folder;
     if let Some(layout) = args.root_layout {
         config.data.root_layout = layout;
     }

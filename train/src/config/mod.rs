@@ -204,6 +204,11 @@ pub struct DataConfig {
     /// Absent: `world`, as configurations written before the heading root read.
     #[serde(default, skip_serializing_if = "is_world")]
     pub root_layout: sinmdm::motion::RootLayout,
+    /// Whether a `.gltf` clip's buffer files may be read outside its folder
+    /// (`--allow-outside-folder`): a permission of this run, not a setting of the model, so it
+    /// is never written to or read from a configuration file.
+    #[serde(skip)]
+    pub allow_outside_folder: bool,
 }
 
 fn is_world(layout: &sinmdm::motion::RootLayout) -> bool {
@@ -295,11 +300,14 @@ impl TrainConfig {
 
     /// Reads and checks a YAML file.
     pub fn load(path: &Path) -> Result<TrainConfig, TrainError> {
-        let text = std::fs::read_to_string(path).map_err(|source| TrainError::Io {
-            what: "read the config",
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            sinmdm::files::read_text_file(path, "a training configuration").map_err(|source| {
+                TrainError::Io {
+                    what: "read the config",
+                    path: path.to_path_buf(),
+                    reason: source,
+                }
+            })?;
         let config = Self::parse(&text).map_err(|message| TrainError::Config {
             path: path.to_path_buf(),
             message,
