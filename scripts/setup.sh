@@ -5,8 +5,11 @@
 #  - an onnxruntime shared library for it to load: any onnxruntime 1.17 or later it already
 #    finds (`sinmdm doctor` says which and where), else the pinned wheel in a project-local
 #    .venv (needs Python 3 with venv; scripts/requirements-runtime.txt).
-# --train also builds the trainer and exporter (sinmdm-train, sinmdm-export: burn, about ten
-# minutes on 2 cores the first time). The tests' own set-up is scripts/setup_tests.sh.
+# --train builds the whole workspace instead, the trainer and exporter included (sinmdm-train,
+# sinmdm-export: burn, about ten minutes on 2 cores the first time); so does any later run once
+# the trainer is built: the command line alone resolves its dependencies' features apart from
+# the workspace, and building the two in turn would rebuild most crates each time. The tests'
+# own set-up is scripts/setup_tests.sh.
 # Safe to run again: it builds incrementally and installs only what is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,9 +28,9 @@ fi
 
 packages=(-p sinmdm-cli)
 what="the sinmdm command line"
-if [ "$train" = 1 ]; then
-  packages+=(-p sinmdm-train)
-  what="$what, sinmdm-train and sinmdm-export"
+if [ "$train" = 1 ] || [ -x target/release/sinmdm-train ]; then
+  packages=(--workspace)
+  what="the workspace (sinmdm, sinmdm-train, sinmdm-export)"
 fi
 echo "setup: building $what (release)"
 cargo build --release --quiet "${packages[@]}"

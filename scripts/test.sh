@@ -10,8 +10,8 @@ part() { # NAME COMMAND...
   "$@"
   echo "test: $name took $((SECONDS - start)) s"
 }
-part setup scripts/setup.sh
 part setup-tests scripts/setup_tests.sh
+part setup scripts/setup.sh
 part workspace cargo test --release --workspace
 # burn's ONNX importer on an exported model: a crate with its own lockfile (burn-onnx needs
 # protobuf 3.7, the export crate pins 3.4.0), built into its own target folder.

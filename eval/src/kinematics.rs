@@ -3,9 +3,11 @@
 //! cannot see this: a model that outputs the clip's mean pose with a little noise covers a calm
 //! clip, copies nothing and is smooth.
 //!
-//! Every joint but the root is placed relative to the root joint, in the root's own frame (the
+//! Every joint below the root is placed relative to the root joint, in the root's own frame (the
 //! body's motion, without travel or turning), divided by the skeleton height H and resampled to
-//! [`KINEMATIC_FPS`] (linearly), so figures compare across clips and frame rates. A frame
+//! [`KINEMATIC_FPS`] (linearly), so figures compare across clips and frame rates. The root is
+//! the joint that carries the body ([`travelling_root`]): a still ground joint above the hips,
+//! as some rigs have, would otherwise count the body's travel as its motion. A frame
 //! pair's *speed* is the mean over those joints of the distance moved times the rate (H/s); a
 //! frame's *acceleration* the mean length of the second difference times the rate squared
 //! (H/s²). Samples are pooled and compared with the clip by:
@@ -18,6 +20,7 @@
 
 use serde::{Deserialize, Serialize};
 use sinmdm::motion::LocalMotion;
+use sinmdm::motion::contacts::travelling_root;
 use sinmdm::motion::ground::percentile;
 use sinmdm::motion::math::Vec3;
 use sinmdm::motion::{GlobalPose, global_poses};
@@ -103,14 +106,21 @@ impl Kinematics {
     }
 }
 
-/// Every joint but the skeleton's roots, relative to the first root joint in its own frame,
-/// divided by `height`: `[frames][joints]`.
+/// Every joint but the travelling root and the still joints above it, relative to the
+/// travelling root in its own frame, divided by `height`: `[frames][joints]`.
 fn root_relative(motion: &LocalMotion, poses: &[GlobalPose], height: f64) -> Vec<Vec<Vec3>> {
     let h = height.max(f64::MIN_POSITIVE);
     let joints = &motion.skeleton.joints;
-    let Some(root) = joints.iter().position(|j| j.parent.is_none()) else {
+    if joints.is_empty() || poses.is_empty() {
         return vec![Vec::new(); poses.len()];
-    };
+    }
+    let root = travelling_root(&motion.skeleton, poses);
+    let mut above = vec![false; joints.len()];
+    let mut chain = Some(root);
+    while let Some(j) = chain {
+        above[j] = true;
+        chain = joints[j].parent;
+    }
     poses
         .iter()
         .map(|pose| {
@@ -119,7 +129,7 @@ fn root_relative(motion: &LocalMotion, poses: &[GlobalPose], height: f64) -> Vec
             joints
                 .iter()
                 .enumerate()
-                .filter(|(_, joint)| joint.parent.is_some())
+                .filter(|&(j, joint)| !above[j] && joint.parent.is_some())
                 .map(|(j, _)| (into_root * (pose.joints[j] - origin)) * (1.0 / h))
                 .collect()
         })

@@ -113,8 +113,10 @@ fn random_noise_covers_nothing() {
 
 #[test]
 fn thread_count_does_not_change_the_result() {
-    let clip = walk();
-    let samples: Vec<Array2<f64>> = (0..5).map(|seed| reordered(&clip, 40, seed)).collect();
+    // The clip's first two seconds (at its 120 fps): the scores' cost grows with the square of
+    // the frames, and the split over threads is what is checked, not the size.
+    let clip = walk().slice(s![..240, ..]).to_owned();
+    let samples: Vec<Array2<f64>> = (0..3).map(|seed| reordered(&clip, 40, seed)).collect();
     let one = evaluate(clip.view(), &samples, 1).unwrap();
     let two = evaluate(clip.view(), &samples, 2).unwrap();
     assert_eq!(one, two);

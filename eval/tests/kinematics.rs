@@ -126,3 +126,59 @@ fn one_pose_held_is_still_throughout_and_a_whole_mean_away() {
         assert_eq!(s.misses(report.clip.still_share).len(), 6, "{name}");
     }
 }
+
+/// `name`'s BVH text with a still ground joint added above its root (as some rigs have: a
+/// `joint_Root` at the origin that never moves, the hips below it carrying the body).
+fn with_ground_root(name: &str) -> LocalMotion {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/bvh")
+        .join(name);
+    let text = std::fs::read_to_string(path).unwrap();
+    let (hierarchy, motion) = text.split_once("MOTION").unwrap();
+    let hierarchy = hierarchy.replacen(
+        "ROOT ",
+        "ROOT ground\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\nJOINT ",
+        1,
+    );
+    let mut lines = motion.lines();
+    let mut text = format!("{}\n}}\nMOTION", hierarchy.trim_end());
+    for line in lines.by_ref() {
+        text.push_str(line);
+        text.push('\n');
+        if line.starts_with("Frame Time") {
+            break;
+        }
+    }
+    for line in lines.filter(|l| !l.trim().is_empty()) {
+        text.push_str("0 0 0 0 0 0 ");
+        text.push_str(line);
+        text.push('\n');
+    }
+    resample(
+        &sinmdm::bvh::parse_bvh(&text, "grounded.bvh")
+            .unwrap()
+            .to_local(),
+        30.0,
+    )
+}
+
+/// A still ground joint above the hips changes nothing: the body is measured from the joint
+/// that carries it, so the body's travel is not counted as its motion.
+#[test]
+fn a_still_ground_joint_above_the_root_changes_nothing() {
+    for name in ["human_walk_cmu_131_01.bvh", "fox_survey_khronos.bvh"] {
+        let (motion, height) = clip(name);
+        let grounded = with_ground_root(name);
+        assert_eq!(grounded.skeleton.len(), motion.skeleton.len() + 1, "{name}");
+        let plain = sinmdm_eval::Kinematics::of_motion(&motion, height);
+        let ground = sinmdm_eval::Kinematics::of_motion(&grounded, height);
+        assert_eq!(plain.speeds.len(), ground.speeds.len(), "{name}");
+        let worst = plain
+            .speeds
+            .iter()
+            .zip(&ground.speeds)
+            .map(|(a, b)| (a - b).abs() / a.abs().max(1e-9))
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "{name}: relative difference {worst}");
+    }
+}

@@ -48,12 +48,12 @@ pub enum ExportError {
     #[error("metadata disagrees with the weights: {0}")]
     Metadata(String),
     /// The file could not be written.
-    #[error("could not write '{}': {source}", path.display())]
+    #[error("could not write '{}': {reason}", path.display())]
     Io {
         /// The file.
         path: std::path::PathBuf,
         /// The reason.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
 }
 
@@ -116,6 +116,6 @@ pub fn write_onnx(
     let bytes = to_onnx_bytes(weights, shape, metadata)?;
     sinmdm::files::write_atomically(path, &bytes).map_err(|source| ExportError::Io {
         path: path.to_path_buf(),
-        source,
+        reason: source,
     })
 }
