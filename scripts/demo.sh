@@ -18,7 +18,7 @@ cd "$(dirname "$0")/.."
 out=${1:-out}
 scripts/setup.sh
 mkdir -p "$out"
-sinmdm=./target/release/sinmdm
+sinmdm=${CARGO_TARGET_DIR:-./target}/release/sinmdm
 walk_model=onnx-models/human_walk_cmu.onnx
 hop_model=onnx-models/human_hop_cmu.onnx
 fox_model=onnx-models/fox_survey_khronos.onnx

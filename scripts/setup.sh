@@ -28,13 +28,14 @@ fi
 
 packages=(-p sinmdm-cli)
 what="the sinmdm command line"
-if [ "$train" = 1 ] || [ -x target/release/sinmdm-train ]; then
+release=${CARGO_TARGET_DIR:-target}/release
+if [ "$train" = 1 ] || [ -x "$release/sinmdm-train" ]; then
   packages=(--workspace)
   what="the workspace (sinmdm, sinmdm-train, sinmdm-export)"
 fi
 echo "setup: building $what (release)"
 cargo build --release --quiet "${packages[@]}"
-sinmdm=target/release/sinmdm
+sinmdm=$release/sinmdm
 
 if ! "$sinmdm" doctor >/dev/null 2>&1; then
   python=${PYTHON:-python3}

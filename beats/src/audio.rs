@@ -68,10 +68,19 @@ fn read_wav(path: &Path) -> Result<Audio, BeatsError> {
     };
     let reader = hound::WavReader::open(path).map_err(decode)?;
     let spec = reader.spec();
+    if spec.sample_rate == 0 {
+        return Err(BeatsError::Decode {
+            path: path.to_path_buf(),
+            reason: "the header's sample rate is 0".into(),
+        });
+    }
     // The header's own count first, so a long file is refused before it is decoded.
     too_long(path, reader.duration() as usize)?;
     let channels = usize::from(spec.channels.max(1));
-    let mut samples = Vec::with_capacity(reader.duration() as usize);
+    // The header is trusted for the reservation only as far as the file's size backs it.
+    let backed = std::fs::metadata(path).map_or(0, |m| m.len()) as usize
+        / (channels * usize::from(spec.bits_per_sample.div_ceil(8)).max(1));
+    let mut samples = Vec::with_capacity((reader.duration() as usize).min(backed));
     let mut frame = Vec::with_capacity(channels);
     let mut push = |value: f32| -> Result<(), BeatsError> {
         frame.push(value);

@@ -42,5 +42,6 @@ mod tests {
         assert_eq!(SINMDM_MAX_THREADS, limits::MAX_THREADS);
         assert_eq!(SINMDM_MAX_SPANS, limits::MAX_SAMPLE_FRAMES);
         assert_eq!(SINMDM_MAX_JOINT_INDICES, 4 * limits::MAX_JOINTS);
+        assert_eq!(SINMDM_MAX_MODEL_BYTES as u64, limits::MAX_MODEL_BYTES);
     }
 }

@@ -57,38 +57,20 @@ fn an_installed_sinmdm_finds_onnxruntime_beside_it_or_on_the_system_path() {
         glb.to_str().unwrap(),
     ];
 
-    // None anywhere (this assumes the machine has no system-wide onnxruntime): every place of
-    // the search is named, in order, by `doctor` and by a command that needs it.
+    // None anywhere: every place of the search is named, in order, by `doctor` and by a command
+    // that needs it. (A machine with an onnxruntime of its own on the loader's path cannot show
+    // this; there the check says so and goes on.)
     let doctor = installed(&bin, &work, None, &["doctor"]);
-    assert!(!doctor.status.success(), "{}", text(&doctor));
     let said = text(&doctor);
-    let places = [
-        "ORT_DYLIB_PATH: not set",
-        &format!(
-            "next to the executable: no libonnxruntime.so in {}",
-            bin.display()
-        ),
-        "the system loader's search path",
-        "a developer checkout's .venv: none",
-    ];
-    let at: Vec<usize> = places
-        .iter()
-        .map(|p| {
-            said.find(p)
-                .unwrap_or_else(|| panic!("'{p}' not in: {said}"))
-        })
-        .collect();
-    assert!(at.windows(2).all(|w| w[0] < w[1]), "out of order: {said}");
-    assert!(said.contains("missing  generate"), "{said}");
-    let run = installed(&bin, &work, None, &generate);
-    assert!(!run.status.success());
-    assert!(
-        text(&run).contains("a developer checkout's .venv: none"),
-        "{}",
-        text(&run)
-    );
-    assert!(!glb.exists());
-
+    if doctor.status.success()
+        && said.contains("the search's place: the system loader's search path")
+    {
+        eprintln!(
+            "this machine's loader finds an onnxruntime of its own; not checked: none anywhere"
+        );
+    } else {
+        nowhere(&bin, &work, &said, &generate, &glb);
+    }
     // On the system loader's path.
     std::fs::copy(&library, system.join("libonnxruntime.so")).unwrap();
     let doctor = installed(&bin, &work, Some(&system), &["doctor"]);
@@ -115,4 +97,36 @@ fn an_installed_sinmdm_finds_onnxruntime_beside_it_or_on_the_system_path() {
     let written = std::fs::read(&glb).unwrap();
     assert_eq!(&written[..4], b"glTF");
     std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// With no onnxruntime to be found, `doctor` (which said `said`) fails naming every place in
+/// order, and `generate` fails the same way and writes nothing.
+fn nowhere(bin: &Path, work: &Path, said: &str, generate: &[&str], glb: &Path) {
+    assert!(said.contains("error: onnxruntime was not found"), "{said}");
+    let places = [
+        "ORT_DYLIB_PATH: not set",
+        &format!(
+            "next to the executable: no libonnxruntime.so in {}",
+            bin.display()
+        ),
+        "the system loader's search path",
+        "a developer checkout's .venv: none",
+    ];
+    let at: Vec<usize> = places
+        .iter()
+        .map(|p| {
+            said.find(p)
+                .unwrap_or_else(|| panic!("'{p}' not in: {said}"))
+        })
+        .collect();
+    assert!(at.windows(2).all(|w| w[0] < w[1]), "out of order: {said}");
+    assert!(said.contains("missing  generate"), "{said}");
+    let run = installed(bin, work, None, generate);
+    assert!(!run.status.success());
+    assert!(
+        text(&run).contains("a developer checkout's .venv: none"),
+        "{}",
+        text(&run)
+    );
+    assert!(!glb.exists());
 }

@@ -7,13 +7,14 @@ use thiserror::Error;
 /// A manifest, task folder or report that could not be read or written.
 #[derive(Debug, Error)]
 pub enum LibraryError {
-    /// A file could not be read or written.
-    #[error("{path}: {source}")]
+    /// A file could not be read or written. The reason is said in the message and not chained
+    /// as a source, so a printer of causes (`{:#}`) says it once.
+    #[error("{path}: {reason}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// What the system said.
-        source: std::io::Error,
+        /// What the system said, or the limit the file broke.
+        reason: std::io::Error,
     },
     /// The manifest is not valid YAML of the manifest's shape.
     #[error("{path}: {message}")]
@@ -41,7 +42,7 @@ impl LibraryError {
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> LibraryError {
         LibraryError::Io {
             path: path.into(),
-            source,
+            reason: source,
         }
     }
 }

@@ -72,17 +72,26 @@ pub struct Row {
     pub speed_p50_ratio: Option<f64>,
 }
 
+/// The largest clip file a manifest may name, as the clip readers' own limits (1 GiB).
+const CLIP_LIMIT: sinmdm::files::FileLimit = sinmdm::files::FileLimit {
+    bytes: sinmdm::bvh::MAX_BVH_BYTES,
+    name: "MAX_BVH_BYTES",
+    what: "a clip file",
+};
+
 /// The text of the configuration `entry` trains with.
 pub fn config_text(manifest: &Manifest, entry: &ClipEntry) -> Result<String, LibraryError> {
     match entry.config.as_ref().or(manifest.config.as_ref()) {
-        Some(path) => std::fs::read_to_string(path).map_err(|e| LibraryError::io(path, e)),
+        Some(path) => sinmdm::files::read_text_file(path, "a training configuration")
+            .map_err(|e| LibraryError::io(path, e)),
         None => Ok(DEFAULT_CONFIG.to_string()),
     }
 }
 
 /// The fingerprint clip `entry` of `manifest` would train under now.
 pub fn current_fingerprint(manifest: &Manifest, entry: &ClipEntry) -> Result<String, LibraryError> {
-    let bytes = std::fs::read(&entry.clip).map_err(|e| LibraryError::io(&entry.clip, e))?;
+    let bytes = sinmdm::files::read_regular_file(&entry.clip, CLIP_LIMIT, None)
+        .map_err(|e| LibraryError::io(&entry.clip, e))?;
     Ok(fingerprint(&bytes, entry, &config_text(manifest, entry)?))
 }
 

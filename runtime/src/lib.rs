@@ -3,7 +3,8 @@
 //! The engine runtime of sinmdm-rs: a model trained on one motion clip (a `.onnx` file written
 //! by `sinmdm-export`) generates new motion of any length, crowds, in-betweens, expansions,
 //! body-part composition and style transfer, through onnxruntime. Its dependencies are `ort`,
-//! `ndarray`, `serde`, `serde_json` and `thiserror`; BVH reading and writing is the default feature `bvh`.
+//! `libloading` (ort's own loader), `ndarray`, `serde`, `serde_json` and `thiserror`; BVH reading
+//! and writing is the default feature `bvh`.
 //!
 //! The engine path is the items on this page: open a [`Model`], look at its [`Skeleton`], make
 //! a [`Request`] of a [`Task`], [`run`] it (or [`plan`] it and step a [`Sampler`] yourself),
@@ -69,7 +70,7 @@ pub mod stream;
 pub mod tasks;
 
 pub use diffusion::{DEFAULT_STEPS, Denoiser, Method, Sampler, SamplerError, StepError};
-pub use model::{MAX_MODEL_BYTES, MODEL_LIMIT, Model, ModelError, ModelOptions};
+pub use model::{Model, ModelError, ModelOptions};
 pub use model_file::ModelMetadata;
 pub use motion::{
     Channel, FeatureLayout, Feet, Joint, LocalMotion, Pose, Quaternion, Skeleton, UpAxis,

@@ -35,6 +35,10 @@ pub const MAX_DIFFUSION_STEPS: usize = 100_000;
 /// Highest frame rate a model may have.
 pub const MAX_FPS: f64 = 10_000.0;
 
+/// The largest model file read, in bytes (2^31 - 1): protobuf's own ceiling, so no valid
+/// self-contained ONNX file is larger.
+pub const MAX_MODEL_BYTES: u64 = 2_147_483_647;
+
 /// Most threads a model runs samples on at once (each has its own onnxruntime session, a few
 /// megabytes): far beyond any machine's cores, and it stops a typo such as `u32::MAX` from
 /// asking for that many sessions.

@@ -176,11 +176,10 @@ fn open_session(environment: &ort::environment::Environment, bytes: &[u8]) -> or
         .commit_from_memory(bytes)
 }
 
-/// The largest model file read (2 GiB): protobuf's own ceiling, so no valid self-contained
-/// ONNX file is larger, and a bound on what a file can make the runtime allocate.
-pub const MAX_MODEL_BYTES: u64 = 1 << 31;
+use crate::limits::MAX_MODEL_BYTES;
+
 /// The size limit of model files, for [`crate::files::read_regular_file`].
-pub const MODEL_LIMIT: crate::files::FileLimit = crate::files::FileLimit {
+const MODEL_LIMIT: crate::files::FileLimit = crate::files::FileLimit {
     bytes: MAX_MODEL_BYTES,
     name: "MAX_MODEL_BYTES",
     what: "a model file",

@@ -22,7 +22,12 @@ pub(crate) fn library_version(path: &Path) -> Option<String> {
         return None;
     }
     // SAFETY: `base` is the library's static table; `GetVersionString` returns a static,
-    // NUL-terminated string.
-    let version = unsafe { CStr::from_ptr(((*base).GetVersionString)()) };
+    // NUL-terminated string (or null, checked).
+    let text = unsafe { ((*base).GetVersionString)() };
+    if text.is_null() {
+        return None;
+    }
+    // SAFETY: non-null and NUL-terminated, as above.
+    let version = unsafe { CStr::from_ptr(text) };
     version.to_str().ok().map(str::to_owned)
 }

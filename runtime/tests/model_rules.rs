@@ -217,7 +217,7 @@ fn sizes_are_bounded_and_agree_with_each_other() {
     );
 }
 
-/// A model path that is a folder, a FIFO or a file over [`sinmdm::MAX_MODEL_BYTES`] is refused
+/// A model path that is a folder, a FIFO or a file over [`sinmdm::limits::MAX_MODEL_BYTES`] is refused
 /// before a byte is read, and the message says why once.
 #[test]
 fn a_model_path_that_is_no_regular_file_or_too_large_is_refused_by_name() {
@@ -239,7 +239,7 @@ fn a_model_path_that_is_no_regular_file_or_too_large_is_refused_by_name() {
     let huge = dir.join("huge.onnx");
     std::fs::File::create(&huge)
         .unwrap()
-        .set_len(sinmdm::MAX_MODEL_BYTES + 1)
+        .set_len(sinmdm::limits::MAX_MODEL_BYTES + 1)
         .unwrap();
     refused(&huge, "MAX_MODEL_BYTES");
     #[cfg(unix)]

@@ -17,23 +17,43 @@ MODEL = ROOT / "tests" / "data" / "models" / "walk_tiny.onnx"
 WALK = ROOT / "tests" / "data" / "bvh" / "human_walk_cmu_131_01.bvh"
 
 
-def root_rotation(path, every=1):
-    """The root joint's rotation per frame: its rotation channels composed in their order."""
+def carrying_root(path, world):
+    """The joint that carries the body: from the top joint down, a joint that never moves and
+    has one child passes the role to it (a still ground joint above the hips)."""
+    joints, _ = read_bvh(path)
+    root = 0
+    while True:
+        children = [k for k, joint in enumerate(joints) if joint["parent"] == root]
+        if len(children) != 1 or np.ptp(world[:, root], axis=0).max() > 1e-9:
+            return root
+        root = children[0]
+
+
+def root_rotation(path, root, every=1):
+    """Joint `root`'s world rotation per frame: the rotation channels of it and the joints
+    above it composed in their order, from the top."""
     joints, motion = read_bvh(path)
     motion = motion[::every]
+    first_column = np.cumsum([0] + [len(j["channels"]) for j in joints])
+    chain = [root]
+    while joints[chain[-1]]["parent"] is not None:
+        chain.append(joints[chain[-1]]["parent"])
     rotation = np.tile(np.eye(3), (len(motion), 1, 1))
-    for column, name in enumerate(joints[0]["channels"]):
-        if name.endswith("rotation"):
-            rotation = rotation @ axis_rotation(name[0], motion[:, column])
+    for joint in reversed(chain):
+        for k, name in enumerate(joints[joint]["channels"]):
+            if name.endswith("rotation"):
+                rotation = rotation @ axis_rotation(name[0], motion[:, first_column[joint] + k])
     return rotation
 
 
 def body_kinematics(path, height, fps, every=1):
-    """Per frame pair the mean speed, per inner frame the mean acceleration, of every joint but
-    the root relative to the root in its own frame, in skeleton heights."""
+    """Per frame pair the mean speed, per inner frame the mean acceleration, of every joint
+    below the root that carries the body, relative to it in its own frame, in skeleton
+    heights."""
     joints, _, _, _ = positions(path, every)
-    r = root_rotation(path, every)
-    rel = np.einsum("fji,fkj->fki", r, joints[:, 1:] - joints[:, :1]) / height
+    root = carrying_root(path, joints)
+    r = root_rotation(path, root, every)
+    rel = np.einsum("fji,fkj->fki", r, joints[:, root + 1:] - joints[:, root:root + 1]) / height
     speeds = np.linalg.norm(np.diff(rel, axis=0), axis=2).mean(axis=1) * fps
     accelerations = np.linalg.norm(rel[2:] - 2 * rel[1:-1] + rel[:-2], axis=2).mean(axis=1) * fps**2
     return speeds, accelerations

@@ -308,8 +308,9 @@ impl Ladder {
         let rung = serde_json::to_string(&Self::rung_config(config, steps))
             .expect("a configuration serialises");
         // The check's version names what a rung's scores hold: version 2 added the backwards
-        // floor and the kinematic figures, which a rung scored before does not have.
-        let check = format!("{} samples, seed {}, check 2", self.samples, self.seed);
+        // floor and the kinematic figures, which a rung scored before does not have; version 3
+        // measures the body from the joint that carries it.
+        let check = format!("{} samples, seed {}, check 3", self.samples, self.seed);
         sinmdm_library::fingerprint::sha256_of_parts(&[
             env!("CARGO_PKG_VERSION").as_bytes(),
             clip_sha256.as_bytes(),

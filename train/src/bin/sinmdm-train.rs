@@ -354,6 +354,9 @@ fn main() -> Result<()> {
         return dry_run(&args);
     }
     if let Some(manifest) = &args.manifest {
+        if args.allow_outside_folder {
+            bail!("--allow-outside-folder is for a clip named on the command line, not --manifest");
+        }
         return library_task(&args, manifest);
     }
     let Some(out) = &args.out else {
@@ -397,6 +400,11 @@ fn main() -> Result<()> {
         }
         if args.clip_anim.is_some() {
             bail!("--clip-anim picks the animation of a new run; a resumed run keeps its own");
+        }
+        if args.allow_outside_folder {
+            bail!(
+                "--allow-outside-folder reads a new run's clip; a resumed run reads its own copy"
+            );
         }
         let config = args.config.as_deref().map(TrainConfig::load).transpose()?;
         Trainer::resume(out, args.clip.as_deref(), config, device)?
