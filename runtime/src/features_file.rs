@@ -47,17 +47,12 @@ pub enum FeaturesFileError {
 /// The largest features file read (1 GiB): a long clip's features as text stay far below it.
 pub const MAX_FEATURES_FILE_BYTES: u64 = 1 << 30;
 
-/// The text of a features file: a regular UTF-8 file of at most [`MAX_FEATURES_FILE_BYTES`].
-fn read_features_text(path: &Path) -> std::io::Result<String> {
-    let limit = crate::files::FileLimit {
-        bytes: MAX_FEATURES_FILE_BYTES,
-        name: "MAX_FEATURES_FILE_BYTES",
-        what: "a features file",
-    };
-    let bytes = crate::files::read_regular_file(path, limit, None)?;
-    String::from_utf8(bytes)
-        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.utf8_error()))
-}
+/// The size limit of features files.
+const FEATURES_FILE_LIMIT: crate::files::FileLimit = crate::files::FileLimit {
+    bytes: MAX_FEATURES_FILE_BYTES,
+    name: "MAX_FEATURES_FILE_BYTES",
+    what: "a features file",
+};
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -105,9 +100,11 @@ pub fn read_features(path: &Path) -> Result<(Array3<f32>, f64), FeaturesFileErro
         path: path.to_path_buf(),
         message,
     };
-    let text = read_features_text(path).map_err(|source| FeaturesFileError::Io {
-        path: path.to_path_buf(),
-        reason: source,
+    let text = crate::files::read_regular_text(path, FEATURES_FILE_LIMIT).map_err(|source| {
+        FeaturesFileError::Io {
+            path: path.to_path_buf(),
+            reason: source,
+        }
     })?;
     let doc: FeaturesJson = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
     if doc.format != FORMAT || doc.version != VERSION {

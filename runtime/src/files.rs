@@ -131,6 +131,12 @@ pub fn read_text_file(path: &Path, what: &'static str) -> std::io::Result<String
         name: "MAX_TEXT_BYTES",
         what,
     };
+    read_regular_text(path, limit)
+}
+
+/// Reads the regular UTF-8 text file `path` within `limit` ([`read_regular_file`], then UTF-8
+/// checked, naming the first bad byte).
+pub fn read_regular_text(path: &Path, limit: FileLimit) -> std::io::Result<String> {
     String::from_utf8(read_regular_file(path, limit, None)?).map_err(|e| {
         std::io::Error::new(
             std::io::ErrorKind::InvalidData,
