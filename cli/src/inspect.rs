@@ -68,6 +68,12 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     {
         bail!("--fps must be a positive number, got {fps}");
     }
+    // A character file without animations: its bones, for --mesh-from.
+    if crate::clip_files::is_gltf(&args.clip)
+        && sinmdm_formats::list_animations(&args.clip).is_ok_and(|a| a.is_empty())
+    {
+        return crate::character::inspect_character(&args.clip);
+    }
     // The file is read once: its animations come with the clip.
     let (clip, source) = read_motion_file_and_source(&args.clip, args.up.clip_anim.as_deref())?;
     let animations = &source.animations;
@@ -120,6 +126,11 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
         "joints     {} ({end_sites} End Sites), {} channels per frame",
         skeleton.len(),
         skeleton.channel_count()
+    );
+    let _ = writeln!(
+        out,
+        "{}",
+        crate::character::convention_line(skeleton.joints.iter().map(|j| j.name.as_str()))
     );
     let up_line = match &encoded.up_detection {
         Some(found) => format!("{} (read from the motion)", found.describe()),

@@ -2,6 +2,7 @@
 //! (`sinmdm`, `sinmdm-render`, `sinmdm-eval`).
 
 mod beats;
+mod character;
 mod clip_files;
 mod convert;
 mod dance;

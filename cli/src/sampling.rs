@@ -20,7 +20,6 @@ use crate::clip_files::{
     write_motion_file,
 };
 use crate::render::write_picture;
-use sinmdm_formats::gltf::splice_into_character;
 
 /// Default respaced sampling steps of the command line: the library's `sinmdm::DEFAULT_STEPS`
 /// (clap needs it as text; a test checks they agree).
@@ -50,10 +49,12 @@ pub struct SamplingArgs {
     #[arg(long)]
     pub proxy_mesh: bool,
     /// The character's own .glb: the output (a .glb) is that file, meshes, skin and materials
-    /// unchanged, with every sample appended as one more animation of its bones (joints
-    /// matched by name, the travel scaled to its units).
+    /// unchanged, with every sample appended as one more animation of its bones (matched by
+    /// name, or as --retarget says; a rig of other proportions or rest pose is retargeted).
     #[arg(long, value_name = "CHARACTER.glb")]
     pub mesh_from: Option<PathBuf>,
+    #[command(flatten)]
+    pub retarget: crate::character::RetargetArg,
     /// Samples to make in one batched run (a crowd).
     #[arg(long, default_value_t = 1)]
     pub count: usize,
@@ -370,6 +371,7 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
         .collect();
     outputs.dedup();
     let destination = args.motion_output(model.metadata().layout.skeleton_height)?;
+    let bones = args.retarget.bone_match()?;
     outputs.extend(args.features_json.iter().cloned());
     outputs.extend(args.render.iter().cloned());
     check_writable(&outputs)?;
@@ -385,30 +387,13 @@ pub fn run_task(args: &SamplingArgs, model: &mut Model, task: Task) -> Result<Ge
     let layout = generated.layout();
     match destination {
         MotionOutput::Character(character) => {
-            let report = splice_into_character(
+            crate::character::put_on_character(
                 character,
                 &args.output,
                 &named_samples(&motions),
                 layout.up,
+                &bones,
             )?;
-            eprintln!(
-                "wrote {}: {} with {} new animation{} after its {} ({} of its units per the model's; {})",
-                args.output.display(),
-                character.display(),
-                report.added_animations,
-                if report.added_animations == 1 {
-                    ""
-                } else {
-                    "s"
-                },
-                report.kept_animations,
-                report.scale,
-                if report.same_frames {
-                    "its bones' frames are the model's"
-                } else {
-                    "its bind pose is the model's rest pose"
-                }
-            );
         }
         MotionOutput::Gltf { metres } => {
             let placement = GltfPlacement {

@@ -30,6 +30,8 @@ pub enum Part {
     Skeleton,
     /// An FBX file's data as a whole.
     Fbx,
+    /// A bone map's entry for the named character bone.
+    MapEntry(String),
 }
 
 impl fmt::Display for Part {
@@ -52,6 +54,7 @@ impl fmt::Display for Part {
             Part::Channel(a, c) => write!(f, "animation {a}, channel {c}"),
             Part::Skeleton => f.write_str("skeleton"),
             Part::Fbx => f.write_str("FBX data"),
+            Part::MapEntry(name) => write!(f, "bone '{name}'"),
         }
     }
 }

@@ -12,6 +12,7 @@ pub mod error;
 pub mod fbx;
 pub mod files;
 pub mod gltf;
+pub mod retarget;
 mod sampled;
 pub use sinmdm::motion::units;
 

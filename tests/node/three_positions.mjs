@@ -19,6 +19,7 @@ gltf.scene.traverse((o) => {
 });
 const out = {
   bones: bones.map((b) => b.name),
+  parents: bones.map((b) => (b.parent && b.parent.isBone ? b.parent.name : null)),
   animations: gltf.animations.map((a) => ({ name: a.name, duration: a.duration, tracks: a.tracks.length })),
   positions: [],
 };

@@ -339,3 +339,77 @@ fn a_gltf_clip_reads_a_buffer_outside_its_folder_only_when_allowed() {
     std::fs::remove_dir_all(&top).unwrap();
     std::fs::remove_file(&glb).unwrap();
 }
+
+/// A model trained from a Mixamo-style FBX (`mixamorig:` names, centimetres) puts its samples
+/// onto another character with the same names and other proportions, rest pose and bone rolls
+/// in one call, retargeted (how well is `formats/tests/retarget.rs`'s to check).
+#[test]
+fn a_model_trained_from_a_mixamo_fbx_goes_onto_another_mixamo_character() {
+    use sinmdm_formats::gltf::container::{glb_bytes, parse_glb};
+    let fbx = root().join("tests/data/fbx/human_walk_cmu_131_01_mixamo_style.fbx");
+    let mut config = tiny();
+    config.training.steps = 2;
+    config.training.checkpoint_every = 2;
+    let run = common::scratch("formats", "mixamo_run");
+    let mut trainer = Trainer::start(&fbx, config, &run, Device::flex().autodiff()).unwrap();
+    let end = trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
+    let sinmdm_train::RunEnd::Finished(checkpoint) = end else {
+        panic!("{end:?}");
+    };
+    let model_file = run.join("mixamo.onnx");
+    sinmdm_train::export::export_checkpoint(&checkpoint, &model_file).unwrap();
+    sinmdm::init_onnxruntime().expect("run scripts/setup.sh first");
+    let mut model = sinmdm::Model::open(&model_file, &sinmdm::ModelOptions::default()).unwrap();
+    let request = sinmdm::Request {
+        task: sinmdm::Task::Generate { frames: 40 },
+        count: 2,
+        seed: 1,
+        steps: Some(3),
+        feet: sinmdm::Feet::Planted,
+        method: Default::default(),
+    };
+    let generated = sinmdm::run(&mut model, &request, &mut |_, _| {
+        std::ops::ControlFlow::Continue(())
+    })
+    .unwrap();
+    let motions = [generated.motion(0).unwrap(), generated.motion(1).unwrap()];
+
+    // Another Mixamo character: Blender's reshaped walk rig under `mixamorig:` names.
+    let rig = root().join("tests/data/gltf/human_walk_rig_other_proportions.glb");
+    let asset = parse_glb(&rig, &std::fs::read(&rig).unwrap()).unwrap();
+    let mut json = asset.json;
+    for node in json["nodes"].as_array_mut().unwrap() {
+        if let Some(name) = node["name"].as_str().filter(|n| !n.contains("Cube")) {
+            node["name"] = serde_json::Value::String(format!("mixamorig:{name}"));
+        }
+    }
+    let character = run.join("character.glb");
+    std::fs::write(&character, glb_bytes(&json, &asset.buffers[0])).unwrap();
+    let out = run.join("character_walks.glb");
+    let named = [
+        ("sample_000".to_string(), &motions[0]),
+        ("sample_001".to_string(), &motions[1]),
+    ];
+    let report = sinmdm_formats::gltf::splice_into_character(
+        &character,
+        &out,
+        &named,
+        generated.layout().up,
+    )
+    .unwrap();
+    let retargeted = report.retargeted.expect("another rig is retargeted");
+    assert!(
+        retargeted.reason.contains("another rig"),
+        "{}",
+        retargeted.reason
+    );
+    assert_eq!(retargeted.map.pairs.len(), motions[0].skeleton.len());
+    assert!(retargeted.dropped_joints.is_empty());
+    let options = sinmdm_formats::ReadOptions {
+        animation: Some(sinmdm_formats::AnimationChoice::Name("sample_001".into())),
+        fps: None,
+    };
+    let played = sinmdm_formats::gltf::read_gltf(&out, &options).unwrap();
+    assert_eq!(played.clip.frame_count(), 40);
+    std::fs::remove_dir_all(&run).unwrap();
+}

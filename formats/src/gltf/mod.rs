@@ -3,6 +3,7 @@
 
 mod accessor;
 pub mod container;
+mod drive;
 mod nodes;
 mod read;
 mod skin;
@@ -10,8 +11,9 @@ mod splice;
 mod tracks;
 mod write;
 
+pub use drive::Retargeted;
 pub use read::{GltfClip, list_animations, read_gltf, read_gltf_with_access};
-pub use splice::{SpliceReport, splice_into_character};
+pub use splice::{SpliceReport, character_bones, splice_into_character, splice_retargeted};
 pub use write::{GltfWriteOptions, gltf_document, write_gltf};
 
 /// The key under a node's `extras` where this crate keeps what glTF has no place for: the

@@ -1,34 +1,22 @@
 //! New animations spliced into a character's own GLB file: its meshes, skin, materials and every
 //! other part are kept byte for byte in the JSON (only the arrays the animations need grow, and
-//! the binary buffer), and each motion becomes one more animation of its joints, matched by name.
-//!
-//! The motions' joint frames are related to the character's nodes in one of two ways, read from
-//! the rest geometry:
-//! - **the same frames**: the model was trained from this file (or one like it), so a joint's
-//!   local rotation is the node's, and its offsets point where the node's children sit;
-//! - **the bind pose is the clip's rest pose**: the character was made from the clip (a BVH
-//!   imported into Blender, say), whose bones have their own rest rotations `B_j`; the node's
-//!   global rotation is then the joint's global rotation times `B_j`.
-//!
-//! A character whose bones fit neither is refused, naming the first bone that does not. The
-//! root's travel is scaled from the motions' units to the character's by the ratio of their
-//! bone lengths.
+//! the binary buffer), and each motion becomes one more animation of the character's bones.
+//! Which bone follows which joint, and how, is the [`super::drive`] module's.
 
 use std::path::Path;
 
 use serde_json::{Value, json};
-use sinmdm::motion::math::{self, Mat3, Vec3};
+use sinmdm::motion::ground::{GROUND_PERCENTILE, percentile};
+use sinmdm::motion::math::{self, Vec3};
 use sinmdm::motion::{LocalMotion, UpAxis, global_poses, up};
 
 use super::container::{Asset, glb_bytes, parse_glb};
+use super::drive::{Drive, Driven, Pairing, Retargeted, by_frames, model_rest, retargeted};
 use super::nodes::{Similarity, node_name, node_trs, parents, uniform};
 use super::write::{Binary, quaternion_xyzw, unit_f32};
 use crate::error::{FormatError, Part};
-use crate::sampled::without_namespace;
-
-/// Largest angle, in radians, between a bone's direction in the motions' skeleton and in the
-/// character's for the two to count as the same bone.
-const DIRECTION_TOLERANCE: f64 = 0.02;
+use crate::retarget::bone_map::{check_chains, pairs_by_name, pairs_by_role};
+use crate::retarget::{BoneMatch, Rig};
 
 /// What a splice did.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,8 +28,10 @@ pub struct SpliceReport {
     /// Character units per unit of the motions.
     pub scale: f64,
     /// Whether the motions' joint frames are the character's (else its bind pose is their rest
-    /// pose).
+    /// pose, or the motion was retargeted).
     pub same_frames: bool,
+    /// What retargeting did, when the character is not the model's rig.
+    pub retargeted: Option<Retargeted>,
 }
 
 /// Each node's global rest transform (uniform scale only).
@@ -90,22 +80,51 @@ fn global_rest(
         .collect())
 }
 
-/// The angle between two vectors, in radians (0 when either is too short to have a direction).
-fn angle(a: Vec3, b: Vec3) -> f64 {
-    let (na, nb) = (a.norm(), b.norm());
-    if na < 1e-12 || nb < 1e-12 {
-        return 0.0;
-    }
-    (a.dot(b) / (na * nb)).clamp(-1.0, 1.0).acos()
-}
-
 /// Splices `motions` (one skeleton, in their file's frame with up axis `up`) into the character
 /// file `character` (a `.glb`) as new animations, and writes the result to `path` (a `.glb`).
+/// The names of a character file's bones: its skins' joints, or every node when it has no
+/// skin; for saying which naming convention it follows.
+pub fn character_bones(path: &Path) -> Result<Vec<String>, FormatError> {
+    let asset = super::container::read_asset(path, crate::FileAccess::default())?;
+    let nodes: Vec<Value> = asset.json["nodes"].as_array().cloned().unwrap_or_default();
+    let mut joints: Vec<usize> = asset.json["skins"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .flat_map(|skin| skin["joints"].as_array().cloned().unwrap_or_default())
+        .filter_map(|j| j.as_u64().map(|j| j as usize))
+        .filter(|&j| j < nodes.len())
+        .collect();
+    joints.sort_unstable();
+    joints.dedup();
+    if joints.is_empty() {
+        joints = (0..nodes.len()).collect();
+    }
+    Ok(joints
+        .into_iter()
+        .map(|n| node_name(&nodes[n]).unwrap_or_else(|| format!("node {n}")))
+        .collect())
+}
+
+/// Bones are matched by name; see [`splice_retargeted`].
 pub fn splice_into_character(
     character: &Path,
     path: &Path,
     motions: &[(String, &LocalMotion)],
     up_axis: UpAxis,
+) -> Result<SpliceReport, FormatError> {
+    splice_retargeted(character, path, motions, up_axis, &BoneMatch::Names)
+}
+
+/// Splices `motions` into `character` as [`splice_into_character`] does, its bones matched to
+/// the motions' joints as `bones` says: a character that is not the model's rig (other rest
+/// pose, proportions or names) has the motion retargeted onto it.
+pub fn splice_retargeted(
+    character: &Path,
+    path: &Path,
+    motions: &[(String, &LocalMotion)],
+    up_axis: UpAxis,
+    bones: &BoneMatch,
 ) -> Result<SpliceReport, FormatError> {
     let bytes = crate::files::read_file(character, crate::files::GLTF_LIMIT)?;
     if !super::container::is_glb(&bytes) {
@@ -137,108 +156,84 @@ pub fn splice_into_character(
     let parent = parents(character, &nodes)?;
     let rest = global_rest(character, &nodes, &parent)?;
 
-    // Our joints by name among the character's nodes: the same name, or else the one node whose
-    // name is it after a namespace (a model read from Mixamo's FBX has `Hips` where the
-    // character's GLB has `mixamorig:Hips`).
-    let mapped: Vec<usize> = skeleton
-        .joints
+    let target_names: Vec<String> = nodes
         .iter()
-        .map(|joint| {
-            let exact = nodes
-                .iter()
-                .position(|n| node_name(n).as_deref() == Some(joint.name.as_str()));
-            let namespaced = || {
-                let mut found = nodes.iter().enumerate().filter(|(_, n)| {
-                    node_name(n).is_some_and(|name| without_namespace(&name) == joint.name)
-                });
-                match (found.next(), found.next()) {
-                    (Some((index, _)), None) => Some(index),
-                    _ => None,
-                }
-            };
-            exact.or_else(namespaced).ok_or_else(|| {
-                bad(
+        .enumerate()
+        .map(|(n, node)| node_name(node).unwrap_or_else(|| format!("node {n}")))
+        .collect();
+    let source_names: Vec<String> = skeleton.joints.iter().map(|j| j.name.clone()).collect();
+    let source_parents: Vec<Option<usize>> = skeleton.joints.iter().map(|j| j.parent).collect();
+    let target = Rig {
+        names: &target_names,
+        parents: &parent,
+    };
+    let source = Rig {
+        names: &source_names,
+        parents: &source_parents,
+    };
+    let model = model_rest(skeleton, up_axis);
+    let pairing = match bones {
+        BoneMatch::Names => {
+            // Our joints by name among the character's nodes: the same name, or else the one
+            // node whose name is it after a namespace (a model read from Mixamo's FBX has
+            // `Hips` where the character's GLB has `mixamorig:Hips`).
+            let pairs = pairs_by_name(&target, &source);
+            let mut mapped = vec![usize::MAX; skeleton.len()];
+            for &(node, joint) in &pairs {
+                mapped[joint] = node;
+            }
+            if let Some(missing) = mapped.iter().position(|&n| n == usize::MAX) {
+                return Err(bad(
                     Part::Skeleton,
                     format!(
-                        "has no node named '{}', a joint of the model's skeleton",
-                        joint.name
+                        "has no node named '{}', a joint of the model's skeleton; for a rig with other bone names pass --retarget auto (or a bone map: --retarget MAP.yaml)",
+                        skeleton.joints[missing].name
                     ),
-                )
-            })
-        })
-        .collect::<Result<_, _>>()?;
-
-    // Our rest pose in glTF's frame: identity rotations, the top joint turned to +Y up.
-    let turn = up_axis.canonical_from_file();
-    let mut our_rest: Vec<(Mat3, Vec3)> = Vec::with_capacity(skeleton.len());
-    for joint in &skeleton.joints {
-        let g = match joint.parent {
-            None => (turn, (turn * joint.offset)),
-            Some(p) => {
-                let (r, t) = our_rest[p];
-                (r, (t + (r * joint.offset)))
+                ));
             }
-        };
-        our_rest.push(g);
-    }
-    // Bones (joint, parent): their length ratio, and which frame relation their directions fit.
-    // Bones much shorter than the longest have no direction to compare (a joint on its
-    // parent: a zero offset, or an exporter's rounding of one).
-    let longest = skeleton
-        .joints
-        .iter()
-        .map(|j| j.offset.norm())
-        .fold(0.0, f64::max);
-    let mut ratios = Vec::new();
-    let mut same_frames = true;
-    let mut bind_is_rest = true;
-    let mut first_misfit = None;
-    for (j, joint) in skeleton.joints.iter().enumerate() {
-        let Some(p) = joint.parent else { continue };
-        let ours_world = our_rest[j].1 - our_rest[p].1;
-        let theirs_world = rest[mapped[j]].translation - rest[mapped[p]].translation;
-        if ours_world.norm() <= 1e-3 * longest {
-            continue;
+            match by_frames(skeleton, &model, &rest, &mapped) {
+                Ok(drive) => Ok(drive),
+                Err(misfit) => Err(Pairing {
+                    pairs,
+                    reason: format!(
+                        "its bones have the model's names but it is another rig: {misfit}"
+                    ),
+                    conventions: None,
+                }),
+            }
         }
-        ratios.push(theirs_world.norm() / ours_world.norm());
-        // In the parent's frame: our offset, and the character's bone seen from the parent node.
-        let parent_frame = rest[mapped[p]];
-        let theirs_local = parent_frame.rotation.transpose() * theirs_world;
-        let fits_local = angle(joint.offset, theirs_local) <= DIRECTION_TOLERANCE;
-        let fits_world = angle(ours_world, theirs_world) <= DIRECTION_TOLERANCE;
-        same_frames &= fits_local;
-        bind_is_rest &= fits_world;
-        if !fits_local && !fits_world && first_misfit.is_none() {
-            first_misfit = Some(joint.name.clone());
+        BoneMatch::Auto => {
+            let found = pairs_by_role(&target, &source).map_err(|m| bad(Part::Skeleton, m))?;
+            Err(Pairing {
+                pairs: found.pairs,
+                reason: format!(
+                    "--retarget auto: the character's bones read as {}, the model's as {}",
+                    found.target, found.source
+                ),
+                conventions: Some((found.target, found.source)),
+            })
         }
-    }
-    if !(same_frames || bind_is_rest) {
-        return Err(bad(
-            Part::Skeleton,
-            format!(
-                "is not the model's skeleton: bone '{}' points elsewhere (neither in its parent's frame nor in the bind pose)",
-                first_misfit.unwrap_or_default()
-            ),
-        ));
-    }
-    ratios.sort_by(f64::total_cmp);
-    let scale = ratios.get(ratios.len() / 2).copied().unwrap_or(1.0);
+        BoneMatch::Map(map, file) => Err(Pairing {
+            pairs: map.indices(&target, &source, file)?,
+            reason: format!("--retarget {}", file.display()),
+            conventions: None,
+        }),
+    };
+    let drive = match pairing {
+        Ok(drive) => drive,
+        Err(pairing) => {
+            check_chains(&pairing.pairs, &target, &source).map_err(|m| bad(Part::Skeleton, m))?;
+            retargeted(pairing, (&target, &source), &model, &rest)
+                .map_err(|m| bad(Part::Skeleton, m))?
+        }
+    };
+    let scale = drive.scale;
     if !(scale.is_finite() && scale > 0.0) {
         return Err(bad(
             Part::Skeleton,
             format!("has bones of scale {scale} to the model's"),
         ));
     }
-    // The constant turn from each joint's frame to its node's: identity, or the bind pose's.
-    let offset_turn: Vec<Mat3> = (0..skeleton.len())
-        .map(|j| {
-            if same_frames {
-                math::IDENTITY
-            } else {
-                our_rest[j].0.transpose() * rest[mapped[j]].rotation
-            }
-        })
-        .collect();
 
     // The binary data goes after the character's, in its one buffer.
     let mut bin = buffers.into_iter().next().unwrap_or_default();
@@ -261,9 +256,7 @@ pub fn splice_into_character(
             name,
             motion,
             up_axis,
-            scale,
-            &mapped,
-            &offset_turn,
+            &drive,
             (&parent, &rest),
         ));
     }
@@ -291,57 +284,71 @@ pub fn splice_into_character(
         kept_animations,
         added_animations: motions.len(),
         scale,
-        same_frames,
+        same_frames: drive.retargeted.is_none()
+            && drive.driven.iter().all(|d| d.turn == math::IDENTITY),
+        retargeted: drive.retargeted,
     })
 }
 
-/// One motion as an animation of the character's nodes: each mapped node's rotation (and the
-/// root's translation, and that of joints with position channels) every frame.
-#[allow(clippy::too_many_arguments)]
+/// One motion as an animation of the character's nodes: each driven node's rotation (and the
+/// translation of those that move) every frame.
 fn spliced_animation(
     binary: &mut Binary,
     name: &str,
     motion: &LocalMotion,
     up_axis: UpAxis,
-    scale: f64,
-    mapped: &[usize],
-    offset_turn: &[Mat3],
+    drive: &Drive,
     (parent, rest): (&[Option<usize>], &[Similarity]),
 ) -> Value {
     let mut canonical = up::to_canonical(motion, up_axis);
     for t in &mut canonical.translations {
-        *t = *t * scale;
+        *t = *t * drive.scale;
     }
     let poses = global_poses(&canonical);
+    // From the motions' ground to the character's, for a retargeted character.
+    let lift = drive.grounds.as_ref().map_or(0.0, |(ground, joints)| {
+        let mut lowest: Vec<f64> = poses
+            .iter()
+            .map(|p| {
+                joints
+                    .iter()
+                    .map(|&j| p.joints[j][1])
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect();
+        lowest.sort_by(f64::total_cmp);
+        ground - percentile(&lowest, GROUND_PERCENTILE)
+    });
+    let lift = Vec3::new(0.0, lift, 0.0);
     let frames = motion.frame_count();
     let input = binary.key_times(frames, motion.fps);
     let mut samplers = Vec::new();
     let mut channels = Vec::new();
-    for (j, joint) in motion.skeleton.joints.iter().enumerate() {
-        let node = mapped[j];
-        let moves = joint.parent.is_none() || !joint.position_axes().is_empty();
+    for driven in &drive.driven {
+        let node = driven.node;
         let mut rotations = Vec::with_capacity(frames * 4);
         let mut translations = Vec::with_capacity(frames * 3);
-        let (anchor, fixed) = parent_frame(node, parent, rest, mapped);
+        let (anchor, fixed) = parent_frame(node, parent, rest, &drive.driven);
         let mut previous = None;
         for pose in &poses {
             let parent_global = match anchor {
-                Some((k, p)) => Similarity {
-                    rotation: (pose.rotations[k] * offset_turn[k]),
-                    translation: pose.joints[k],
+                Some((above, p)) => Similarity {
+                    rotation: (pose.rotations[above.joint] * above.turn),
+                    translation: pose.joints[above.joint] + lift,
                     scale: rest[p].scale,
                 }
                 .then(&fixed),
                 None => fixed,
             };
             let inverse_parent = parent_global.rotation.transpose();
-            let global_rotation = pose.rotations[j] * offset_turn[j];
+            let global_rotation = pose.rotations[driven.joint] * driven.turn;
             let local_rotation = inverse_parent * global_rotation;
             let q = quaternion_xyzw(&local_rotation, previous);
             previous = Some(q);
             rotations.extend(unit_f32(q));
-            if moves {
-                let local = (inverse_parent * (pose.joints[j] - parent_global.translation))
+            if driven.moves {
+                let world = pose.joints[driven.joint] + lift;
+                let local = (inverse_parent * (world - parent_global.translation))
                     * (1.0 / parent_global.scale);
                 translations.extend(local.map(|v| v as f32));
             }
@@ -351,7 +358,7 @@ fn spliced_animation(
         channels.push(
             json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": "rotation"}}),
         );
-        if moves {
+        if driven.moves {
             let output = binary.accessor(&translations, "VEC3", 3, false);
             samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
             channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": "translation"}}));
@@ -360,25 +367,24 @@ fn spliced_animation(
     json!({"name": name, "samplers": samplers, "channels": channels})
 }
 
-/// How the global transform of node `n`'s parent is had at any frame: the nearest mapped joint
-/// above it (its index among the motion's joints, and its node) followed by the fixed rest
-/// transforms of the nodes between; or, with no joint above, that parent's fixed global rest
-/// transform.
+/// How the global transform of node `n`'s parent is had at any frame: the nearest driven node
+/// above it (how it is driven, and the node) followed by the fixed rest transforms of the
+/// nodes between; or, with no driven node above, that parent's fixed global rest transform.
 fn parent_frame(
     n: usize,
     parent: &[Option<usize>],
     rest: &[Similarity],
-    mapped: &[usize],
-) -> (Option<(usize, usize)>, Similarity) {
+    driven: &[Driven],
+) -> (Option<(Driven, usize)>, Similarity) {
     let mut chain: Vec<usize> = Vec::new();
     let mut at = parent[n];
     while let Some(p) = at {
-        if let Some(k) = mapped.iter().position(|&m| m == p) {
+        if let Some(above) = driven.iter().find(|d| d.node == p) {
             let fixed = chain.iter().rev().fold(Similarity::IDENTITY, |g, &c| {
                 let above = rest[parent[c].expect("a node below a joint has a parent")];
                 g.then(&relative(&above, &rest[c]))
             });
-            return (Some((k, p)), fixed);
+            return (Some((*above, p)), fixed);
         }
         chain.push(p);
         at = parent[p];
