@@ -68,6 +68,12 @@ pub fn put_on_character(
             "  travel and height scaled by {:.4}, the ratio of the hips' heights above the feet at rest ({:.4} on the character, {:.4} on the motion's skeleton)",
             report.scale, r.hip_heights[0], r.hip_heights[1]
         );
+        if !r.planted_feet.is_empty() {
+            eprintln!(
+                "  ankles kept where the motion's are, scaled (legs of other proportions bend to reach): {}",
+                r.planted_feet.join(", ")
+            );
+        }
         if !r.still_bones.is_empty() {
             eprintln!(
                 "  {} character bone{} follow no joint and keep their rest pose: {}",

@@ -84,6 +84,43 @@ impl Played {
         lowest[(0.05 * (lowest.len() - 1) as f64).round() as usize]
     }
 
+    /// Mean speed over the ground, in hips' heights per second, of `feet` in the frames in
+    /// which `stance` (another play's same feet) stands: within 5 % of its hips' height of the
+    /// ground and slower than 0.3 of it a second.
+    fn stance_slide(
+        &self,
+        feet: &[usize],
+        hips: usize,
+        stance: (&Played, &[usize], usize),
+        fps: f64,
+    ) -> f64 {
+        let (other, other_feet, other_hips) = stance;
+        let leg = |p: &Played, f: &[usize], h: usize| {
+            let g = p.ground(f);
+            (
+                g,
+                p.positions.iter().map(|q| q[h][1] - g).sum::<f64>() / p.positions.len() as f64,
+            )
+        };
+        let (og, oleg) = leg(other, other_feet, other_hips);
+        let (_, ours) = leg(self, feet, hips);
+        let flat = |d: Vec3| (d[0] * d[0] + d[2] * d[2]).sqrt();
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (k, (&f, &of)) in feet.iter().zip(other_feet).enumerate() {
+            let _ = k;
+            for i in 0..self.positions.len() - 1 {
+                let o = &other.positions;
+                let low = o[i][of][1] - og < 0.05 * oleg && o[i + 1][of][1] - og < 0.05 * oleg;
+                let slow = flat(o[i + 1][of] - o[i][of]) * fps < 0.3 * oleg;
+                if low && slow {
+                    sum += flat(self.positions[i + 1][f] - self.positions[i][f]) * fps / ours;
+                    count += 1;
+                }
+            }
+        }
+        sum / count.max(1) as f64
+    }
+
     /// The mean over frames of the figure's vertical extent.
     fn height(&self) -> f64 {
         self.positions
@@ -172,7 +209,7 @@ fn worst_direction(target: &Played, source: &Played, map: &BoneMap) -> (f64, Str
             }
         }
     }
-    assert!(bones >= 15, "only {bones} bones compared");
+    assert!(bones >= 10, "only {bones} bones compared");
     worst
 }
 
@@ -377,5 +414,93 @@ fn a_mixamo_clip_goes_onto_another_mixamo_character_by_its_names_alone() {
         &retargeted,
         ("mixamorig:Hips", LEG_FACTOR / 0.0564),
         [&feet[0], &feet[1], &feet[2], &feet[3]],
+    );
+}
+
+#[test]
+fn a_leg_that_is_not_the_clips_scaled_alike_bends_to_put_its_ankle_where_the_clips_is() {
+    // The reshaped rig with shins 0.8x as long again: its legs cannot follow the clip's bones
+    // and keep its feet, so its knees bend (and its hips turn) to put the ankles where the
+    // clip's are, scaled as the travel is.
+    let walk = the_walk();
+    let rig = fixtures().join("human_walk_rig_other_proportions.glb");
+    let asset = parse_glb(&rig, &std::fs::read(&rig).unwrap()).unwrap();
+    let mut json = asset.json;
+    for node in json["nodes"].as_array_mut().unwrap() {
+        if matches!(node["name"].as_str(), Some("LeftAnkle" | "RightAnkle")) {
+            for v in node["translation"].as_array_mut().unwrap() {
+                *v = serde_json::json!(v.as_f64().unwrap() * 0.8);
+            }
+        }
+    }
+    let character = scratch("short_shins.glb");
+    std::fs::write(&character, glb_bytes(&json, &asset.buffers[0])).unwrap();
+    let out = scratch("short_shins_walk.glb");
+    let report = splice_retargeted(
+        &character,
+        &out,
+        &[("walk".into(), &walk)],
+        UpAxis::PosY,
+        &BoneMatch::Names,
+    )
+    .unwrap();
+    let retargeted = report.retargeted.unwrap();
+    assert_eq!(retargeted.planted_feet, ["LeftAnkle", "RightAnkle"]);
+    let (source, target) = (Played::of(&walk), Played::read(&out, "walk"));
+    let ratio = report.scale;
+    let (hips_s, hips_t) = (source.index("Hips"), target.index("Hips"));
+    let leg = retargeted.hip_heights[0];
+    let mut worst = 0.0f64;
+    for side in ["LeftAnkle", "RightAnkle"] {
+        let (a_s, a_t) = (source.index(side), target.index(side));
+        let reach = ["LeftHip", "LeftKnee"]
+            .map(|j| target.index(&j.replace("Left", &side[..side.len() - 5])));
+        for (s, t) in source.positions.iter().zip(&target.positions) {
+            let want = (s[a_s] - s[hips_s]) * ratio;
+            // Only where the shorter leg reaches.
+            let span = (t[reach[1]] - t[reach[0]]).norm() + (t[a_t] - t[reach[1]]).norm();
+            if (t[hips_t] + want - t[reach[0]]).norm() > 0.98 * span {
+                continue;
+            }
+            worst = worst.max(((t[a_t] - t[hips_t]) - want).norm() / leg);
+        }
+    }
+    assert!(
+        worst < 1e-4,
+        "an ankle is {worst:.2e} leg lengths off the clip's"
+    );
+    // The feet slide in their stance no more than the clip's do.
+    let ankles = |p: &Played| ["LeftAnkle", "RightAnkle"].map(|a| p.index(a));
+    let slide_t = target.stance_slide(
+        &ankles(&target),
+        hips_t,
+        (&source, &ankles(&source), hips_s),
+        walk.fps,
+    );
+    let slide_s = source.stance_slide(
+        &ankles(&source),
+        hips_s,
+        (&source, &ankles(&source), hips_s),
+        walk.fps,
+    );
+    assert!(
+        slide_t <= slide_s * 1.05 + 1e-3,
+        "{slide_t:.4} > {slide_s:.4}"
+    );
+    // Everything but the legs still points where the clip's bones point.
+    let legs = ["Hip", "Knee", "Ankle", "Toe"];
+    let upper = BoneMap {
+        pairs: retargeted
+            .map
+            .pairs
+            .iter()
+            .filter(|(b, _)| !legs.iter().any(|l| b.ends_with(l)))
+            .cloned()
+            .collect(),
+    };
+    let (angle, bone) = worst_direction(&target, &source, &upper);
+    assert!(
+        angle <= 1.0,
+        "bone '{bone}' is {angle:.3} degrees off its joint"
     );
 }

@@ -2,8 +2,9 @@
 writer: the walk's skinned character (human_walk_cmu_131_01_skinned.glb) made into two other
 characters, without its animation:
 
-- `human_walk_rig_other_proportions.glb`: the same bone names, legs 1.2x, arms 0.85x, spine,
-  neck and head 1.1x longer, the arms lowered 40 degrees (an A pose), every bone rolled;
+- `human_walk_rig_other_proportions.glb`: the same bone names, legs 1.2x (every leg bone: the
+  hips stand 1.2x as high), arms 0.85x, spine, neck and head 1.1x longer, the arms lowered 40
+  degrees (an A pose), every bone rolled;
 - `human_walk_rig_unreal_names.glb`: the same rig with Unreal mannequin names (`pelvis`,
   `thigh_l`, `spine_01`), bones the mannequin lacks given names no convention knows.
 
@@ -20,7 +21,9 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 FIXTURES = ROOT / "tests" / "data" / "gltf"
 SOURCE = FIXTURES / "human_walk_cmu_131_01_skinned.glb"
 
-LEG = ("HipJoint", "Hip", "Knee", "Ankle", "Toe")
+PELVIS = ("HipJoint", "Hip")
+THIGH = ("Knee",)
+SHIN = ("Ankle", "Toe")
 ARM = ("Shoulder", "Elbow", "Wrist", "hand", "Fingers", "Thumb")
 SIDES = {"Left": "l", "Right": "r", "L": "l", "R": "r", "l": "l", "r": "r"}
 
@@ -53,14 +56,16 @@ for long, s in (("Left", "l"), ("Right", "r")):
 
 def group(name):
     base = name.removesuffix("_end")
-    if any(base.endswith(part) for part in LEG):
-        return "leg"
+    # A bone's offset from its parent is the parent's bone: the knee's offset is the thigh.
+    for name, parts in (("pelvis", PELVIS), ("thigh", THIGH), ("shin", SHIN)):
+        if any(base.endswith(part) for part in parts):
+            return name
     if any(base.endswith(part) for part in ARM) and "Collar" not in base:
         return "arm"
     return "body"
 
 
-FACTOR = {"leg": 1.2, "arm": 0.85, "body": 1.1}
+FACTOR = {"pelvis": 1.2, "thigh": 1.2, "shin": 1.2, "arm": 0.85, "body": 1.1}
 
 
 def load():

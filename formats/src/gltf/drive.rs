@@ -58,6 +58,9 @@ pub struct Retargeted {
     pub still_bones: Vec<String>,
     /// Model joints no character bone follows.
     pub dropped_joints: Vec<String>,
+    /// The character's bones whose contacts with the ground were held still again (the model's
+    /// feet, as the motion shows them, on the bones that follow them).
+    pub planted_feet: Vec<String>,
 }
 
 /// The nodes driven, and how the motions' positions become the character's.
@@ -305,6 +308,7 @@ pub(super) fn retargeted(
             hip_heights,
             still_bones,
             dropped_joints,
+            planted_feet: Vec::new(),
         }),
         driven,
     })

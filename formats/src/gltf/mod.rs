@@ -6,6 +6,7 @@ pub mod container;
 mod drive;
 mod nodes;
 mod read;
+mod replant;
 mod skin;
 mod splice;
 mod tracks;

@@ -8,11 +8,12 @@ use std::path::Path;
 use serde_json::{Value, json};
 use sinmdm::motion::ground::{GROUND_PERCENTILE, percentile};
 use sinmdm::motion::math::{self, Vec3};
-use sinmdm::motion::{LocalMotion, UpAxis, global_poses, up};
+use sinmdm::motion::{GlobalPose, LocalMotion, UpAxis, global_poses, up};
 
 use super::container::{Asset, glb_bytes, parse_glb};
 use super::drive::{Drive, Driven, Pairing, Retargeted, by_frames, model_rest, retargeted};
 use super::nodes::{Similarity, node_name, node_trs, parents, uniform};
+use super::replant::{CharacterMotion, character_motion};
 use super::write::{Binary, quaternion_xyzw, unit_f32};
 use crate::error::{FormatError, Part};
 use crate::retarget::bone_map::{check_chains, pairs_by_name, pairs_by_role};
@@ -243,6 +244,7 @@ pub fn splice_retargeted(
     let first_view = json["bufferViews"].as_array().map_or(0, Vec::len);
     let mut binary = Binary::after(bin, first_accessor, first_view);
     let kept_animations = json["animations"].as_array().map_or(0, Vec::len);
+    let mut planted_feet = Vec::new();
     let mut animations = Vec::with_capacity(motions.len());
     for (name, motion) in motions {
         if motion.skeleton != *skeleton {
@@ -251,14 +253,29 @@ pub fn splice_retargeted(
                 message: format!("motion '{name}' has another skeleton than the first"),
             });
         }
-        animations.push(spliced_animation(
-            &mut binary,
-            name,
-            motion,
-            up_axis,
-            &drive,
-            (&parent, &rest),
-        ));
+        let retargeted = drive.retargeted.is_some().then(|| {
+            retargeted_animation(
+                &mut binary,
+                (name, motion),
+                up_axis,
+                &drive,
+                (&parent, &rest, &target_names),
+            )
+        });
+        match retargeted.flatten() {
+            Some((animation, feet)) => {
+                planted_feet = feet;
+                animations.push(animation);
+            }
+            None => animations.push(spliced_animation(
+                &mut binary,
+                name,
+                motion,
+                up_axis,
+                &drive,
+                (&parent, &rest),
+            )),
+        }
     }
     // Append: the arrays grow, nothing else of the document changes but the buffer's length.
     for (key, items) in [
@@ -286,20 +303,13 @@ pub fn splice_retargeted(
         scale,
         same_frames: drive.retargeted.is_none()
             && drive.driven.iter().all(|d| d.turn == math::IDENTITY),
-        retargeted: drive.retargeted,
+        retargeted: drive.retargeted.map(|r| Retargeted { planted_feet, ..r }),
     })
 }
 
-/// One motion as an animation of the character's nodes: each driven node's rotation (and the
-/// translation of those that move) every frame.
-fn spliced_animation(
-    binary: &mut Binary,
-    name: &str,
-    motion: &LocalMotion,
-    up_axis: UpAxis,
-    drive: &Drive,
-    (parent, rest): (&[Option<usize>], &[Similarity]),
-) -> Value {
+/// The motion's canonical global poses with its travel scaled to the character's units, and
+/// the lift from its ground to the character's (none unless retargeted onto a standing rig).
+fn scaled_poses(motion: &LocalMotion, up_axis: UpAxis, drive: &Drive) -> (Vec<GlobalPose>, Vec3) {
     let mut canonical = up::to_canonical(motion, up_axis);
     for t in &mut canonical.translations {
         *t = *t * drive.scale;
@@ -319,7 +329,95 @@ fn spliced_animation(
         lowest.sort_by(f64::total_cmp);
         ground - percentile(&lowest, GROUND_PERCENTILE)
     });
-    let lift = Vec3::new(0.0, lift, 0.0);
+    (poses, Vec3::new(0.0, lift, 0.0))
+}
+
+/// One motion as an animation of a retargeted character: its bones' rotations (the legs'
+/// turned so the feet stand still again) and the carrying bone's translation, every frame.
+fn retargeted_animation(
+    binary: &mut Binary,
+    (name, motion): (&str, &LocalMotion),
+    up_axis: UpAxis,
+    drive: &Drive,
+    (parent, rest, names): (&[Option<usize>], &[Similarity], &[String]),
+) -> Option<(Value, Vec<String>)> {
+    let (poses, lift) = scaled_poses(motion, up_axis, drive);
+    let character = character_motion(
+        &motion.skeleton,
+        &poses,
+        lift,
+        motion.fps,
+        drive,
+        (parent, rest, names),
+    )?;
+    let CharacterMotion {
+        nodes,
+        above,
+        motion: played,
+        planted,
+    } = character;
+    let frames = played.frame_count();
+    let count = nodes.len();
+    let input = binary.key_times(frames, played.fps);
+    let mut samplers = Vec::new();
+    let mut channels = Vec::new();
+    let inverse_above = above.rotation.transpose();
+    for (k, &node) in nodes.iter().enumerate() {
+        let rest_local = match parent[node] {
+            Some(p) => rest[p].rotation.transpose() * rest[node].rotation,
+            None => rest[node].rotation,
+        };
+        let local = |f: usize| {
+            let r = played.rotations[f * count + k];
+            if k == 0 { inverse_above * r } else { r }
+        };
+        let driven = drive.driven.iter().any(|d| d.node == node);
+        let turned = (0..frames).any(|f| math::mat_max_abs_diff(&local(f), &rest_local) > 1e-9);
+        if !(driven || turned) {
+            continue;
+        }
+        let mut rotations = Vec::with_capacity(frames * 4);
+        let mut previous = None;
+        for f in 0..frames {
+            let q = quaternion_xyzw(&local(f), previous);
+            previous = Some(q);
+            rotations.extend(unit_f32(q));
+        }
+        let output = binary.accessor(&rotations, "VEC4", 4, false);
+        samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
+        channels.push(
+            json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": "rotation"}}),
+        );
+        if k == 0 {
+            let mut translations = Vec::with_capacity(frames * 3);
+            for f in 0..frames {
+                let world = played.translations[f * count];
+                let local = (inverse_above * (world - above.translation)) * (1.0 / above.scale);
+                translations.extend(local.map(|v| v as f32));
+            }
+            let output = binary.accessor(&translations, "VEC3", 3, false);
+            samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
+            channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": "translation"}}));
+        }
+    }
+    let feet = planted.iter().map(|&k| names[nodes[k]].clone()).collect();
+    Some((
+        json!({"name": name, "samplers": samplers, "channels": channels}),
+        feet,
+    ))
+}
+
+/// One motion as an animation of the character's nodes: each driven node's rotation (and the
+/// translation of those that move) every frame.
+fn spliced_animation(
+    binary: &mut Binary,
+    name: &str,
+    motion: &LocalMotion,
+    up_axis: UpAxis,
+    drive: &Drive,
+    (parent, rest): (&[Option<usize>], &[Similarity]),
+) -> Value {
+    let (poses, lift) = scaled_poses(motion, up_axis, drive);
     let frames = motion.frame_count();
     let input = binary.key_times(frames, motion.fps);
     let mut samplers = Vec::new();
