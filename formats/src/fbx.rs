@@ -52,6 +52,10 @@ fn load(path: &Path) -> Result<ufbx::SceneRoot, FormatError> {
         },
         target_unit_meters: 1.0,
         space_conversion: ufbx::SpaceConversion::ModifyGeometry,
+        // Textures and videos packed into the file are not motion.
+        ignore_embedded: true,
+        temp_allocator: bounded(),
+        result_allocator: bounded(),
         ..Default::default()
     };
     ufbx::load_memory(&bytes, options).map_err(|error| {
@@ -64,12 +68,57 @@ fn load(path: &Path) -> Result<ufbx::SceneRoot, FormatError> {
         FormatError::bad(
             path,
             Part::Fbx,
-            format!(
-                "is not an FBX file this reads: {}{detail}",
-                error.description
-            ),
+            format!("{}{detail}", load_failure(&error, &bytes)),
         )
     })
+}
+
+/// The most memory ufbx may take for each of its two arenas while loading a file (1 GiB): far
+/// above any clip's needs (the 3.3 s Mixamo dance takes a few MB), and a bound on a file that
+/// declares huge arrays.
+pub const FBX_MEMORY_LIMIT: usize = 1 << 30;
+
+fn bounded() -> ufbx::AllocatorOpts {
+    ufbx::AllocatorOpts {
+        memory_limit: FBX_MEMORY_LIMIT,
+        ..Default::default()
+    }
+}
+
+/// Why ufbx could not load a file, in words: its error kind said plainly where it has one, and
+/// otherwise ("Failed to load", every unknown kind's text) what the file's first bytes show.
+fn load_failure(error: &ufbx::Error, bytes: &[u8]) -> String {
+    use ufbx::ErrorType as E;
+    let what = match error.type_ {
+        E::EmptyFile => "it is empty",
+        E::TruncatedFile | E::TruncatedVertexStream => "it ends early: the file is cut short",
+        E::UnrecognizedFileFormat => "it has neither the binary FBX header nor ASCII FBX's",
+        E::UnsupportedVersion => "its FBX version is not one this reads",
+        E::OutOfMemory | E::MemoryLimit | E::AllocationLimit => {
+            "it asks for more memory than the limit of 1 GiB (its arrays declare more data than an FBX clip holds)"
+        }
+        E::NodeDepthLimit => "it nests its nodes deeper than the reader's limit",
+        E::InvalidUtf8 => "it holds a name that is not UTF-8",
+        E::BadIndex => "it holds an index out of range",
+        _ if bytes.starts_with(b"Kaydara FBX Binary") => {
+            "it has a binary FBX header but cannot be parsed after it: damaged or cut short"
+        }
+        _ if is_ascii_fbx(bytes) => "it is ASCII FBX that cannot be parsed: damaged or cut short",
+        _ => "it has neither the binary FBX header nor ASCII FBX's",
+    };
+    format!(
+        "is not an FBX file this reads: {what} (the FBX reader says: {})",
+        error.description
+    )
+}
+
+/// Whether `bytes` open as ASCII FBX does: a `; FBX` comment or an `FBXHeaderExtension` early on.
+fn is_ascii_fbx(bytes: &[u8]) -> bool {
+    let head = &bytes[..bytes.len().min(4096)];
+    head.starts_with(b"; FBX")
+        || head
+            .windows(b"FBXHeaderExtension".len())
+            .any(|w| w == b"FBXHeaderExtension")
 }
 
 /// A stack's time range: the one it declares, or where it declares none, from its first key to

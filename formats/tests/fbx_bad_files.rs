@@ -54,7 +54,23 @@ fn each_kind_of_problem_is_named() {
     // Not FBX at all, and an empty file.
     let message = error(b"solid cube\nendsolid cube\n", "not_fbx.fbx");
     assert!(message.contains("not an FBX file"), "{message}");
-    error(b"", "empty.fbx");
+    assert!(error(b"", "empty.fbx").contains("it is empty"));
+    // A binary header and nothing sound after it, and the ASCII file cut short: said plainly,
+    // and the reader's own words once.
+    let message = error(
+        b"Kaydara FBX Binary  \x00\x1a\x00\xe8\x1c\x00\x00",
+        "cut.fbx",
+    );
+    assert!(
+        message.contains("binary FBX header") && message.contains("damaged or cut short"),
+        "{message}"
+    );
+    assert_eq!(message.matches("Failed to load").count(), 1, "{message}");
+    let message = error(&text.as_bytes()[..text.len() / 3], "half.fbx");
+    assert!(
+        message.contains("cut short") || message.contains("damaged"),
+        "{message}"
+    );
 
     // No bones: every limb node made a plain null.
     let message = error(

@@ -6,6 +6,9 @@ mod stream_write;
 mod write;
 
 pub use error::{BvhError, BvhErrorKind};
-pub use read::{BVH_LIMIT, MAX_BVH_BYTES, MAX_BVH_JOINTS, MAX_BVH_NAME_BYTES, parse_bvh, read_bvh};
+pub use read::{
+    BVH_LIMIT, MAX_BVH_BYTES, MAX_BVH_JOINTS, MAX_BVH_LINE_WORDS, MAX_BVH_NAME_BYTES, parse_bvh,
+    read_bvh,
+};
 pub use stream_write::BvhStreamWriter;
 pub use write::{to_bvh_string, write_bvh};

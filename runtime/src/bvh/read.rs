@@ -18,6 +18,9 @@ pub const MAX_BVH_BYTES: u64 = 1 << 30;
 /// nesting depth too (the parser keeps open joints on a stack, not the call stack, so a chain
 /// of this many joints is read).
 pub const MAX_BVH_JOINTS: usize = crate::limits::MAX_JOINTS;
+/// The most words a line of the hierarchy may hold: a keyword and six channels, or a joint name
+/// of up to [`MAX_BVH_NAME_BYTES`], take far fewer.
+pub const MAX_BVH_LINE_WORDS: usize = 256;
 /// The longest joint name, in bytes: the longest a model's skeleton may have.
 pub const MAX_BVH_NAME_BYTES: usize = crate::limits::MAX_NAME_BYTES;
 /// The size limit of BVH files, for [`read_regular_file`].
@@ -60,8 +63,13 @@ struct OpenJoint {
 struct Parser<'a> {
     file: &'a str,
     lines: Vec<&'a str>,
+    /// The hierarchy's tokens read so far: lines are split as the parser reaches them, so a
+    /// file refused at its joint limit is never split beyond it.
     tokens: Vec<Token<'a>>,
     next: usize,
+    /// Lines of the hierarchy split into `tokens` so far, and where the hierarchy ends.
+    split_lines: usize,
+    hierarchy_end: usize,
 }
 
 impl<'a> Parser<'a> {
@@ -72,6 +80,8 @@ impl<'a> Parser<'a> {
             lines,
             tokens: Vec::new(),
             next: 0,
+            split_lines: 0,
+            hierarchy_end: 0,
         }
     }
 
@@ -91,7 +101,16 @@ impl<'a> Parser<'a> {
             .map_or(1, |i| i + 1)
     }
 
-    fn peek(&self) -> Option<Token<'a>> {
+    fn peek(&mut self) -> Option<Token<'a>> {
+        while self.tokens.len() <= self.next && self.split_lines < self.hierarchy_end {
+            let i = self.split_lines;
+            let line = self.lines[i];
+            self.tokens.extend(
+                line.split_whitespace()
+                    .map(|text| Token { line: i + 1, text }),
+            );
+            self.split_lines += 1;
+        }
         self.tokens.get(self.next).copied()
     }
 
@@ -150,13 +169,20 @@ impl<'a> Parser<'a> {
             .lines
             .iter()
             .position(|l| l.split_whitespace().next() == Some("MOTION"));
-        let hierarchy_end = motion_line.unwrap_or(self.lines.len());
-        let lines = self.lines.clone();
-        for (i, line) in lines[..hierarchy_end].iter().enumerate() {
-            self.tokens.extend(
-                line.split_whitespace()
-                    .map(|text| Token { line: i + 1, text }),
-            );
+        self.hierarchy_end = motion_line.unwrap_or(self.lines.len());
+        // A hierarchy line holds a keyword and a few values (or a name of a few words): one of
+        // millions of words is refused before it is split.
+        for (i, line) in self.lines[..self.hierarchy_end].iter().enumerate() {
+            if line.split_whitespace().nth(MAX_BVH_LINE_WORDS).is_some() {
+                return Err(self.error(
+                    Some(i + 1),
+                    BvhErrorKind::OverLimit {
+                        what: "a hierarchy line's words".into(),
+                        limit: MAX_BVH_LINE_WORDS,
+                        name: "MAX_BVH_LINE_WORDS",
+                    },
+                ));
+            }
         }
         let skeleton = self.hierarchy()?;
         if let Some(extra) = self.peek() {
