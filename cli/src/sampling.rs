@@ -16,8 +16,7 @@ use sinmdm::{Model, ModelOptions};
 use sinmdm_render::{Camera, Figure};
 
 use crate::clip_files::{
-    ClipUpArg, GltfPlacement, is_gltf, metres_per_unit, named_samples, read_motion_file,
-    write_motion_file,
+    ClipUpArg, GltfPlacement, is_gltf, metres_per_unit, named_samples, write_motion_file,
 };
 use crate::render::write_picture;
 
@@ -278,8 +277,26 @@ pub fn parse_span(text: &str, fps: f64, frames: usize) -> Result<Span> {
 
 /// Reads a clip (BVH, glTF or FBX) of the model's skeleton as raw features in the model's layout
 /// ([`encode_for_model`]), saying so when the clip was turned into the model's up convention.
+/// A clip in which nothing moves is refused, naming the animation read: a still reference has
+/// nothing for a task to keep or a score to compare (a Mixamo download's `Take 001`).
 pub fn reference_features(model: &Model, clip: &Path, read: &ClipUpArg) -> Result<Array2<f32>> {
-    let channels = read_motion_file(clip, read.clip_anim.as_deref())?;
+    let (channels, source) =
+        crate::clip_files::read_motion_file_and_source(clip, read.clip_anim.as_deref())?;
+    if !sinmdm_formats::clip_moves(&channels) {
+        let what = source.animation.map_or("the clip".to_string(), |a| {
+            format!("animation {}", a.describe())
+        });
+        bail!(
+            "{}: nothing moves in {what} (no channel varies by more than {}); a reference must move{}",
+            clip.display(),
+            sinmdm_formats::STILL_TOLERANCE,
+            if source.animations.len() > 1 {
+                ": pick another animation with --clip-anim NAME|INDEX"
+            } else {
+                ""
+            }
+        );
+    }
     let layout = &model.metadata().layout;
     let encoded = encode_for_model(&channels, layout, read.up).with_context(|| {
         format!(

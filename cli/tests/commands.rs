@@ -137,7 +137,25 @@ fn eval_command_refuses_bad_input_and_writes_nothing() {
     let model = test_model();
     let walk = repo_file("tests/data/bvh/human_walk_cmu_131_01.bvh");
     let fox = repo_file("tests/data/bvh/fox_survey_khronos.bvh");
-    let cases: [(&[&std::ffi::OsStr], &str); 3] = [
+    // The walk's first pose held for 2 s: a clip in which nothing moves.
+    std::fs::create_dir_all(&dir).unwrap();
+    let still = dir.join("still.bvh");
+    let text = std::fs::read_to_string(&walk).unwrap();
+    let (hierarchy, motion) = text.split_once("MOTION").unwrap();
+    let mut lines = motion.lines().skip_while(|l| !l.starts_with("Frame Time"));
+    let time = lines.next().unwrap();
+    let pose = lines.next().unwrap();
+    let frames: String = std::iter::repeat_n(format!("{pose}\n"), 240).collect();
+    std::fs::write(
+        &still,
+        format!("{hierarchy}MOTION\nFrames: 240\n{time}\n{frames}"),
+    )
+    .unwrap();
+    let cases: [(&[&std::ffi::OsStr], &str); 4] = [
+        (
+            &["--clip".as_ref(), still.as_os_str()],
+            "nothing moves in the clip",
+        ),
         (
             &[
                 "--clip".as_ref(),
@@ -179,6 +197,27 @@ fn eval_command_refuses_bad_input_and_writes_nothing() {
         assert!(stderr.contains(message), "{extra:?}: {stderr}");
         assert!(!json.exists(), "{extra:?} left {}", json.display());
     }
+    // A task's reference is held to the same rule.
+    let out = dir.join("ib.bvh");
+    let args: Vec<&std::ffi::OsStr> = vec![
+        "inbetween".as_ref(),
+        "-m".as_ref(),
+        model.as_os_str(),
+        "--reference".as_ref(),
+        still.as_os_str(),
+        "--keep".as_ref(),
+        "0:1s".as_ref(),
+        "-o".as_ref(),
+        out.as_os_str(),
+        "--quiet".as_ref(),
+    ];
+    let done = sinmdm(&args);
+    let stderr = String::from_utf8_lossy(&done.stderr);
+    assert!(
+        !done.status.success() && stderr.contains("nothing moves in the clip"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
 
