@@ -54,8 +54,8 @@ fn load(path: &Path) -> Result<ufbx::SceneRoot, FormatError> {
         space_conversion: ufbx::SpaceConversion::ModifyGeometry,
         // Textures and videos packed into the file are not motion.
         ignore_embedded: true,
-        temp_allocator: bounded(),
-        result_allocator: bounded(),
+        temp_allocator: bounded(bytes.len()),
+        result_allocator: bounded(bytes.len()),
         ..Default::default()
     };
     ufbx::load_memory(&bytes, options).map_err(|error| {
@@ -73,14 +73,25 @@ fn load(path: &Path) -> Result<ufbx::SceneRoot, FormatError> {
     })
 }
 
-/// The most memory ufbx may take for each of its two arenas while loading a file (1 GiB): far
-/// above any clip's needs (the 3.3 s Mixamo dance takes a few MB), and a bound on a file that
-/// declares huge arrays.
+/// The most memory ufbx may take for each of its two arenas while loading a file (1 GiB).
 pub const FBX_MEMORY_LIMIT: usize = 1 << 30;
+/// Below [`FBX_MEMORY_LIMIT`], each arena may take this much ...
+pub const FBX_MEMORY_BASE: usize = 64 << 20;
+/// ... plus this many bytes per byte of the file: far above what an FBX clip's arrays expand to
+/// (compressed arrays inflate a few times), far below what a file that declares huge arrays in a
+/// few bytes of zlib asks for.
+pub const FBX_MEMORY_PER_BYTE: usize = 32;
 
-fn bounded() -> ufbx::AllocatorOpts {
+/// The memory ufbx may take for each arena while loading a file of `file_bytes`.
+pub fn fbx_memory_limit(file_bytes: usize) -> usize {
+    FBX_MEMORY_BASE
+        .saturating_add(file_bytes.saturating_mul(FBX_MEMORY_PER_BYTE))
+        .min(FBX_MEMORY_LIMIT)
+}
+
+fn bounded(file_bytes: usize) -> ufbx::AllocatorOpts {
     ufbx::AllocatorOpts {
-        memory_limit: FBX_MEMORY_LIMIT,
+        memory_limit: fbx_memory_limit(file_bytes),
         ..Default::default()
     }
 }
@@ -95,7 +106,11 @@ fn load_failure(error: &ufbx::Error, bytes: &[u8]) -> String {
         E::UnrecognizedFileFormat => "it has neither the binary FBX header nor ASCII FBX's",
         E::UnsupportedVersion => "its FBX version is not one this reads",
         E::OutOfMemory | E::MemoryLimit | E::AllocationLimit => {
-            "it asks for more memory than the limit of 1 GiB (its arrays declare more data than an FBX clip holds)"
+            return format!(
+                "is not an FBX file this reads: it asks for more than the {} MB a file of its size may take to load (its arrays declare more data than the file holds; FBX_MEMORY_BASE + FBX_MEMORY_PER_BYTE per byte) (the FBX reader says: {})",
+                fbx_memory_limit(bytes.len()) >> 20,
+                error.description
+            );
         }
         E::NodeDepthLimit => "it nests its nodes deeper than the reader's limit",
         E::InvalidUtf8 => "it holds a name that is not UTF-8",
