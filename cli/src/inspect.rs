@@ -68,14 +68,21 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     {
         bail!("--fps must be a positive number, got {fps}");
     }
-    // A character file without animations: its bones, for --mesh-from.
-    if crate::clip_files::is_gltf(&args.clip)
-        && sinmdm_formats::list_animations(&args.clip).is_ok_and(|a| a.is_empty())
+    // The file is read once: its animations come with the clip. Only a glTF file that could not
+    // be read as a clip is asked whether it is a character without animations (for
+    // --mesh-from), so a clip is not read twice.
+    let (clip, source) = match read_motion_file_and_source(&args.clip, args.up.clip_anim.as_deref())
     {
-        return crate::character::inspect_character(&args.clip);
-    }
-    // The file is read once: its animations come with the clip.
-    let (clip, source) = read_motion_file_and_source(&args.clip, args.up.clip_anim.as_deref())?;
+        Ok(read) => read,
+        Err(error) => {
+            if crate::clip_files::is_gltf(&args.clip)
+                && sinmdm_formats::list_animations(&args.clip).is_ok_and(|a| a.is_empty())
+            {
+                return crate::character::inspect_character(&args.clip);
+            }
+            return Err(error);
+        }
+    };
     let animations = &source.animations;
     if !animations.is_empty() {
         println!("animations {}", animations.len());

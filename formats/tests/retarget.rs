@@ -32,6 +32,22 @@ fn the_walk() -> LocalMotion {
         .to_local()
 }
 
+/// Blender's reshaped rig with `change` made to each of its nodes, written as scratch file
+/// `name`.
+fn reshaped_rig_with(name: &str, mut change: impl FnMut(&mut serde_json::Value)) -> PathBuf {
+    let rig = fixtures().join("human_walk_rig_other_proportions.glb");
+    let asset = parse_glb(&rig, &std::fs::read(&rig).unwrap()).unwrap();
+    let mut json = asset.json;
+    json["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .for_each(&mut change);
+    let character = scratch(name);
+    std::fs::write(&character, glb_bytes(&json, &asset.buffers[0])).unwrap();
+    character
+}
+
 /// A motion's joints: names, parents and every frame's positions.
 struct Played {
     names: Vec<String>,
@@ -379,17 +395,11 @@ fn a_mixamo_clip_goes_onto_another_mixamo_character_by_its_names_alone() {
     let fbx = root().join("tests/data/fbx/human_walk_cmu_131_01_mixamo_style.fbx");
     let (clip, _) = read_clip(&fbx, &ReadOptions::default()).unwrap();
     let mixamo = clip.to_local();
-    let bytes = std::fs::read(fixtures().join("human_walk_rig_other_proportions.glb")).unwrap();
-    let asset = parse_glb(Path::new("rig.glb"), &bytes).unwrap();
-    let mut json = asset.json;
-    for node in json["nodes"].as_array_mut().unwrap() {
+    let character = reshaped_rig_with("mixamo_character.glb", |node| {
         if let Some(name) = node["name"].as_str().filter(|n| !n.contains("Cube")) {
             node["name"] = serde_json::Value::String(format!("mixamorig:{name}"));
         }
-    }
-    let character = scratch("mixamo_character.glb");
-    let bin = asset.buffers.into_iter().next().unwrap();
-    std::fs::write(&character, glb_bytes(&json, &bin)).unwrap();
+    });
 
     let out = scratch("mixamo_on_mixamo.glb");
     let report = splice_retargeted(
@@ -423,18 +433,13 @@ fn a_leg_that_is_not_the_clips_scaled_alike_bends_to_put_its_ankle_where_the_cli
     // and keep its feet, so its knees bend (and its hips turn) to put the ankles where the
     // clip's are, scaled as the travel is.
     let walk = the_walk();
-    let rig = fixtures().join("human_walk_rig_other_proportions.glb");
-    let asset = parse_glb(&rig, &std::fs::read(&rig).unwrap()).unwrap();
-    let mut json = asset.json;
-    for node in json["nodes"].as_array_mut().unwrap() {
+    let character = reshaped_rig_with("short_shins.glb", |node| {
         if matches!(node["name"].as_str(), Some("LeftAnkle" | "RightAnkle")) {
             for v in node["translation"].as_array_mut().unwrap() {
                 *v = serde_json::json!(v.as_f64().unwrap() * 0.8);
             }
         }
-    }
-    let character = scratch("short_shins.glb");
-    std::fs::write(&character, glb_bytes(&json, &asset.buffers[0])).unwrap();
+    });
     let out = scratch("short_shins_walk.glb");
     let report = splice_retargeted(
         &character,

@@ -204,7 +204,7 @@ pub(super) fn retargeted(
         return Err("no bone of the character follows a joint of the model".into());
     }
     // In the character's hierarchy order, so a bone's paired ancestor comes first.
-    pairs.sort_by_key(|&(node, _)| depth(target.parents, node));
+    pairs.sort_by_key(|&(node, _)| target.depth(node));
     let paired_parent: Vec<Option<usize>> = pairs
         .iter()
         .map(|&(node, _)| {
@@ -226,7 +226,7 @@ pub(super) fn retargeted(
     // The bone that carries the body: the top paired bone following the highest joint.
     let top = (0..pairs.len())
         .filter(|&k| paired_parent[k].is_none())
-        .min_by_key(|&k| depth(source.parents, pairs[k].1))
+        .min_by_key(|&k| source.depth(pairs[k].1))
         .unwrap_or(0);
     // Each bone's rest alignment, from the directions to its paired children.
     let mut align: Vec<Mat3> = Vec::with_capacity(pairs.len());
@@ -279,18 +279,12 @@ pub(super) fn retargeted(
             moves: k == top,
         })
         .collect();
-    let below_top = |n: usize| {
-        let mut at = Some(n);
-        while let Some(a) = at {
-            if a == pairs[top].0 {
-                return true;
-            }
-            at = target.parents[a];
-        }
-        false
-    };
     let still_bones = (0..target.names.len())
-        .filter(|&n| n != pairs[top].0 && below_top(n) && !pairs.iter().any(|&(p, _)| p == n))
+        .filter(|&n| {
+            n != pairs[top].0
+                && target.holds(pairs[top].0, n)
+                && !pairs.iter().any(|&(p, _)| p == n)
+        })
         .map(|n| target.names[n].clone())
         .collect();
     let dropped_joints = (0..source.names.len())
@@ -312,18 +306,4 @@ pub(super) fn retargeted(
         }),
         driven,
     })
-}
-
-/// How many ancestors node `n` has.
-fn depth(parents: &[Option<usize>], n: usize) -> usize {
-    let mut depth = 0;
-    let mut at = parents[n];
-    while let Some(p) = at {
-        depth += 1;
-        if depth > parents.len() {
-            break;
-        }
-        at = parents[p];
-    }
-    depth
 }

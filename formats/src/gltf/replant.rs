@@ -11,6 +11,7 @@ use sinmdm::motion::math::{Mat3, Vec3};
 use sinmdm::motion::skeleton::{Axis, Channel, Joint, Skeleton};
 use sinmdm::motion::{GlobalPose, LocalMotion, skeleton_height};
 
+use crate::retarget::Rig;
 use crate::retarget::align::shortest_rotation;
 
 use super::drive::Drive;
@@ -42,7 +43,7 @@ pub(super) fn character_motion(
     (parent, rest, names): (&[Option<usize>], &[Similarity], &[String]),
 ) -> Option<CharacterMotion> {
     let top = drive.driven.iter().find(|d| d.moves)?;
-    // The carrying bone's subtree, depth first, parents before children.
+    // The carrying bone's subtree, breadth first: parents before children.
     let mut nodes = vec![top.node];
     let mut next = 0;
     while next < nodes.len() {
@@ -53,7 +54,11 @@ pub(super) fn character_motion(
     let index = |n: usize| nodes.iter().position(|&m| m == n);
     let above = match parent[top.node] {
         Some(p) => {
-            if drive.driven.iter().any(|d| holds(parent, d.node, p)) {
+            let rig = Rig {
+                names,
+                parents: parent,
+            };
+            if drive.driven.iter().any(|d| rig.holds(d.node, p)) {
                 return None;
             }
             rest[p]
@@ -100,16 +105,20 @@ pub(super) fn character_motion(
             None => rest[n].rotation,
         })
         .collect();
-    let driven_by = |n: usize| drive.driven.iter().find(|d| d.node == n);
+    // How each joint is driven, looked up once rather than every frame.
+    let driven_by: Vec<Option<&super::drive::Driven>> = nodes
+        .iter()
+        .map(|&n| drive.driven.iter().find(|d| d.node == n))
+        .collect();
     let legs = legs(source, poses, drive, &nodes, &skeleton);
     let mut rotations = Vec::with_capacity(poses.len() * nodes.len());
     let mut translations = Vec::with_capacity(poses.len() * nodes.len());
     for pose in poses {
         let mut global: Vec<Mat3> = Vec::with_capacity(nodes.len());
         let mut position: Vec<Vec3> = Vec::with_capacity(nodes.len());
-        for (k, &n) in nodes.iter().enumerate() {
+        for (k, driven) in driven_by.iter().enumerate() {
             let up = skeleton.joints[k].parent;
-            let g = match driven_by(n) {
+            let g = match driven {
                 Some(d) => pose.rotations[d.joint] * d.turn,
                 None => match up {
                     Some(p) => global[p] * rest_local[k],
@@ -288,21 +297,4 @@ fn rotation_about(axis: Vec3, angle: f64) -> Mat3 {
         [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
         [t * x * z - s * y, t * y * z + s * x, t * z * z + c],
     ])
-}
-
-/// Whether node `above` is node `below` or one of its ancestors.
-fn holds(parent: &[Option<usize>], above: usize, below: usize) -> bool {
-    let mut at = Some(below);
-    let mut steps = 0;
-    while let Some(n) = at {
-        if n == above {
-            return true;
-        }
-        steps += 1;
-        if steps > parent.len() {
-            return false;
-        }
-        at = parent[n];
-    }
-    false
 }

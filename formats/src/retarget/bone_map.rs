@@ -18,7 +18,7 @@ pub struct Rig<'a> {
 
 impl Rig<'_> {
     /// Whether bone `above` is bone `below` or one of its ancestors.
-    fn holds(&self, above: usize, below: usize) -> bool {
+    pub(crate) fn holds(&self, above: usize, below: usize) -> bool {
         let mut at = Some(below);
         let mut steps = 0;
         while let Some(n) = at {
@@ -35,7 +35,7 @@ impl Rig<'_> {
     }
 
     /// How many ancestors bone `n` has.
-    fn depth(&self, n: usize) -> usize {
+    pub(crate) fn depth(&self, n: usize) -> usize {
         let mut depth = 0;
         let mut at = self.parents[n];
         while let Some(p) = at {
@@ -340,6 +340,13 @@ mod tests {
         )
     }
 
+    fn rig_of(bones: &(Vec<String>, Vec<Option<usize>>)) -> Rig<'_> {
+        Rig {
+            names: &bones.0,
+            parents: &bones.1,
+        }
+    }
+
     fn cmu() -> (Vec<String>, Vec<Option<usize>>) {
         rig(&[
             ("Hips", None),
@@ -379,18 +386,8 @@ mod tests {
 
     #[test]
     fn an_unreal_mannequin_follows_a_cmu_clip_by_role() {
-        let (tn, tp) = unreal();
-        let (sn, sp) = cmu();
-        let (target, source) = (
-            Rig {
-                names: &tn,
-                parents: &tp,
-            },
-            Rig {
-                names: &sn,
-                parents: &sp,
-            },
-        );
+        let (unreal, cmu) = (unreal(), cmu());
+        let (target, source) = (rig_of(&unreal), rig_of(&cmu));
         let found = pairs_by_role(&target, &source).unwrap();
         assert_eq!(found.target, Convention::Unreal);
         assert_eq!(found.source, Convention::CmuBvh);
@@ -421,18 +418,8 @@ mod tests {
 
     #[test]
     fn a_map_that_turns_a_chain_round_is_refused_naming_the_bone() {
-        let (tn, tp) = unreal();
-        let (sn, sp) = cmu();
-        let (target, source) = (
-            Rig {
-                names: &tn,
-                parents: &tp,
-            },
-            Rig {
-                names: &sn,
-                parents: &sp,
-            },
-        );
+        let (unreal, cmu) = (unreal(), cmu());
+        let (target, source) = (rig_of(&unreal), rig_of(&cmu));
         let map = BoneMap::parse("pelvis: Hips\nthigh_l: LeftLeg\ncalf_l: LeftUpLeg\n").unwrap();
         let pairs = map
             .indices(&target, &source, Path::new("map.yaml"))
@@ -446,18 +433,8 @@ mod tests {
 
     #[test]
     fn a_map_naming_a_missing_bone_says_which() {
-        let (tn, tp) = unreal();
-        let (sn, sp) = cmu();
-        let (target, source) = (
-            Rig {
-                names: &tn,
-                parents: &tp,
-            },
-            Rig {
-                names: &sn,
-                parents: &sp,
-            },
-        );
+        let (unreal, cmu) = (unreal(), cmu());
+        let (target, source) = (rig_of(&unreal), rig_of(&cmu));
         let map = BoneMap::parse("pelvis: Hips\nthigh_left: LeftUpLeg\n").unwrap();
         let err = map
             .indices(&target, &source, Path::new("map.yaml"))
