@@ -13,6 +13,46 @@ use crate::error::{FormatError, Part};
 pub const MAX_CLIP_FRAMES: usize = 100_000;
 /// The most joint transforms (frames x joints) a clip read from keyframes (glTF, FBX) may have: about 1 GB.
 pub const MAX_JOINT_FRAMES: usize = 10_000_000;
+/// The most joint transforms a clip read from keyframes may have beyond one per
+/// [`BYTES_PER_SPARSE_TRANSFORM`] bytes read: sampling is a reader's costliest step, so a small
+/// file whose few keys lie far apart must not make it sample for minutes (a reader's time stays
+/// linear in what it reads). 100 000 covers a 55 s, 60-joint clip keyed as sparsely as an
+/// animator likes.
+pub const MAX_SPARSE_TRANSFORMS: usize = 100_000;
+/// Beyond [`MAX_SPARSE_TRANSFORMS`], the bytes read per transform sampled: a file keyed on every
+/// frame brings at least 20 (a rotation and its time) for each.
+pub const BYTES_PER_SPARSE_TRANSFORM: usize = 4;
+
+/// Checks that sampling `joints` x `frames` transforms from a file of `bytes_read` bytes stays
+/// within [`MAX_JOINT_FRAMES`], and within [`MAX_SPARSE_TRANSFORMS`] or one transform per
+/// [`BYTES_PER_SPARSE_TRANSFORM`] bytes, whichever is more.
+pub(crate) fn check_sampled_size(
+    path: &Path,
+    joints: usize,
+    frames: usize,
+    bytes_read: usize,
+) -> Result<(), FormatError> {
+    let transforms = frames.saturating_mul(joints);
+    if transforms > MAX_JOINT_FRAMES {
+        return Err(FormatError::bad(
+            path,
+            Part::Skeleton,
+            format!(
+                "{joints} joints x {frames} frames are more transforms than the {MAX_JOINT_FRAMES} a clip may have"
+            ),
+        ));
+    }
+    if transforms > MAX_SPARSE_TRANSFORMS.max(bytes_read / BYTES_PER_SPARSE_TRANSFORM) {
+        return Err(FormatError::bad(
+            path,
+            Part::Skeleton,
+            format!(
+                "{joints} joints x {frames} frames are {transforms} transforms to sample from {bytes_read} bytes of keys: more than {MAX_SPARSE_TRANSFORMS} (MAX_SPARSE_TRANSFORMS) or one per {BYTES_PER_SPARSE_TRANSFORM} bytes; are the key times right? A lower frame rate (--fps) samples fewer"
+            ),
+        ));
+    }
+    Ok(())
+}
 
 /// A clip moves when some channel's standard deviation over its frames is above this (degrees
 /// for rotations, file units for positions): far below any motion a person could see, far above

@@ -19,9 +19,7 @@ use std::path::Path;
 use sinmdm::motion::math::{Mat3, Vec3};
 use sinmdm::motion::{ChannelClip, fps_from_frame_time};
 
-use crate::animation::{
-    AnimationInfo, MAX_CLIP_FRAMES, MAX_JOINT_FRAMES, ReadOptions, choose_and_sample,
-};
+use crate::animation::{AnimationInfo, MAX_CLIP_FRAMES, ReadOptions, choose_and_sample};
 use crate::error::{FormatError, Part};
 use crate::sampled::{Recorded, SampledJoints, unique_names, without_namespace};
 
@@ -41,8 +39,8 @@ pub struct FbxClip {
 /// A joint's scale may differ from its parent's by this share before the file is refused.
 const SCALE_TOLERANCE: f64 = 1e-4;
 
-/// The scene of `path`, loaded and converted to +Y up, metres.
-fn load(path: &Path) -> Result<ufbx::SceneRoot, FormatError> {
+/// The scene of `path`, loaded and converted to +Y up, metres, and the file's size in bytes.
+fn load(path: &Path) -> Result<(ufbx::SceneRoot, usize), FormatError> {
     let bytes = crate::files::read_file(path, crate::files::FBX_LIMIT)?;
     let options = ufbx::LoadOpts {
         target_axes: ufbx::CoordinateAxes {
@@ -58,7 +56,7 @@ fn load(path: &Path) -> Result<ufbx::SceneRoot, FormatError> {
         result_allocator: bounded(bytes.len()),
         ..Default::default()
     };
-    ufbx::load_memory(&bytes, options).map_err(|error| {
+    let scene = ufbx::load_memory(&bytes, options).map_err(|error| {
         let info = error.info();
         let detail = if info.is_empty() {
             String::new()
@@ -70,7 +68,8 @@ fn load(path: &Path) -> Result<ufbx::SceneRoot, FormatError> {
             Part::Fbx,
             format!("{}{detail}", load_failure(&error, &bytes)),
         )
-    })
+    })?;
+    Ok((scene, bytes.len()))
 }
 
 /// The most memory ufbx may take for each of its two arenas while loading a file (1 GiB).
@@ -180,7 +179,7 @@ fn stack_infos(scene: &ufbx::Scene) -> Vec<AnimationInfo> {
 
 /// The animation stacks of an FBX file with their lengths (for `inspect`).
 pub fn list_fbx_animations(path: &Path) -> Result<Vec<AnimationInfo>, FormatError> {
-    let scene = load(path)?;
+    let (scene, _) = load(path)?;
     Ok(stack_infos(&scene))
 }
 
@@ -363,6 +362,7 @@ fn sample_stack(
     (chosen, name): (usize, Option<String>),
     (order, parents): (&[usize], &[Option<usize>]),
     options: &ReadOptions,
+    bytes_read: usize,
 ) -> Result<ChannelClip, FormatError> {
     let stack = &scene.anim_stacks[chosen];
     let part = || Part::Animation(chosen, name.clone());
@@ -393,14 +393,7 @@ fn sample_stack(
     }
     let frames = span as usize + 1;
     let joints = order.len();
-    if frames.saturating_mul(joints) > MAX_JOINT_FRAMES {
-        return Err(bad(
-            Part::Skeleton,
-            format!(
-                "{joints} bones x {frames} frames are more transforms than the {MAX_JOINT_FRAMES} a clip may have"
-            ),
-        ));
-    }
+    crate::animation::check_sampled_size(path, joints, frames, bytes_read)?;
     let mut rotations = Vec::with_capacity(frames * joints);
     let mut translations = Vec::with_capacity(frames * joints);
     for f in 0..frames {
@@ -449,7 +442,7 @@ fn sample_stack(
 
 /// Reads the clip of one animation stack of an `.fbx` file.
 pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatError> {
-    let scene = load(path)?;
+    let (scene, bytes_read) = load(path)?;
     let mut animations = stack_infos(&scene);
     let (order, parents) = skeleton_nodes(path, &scene)?;
     let names: Vec<Option<String>> = animations.iter().map(|a| a.name.clone()).collect();
@@ -460,7 +453,8 @@ pub fn read_fbx(path: &Path, options: &ReadOptions) -> Result<FbxClip, FormatErr
         (Part::Fbx, "animation stack"),
         |chosen| {
             let name = (chosen, names[chosen].clone());
-            sample_stack(path, &scene, name, (&order, &parents), options)
+            let skeleton = (&order[..], &parents[..]);
+            sample_stack(path, &scene, name, skeleton, options, bytes_read)
         },
     )?;
     Ok(FbxClip {

@@ -21,8 +21,8 @@ use std::path::Path;
 use sinmdm::motion::ChannelClip;
 
 pub use animation::{
-    AnimationChoice, AnimationInfo, MAX_CLIP_FRAMES, MAX_JOINT_FRAMES, ReadOptions,
-    STILL_TOLERANCE, clip_moves,
+    AnimationChoice, AnimationInfo, BYTES_PER_SPARSE_TRANSFORM, MAX_CLIP_FRAMES, MAX_JOINT_FRAMES,
+    MAX_SPARSE_TRANSFORMS, ReadOptions, STILL_TOLERANCE, clip_moves,
 };
 pub use error::{FormatError, Part};
 pub use files::FileAccess;

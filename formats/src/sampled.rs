@@ -251,14 +251,9 @@ fn drop_static_leaves(
         let Some(p) = joints[j].parent else { continue };
         let leaf = !joints.iter().any(|o| o.parent == Some(j));
         let only_child = joints.iter().filter(|o| o.parent == Some(p)).count() == 1;
-        let (turns, moves) = turns_and_moves(&rotations, &translations, shape, j);
-        if !recorded[j].ours
-            && leaf
-            && only_child
-            && !turns
-            && !moves
-            && joints[p].end_site.is_none()
-        {
+        // The frames are read only for a joint that could become an End Site.
+        let candidate = !recorded[j].ours && leaf && only_child && joints[p].end_site.is_none();
+        if candidate && turns_and_moves(&rotations, &translations, shape, j) == (false, false) {
             joints[p].end_site = Some(translations[j]);
             keep[j] = false;
         }

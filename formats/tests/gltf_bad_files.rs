@@ -161,6 +161,44 @@ fn each_problem_is_named_with_the_file_and_the_part() {
     std::fs::remove_file(path).unwrap();
 }
 
+/// The fox with the last key of every sampler moved to `seconds`: a few keys far apart.
+fn last_key_at(seconds: f32) -> (Value, Vec<u8>) {
+    let (json, mut bin) = fox();
+    for sampler in json["animations"][0]["samplers"].as_array().unwrap() {
+        let input = sampler["input"].as_u64().unwrap() as usize;
+        let accessor = &json["accessors"][input];
+        let view = &json["bufferViews"][accessor["bufferView"].as_u64().unwrap() as usize];
+        let at = view["byteOffset"].as_u64().unwrap_or(0) as usize
+            + accessor["byteOffset"].as_u64().unwrap_or(0) as usize
+            + 4 * (accessor["count"].as_u64().unwrap() as usize - 1);
+        bin[at..at + 4].copy_from_slice(&seconds.to_le_bytes());
+    }
+    (json, bin)
+}
+
+#[test]
+fn a_few_keys_far_apart_cannot_make_the_reader_sample_for_long() {
+    // 12 keys a bone: to 100 s the reader samples 3 000 frames (66 000 transforms, under
+    // MAX_SPARSE_TRANSFORMS); to 1 000 s, 30 000 frames from a file of a few kilobytes.
+    let (json, bin) = last_key_at(100.0);
+    assert_eq!(read(&json, &bin, "far_100.glb"), None);
+    let (json, bin) = last_key_at(1000.0);
+    let message = error(&json, &bin, "far_1000.glb");
+    assert!(
+        message.contains("far_1000.glb")
+            && message.contains("MAX_SPARSE_TRANSFORMS")
+            && message.contains("--fps"),
+        "{message}"
+    );
+    // The input the glTF fuzz target found (31 KB): a key moved to 522 s, 12 544 frames of 22
+    // joints, which took the reader 0.8 s before the bound.
+    let found = root().join("tests/data/gltf/fuzz_far_keys.glb");
+    let message = read_gltf(&found, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("MAX_SPARSE_TRANSFORMS"), "{message}");
+}
+
 /// Every path to a value inside `value`.
 fn paths(value: &Value, at: Vec<Value>, out: &mut Vec<Vec<Value>>) {
     out.push(at.clone());

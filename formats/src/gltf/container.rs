@@ -28,6 +28,8 @@ pub struct Asset {
     pub json: serde_json::Value,
     /// The bytes of each buffer.
     pub buffers: Vec<Vec<u8>>,
+    /// The bytes read to make it: the file, and a `.gltf`'s decoded buffers.
+    pub bytes_read: usize,
 }
 
 /// A GLB file of `json` (serialised compactly) and one binary chunk `bin`.
@@ -64,7 +66,12 @@ pub fn read_asset(path: &Path, access: FileAccess) -> Result<Asset, FormatError>
         let json: serde_json::Value = serde_json::from_slice(&bytes)
             .map_err(|e| FormatError::bad(path, Part::Json, format!("is not JSON: {e}")))?;
         let buffers = load_buffers(path, &json, None, access)?;
-        Ok(Asset { json, buffers })
+        let bytes_read = bytes.len() + buffers.iter().map(Vec::len).sum::<usize>();
+        Ok(Asset {
+            json,
+            buffers,
+            bytes_read,
+        })
     }
 }
 
@@ -127,7 +134,11 @@ pub fn parse_glb(path: &Path, bytes: &[u8]) -> Result<Asset, FormatError> {
         .map_err(|e| FormatError::bad(path, Part::Json, format!("JSON chunk: {e}")))?;
     // A GLB's buffers are its binary chunk and data URIs; side-car files are for `.gltf`.
     let buffers = load_buffers(path, &json, bin, FileAccess::default())?;
-    Ok(Asset { json, buffers })
+    Ok(Asset {
+        json,
+        buffers,
+        bytes_read: bytes.len(),
+    })
 }
 
 /// The bytes of every buffer of `json`: the GLB's binary chunk for a buffer without a URI,

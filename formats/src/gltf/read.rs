@@ -24,7 +24,7 @@ use super::accessor::{field_usize, read_floats};
 use super::container::{Asset, read_asset};
 use super::nodes::{Similarity, Trs, node_name, node_trs, parents, rotation_of, unit_scale};
 use super::skin::{SkinJoints, node_names, recorded_joints, skin_joints};
-use super::tracks::{MAX_JOINT_FRAMES, Property, Track, frame_rate, read_tracks};
+use super::tracks::{Property, Track, frame_rate, read_tracks};
 use crate::animation::{AnimationInfo, ReadOptions, choose_and_sample};
 use crate::error::{FormatError, Part};
 use crate::files::FileAccess;
@@ -185,16 +185,7 @@ pub fn read_gltf_with_access(
         let tracks = read_tracks(path, &asset, chosen, |n| skin.joint_of(n))?;
         let timing = frame_rate(path, part, &tracks, options.fps)?;
         let (_, fps, frames) = timing;
-        if frames.saturating_mul(skin.order.len()) > MAX_JOINT_FRAMES {
-            return Err(FormatError::bad(
-                path,
-                Part::Skeleton,
-                format!(
-                    "{} joints x {frames} frames are more transforms than the {MAX_JOINT_FRAMES} a clip may have",
-                    skin.order.len()
-                ),
-            ));
-        }
+        crate::animation::check_sampled_size(path, skin.order.len(), frames, asset.bytes_read)?;
         let (rotations, translations) = sample_frames(path, nodes, &rest, &skin, &tracks, timing)?;
         // The joints' own transforms, with the nodes above each folded in.
         let rest_rotations = skin

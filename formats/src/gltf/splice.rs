@@ -134,7 +134,9 @@ pub fn splice_retargeted(
             message: "is not a .glb: the character file is read as binary glTF (.glb), whose mesh and skin travel in one file; export it as glTF Binary (.glb), e.g. from Blender (File > Export > glTF 2.0, Format: glTF Binary)".into(),
         });
     }
-    let Asset { mut json, buffers } = parse_glb(character, &bytes)?;
+    let Asset {
+        mut json, buffers, ..
+    } = parse_glb(character, &bytes)?;
     let bad = |part: Part, message: String| FormatError::bad(character, part, message);
     if buffers.len() > 1
         || json["buffers"]

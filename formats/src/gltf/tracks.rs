@@ -10,7 +10,7 @@ use sinmdm::motion::math;
 use super::accessor::{field_usize, read_floats};
 use super::container::Asset;
 use super::nodes::node_name;
-pub(crate) use crate::animation::{MAX_CLIP_FRAMES, MAX_JOINT_FRAMES};
+pub(crate) use crate::animation::MAX_CLIP_FRAMES;
 use crate::error::{FormatError, Part};
 
 /// How a sampler interpolates.
