@@ -13,8 +13,9 @@
 //!   more the longer it trains. It keeps the configuration's steps, and its QnA window and
 //!   dropout follow its feet (the contact joints the clip's layout found):
 //!   - on two feet or fewer, its samples shake more than the clip at the configuration's window:
-//!     it trains a wider window ([`VARIED_WINDOW`]) that smooths them and more dropout
-//!     ([`VARIED_DROPOUT`]) that keeps them varied;
+//!     it trains a wider window ([`VARIED_WINDOW`]) that smooths them, and keeps the
+//!     configuration's dropout: more damps its samples below the clip's speed
+//!     (docs/TRAINING_EXPERIMENTS.md, "The candidates one at a time");
 //!   - on [`MANY_FEET`] feet or more (a dog, a horse, a fox), its samples at a window that serves
 //!     a biped keep too little of the clip (a fifth of a dog's one-second windows are never
 //!     made): the legs' phases must hold over a longer span, and the network needs the width to
@@ -54,8 +55,6 @@ pub fn calm_most_steps() -> u64 {
 /// QnA window of a varied clip on two feet or fewer, meant at 30 fps (it follows the frame rate
 /// when the configuration's window does).
 pub const VARIED_WINDOW: usize = 5;
-/// Dropout of a varied clip on two feet or fewer.
-pub const VARIED_DROPOUT: f64 = 0.5;
 /// The feet (contact joints) from which a varied clip trains [`MANY_FEET_WINDOW`] and
 /// [`MANY_FEET_CHANNELS`].
 pub const MANY_FEET: usize = 3;
@@ -289,7 +288,7 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
     lines.push(match (asked.dropout, calm) {
         (false, _) => format!("dropout         {} ({kept})", config.model.dropout),
         (true, true) => format!(
-            "dropout         {} (the configuration's): the rule raises only a varied clip's",
+            "dropout         {} (the configuration's): the rule raises only a varied clip's on three feet or more",
             config.model.dropout
         ),
         (true, false) if reading.has_many_feet() => {
@@ -299,12 +298,10 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
                 reading.feet
             )
         }
-        (true, false) => {
-            out.model.dropout = VARIED_DROPOUT;
-            format!(
-                "dropout         {VARIED_DROPOUT}: keeps a varied clip's samples varied at the wider window"
-            )
-        }
+        (true, false) => format!(
+            "dropout         {} (the configuration's): more damps a varied clip's samples on two feet (their median speed falls below the clip's)",
+            config.model.dropout
+        ),
     });
     lines.push(match (asked.channels, calm) {
         (false, _) => format!("channels        {} ({kept})", config.model.channels),
@@ -632,7 +629,7 @@ mod tests {
         assert!(!choice.climb_ladder);
         assert_eq!(choice.config.training.steps, config.training.steps);
         assert_eq!(choice.config.model.window, VARIED_WINDOW);
-        assert_eq!(choice.config.model.dropout, VARIED_DROPOUT);
+        assert_eq!(choice.config.model.dropout, config.model.dropout);
         assert!(
             choice.lines[0].contains("varied") && choice.lines[0].contains("no rung covered it"),
             "{:?}",
@@ -650,7 +647,7 @@ mod tests {
             assert_eq!(out.training.steps, config.training.steps);
             assert_eq!(out.training.warmup_steps, config.training.warmup_steps);
             assert_eq!(out.model.window, VARIED_WINDOW);
-            assert_eq!(out.model.dropout, VARIED_DROPOUT);
+            assert_eq!(out.model.dropout, config.model.dropout, "two feet");
             assert_eq!(out.model.channels, config.model.channels, "two feet");
             assert!(
                 out.model.window_follows_fps,
@@ -679,8 +676,8 @@ mod tests {
         assert_eq!(out.model.channels, MANY_FEET_CHANNELS);
         assert_eq!(out.model.dropout, MANY_FEET_DROPOUT);
         assert!(
-            config.model.dropout < MANY_FEET_DROPOUT && MANY_FEET_DROPOUT < VARIED_DROPOUT,
-            "more than the configuration's, less than a biped's"
+            config.model.dropout < MANY_FEET_DROPOUT,
+            "more than the configuration's"
         );
         assert_eq!(out.training.steps, MANY_FEET_STEPS);
         assert!(MANY_FEET_STEPS < config.training.steps);

@@ -435,10 +435,10 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
             ))
             && text.contains("(249 frames at 30 fps)")
             // The rule that reads the clip finds the walk varied (its own intra diversity
-            // 0.837) and widens its window to 5 (29 frames) with dropout 0.5.
+            // 0.837) and widens its window to 5 (29 frames), keeping the dropout 0.2.
             && text.contains("clip            varied: its own intra diversity 0.837")
             && text.contains("receptive field 29 frames (QnA window 5)")
-            && text.contains("dropout         0.5:")
+            && text.contains("dropout         0.2 (the configuration's): more damps")
             // The default gives a walk the heading-relative root, and says so.
             && text.contains("root            heading-relative: facing across LeftHip and RightHip")
             && text.contains("chosen from the clip (data.root_layout auto)"),
