@@ -1,5 +1,5 @@
-// The Bevy snippet of the repository's README.md, section "Steering" (the lines from `use` to
-// the closing brace of `spawn_zombie`, line for line): change both together.
+// The snippet of bindings/bevy/README.md, section "Quick start" (the lines from
+// `use` to the closing brace of `spawn_zombie`, line for line): change both together.
 // tests/readme_snippet.rs compiles it and runs it in a headless app.
 use bevy::prelude::*; // a game's Bevy, with DefaultPlugins
 use sinmdm_bevy::{CharacterOptions, MotionModel, SinmdmPlugin, Steering, spawn_character};

@@ -1,6 +1,6 @@
-//! The README's Bevy snippet (docs/readme_snippet.rs, the README's code block line for line)
-//! compiles against the plugin and runs in a headless app; a test also checks that the README
-//! still shows it.
+//! The plugin README's snippet (docs/readme_snippet.rs, its code block line for line) compiles
+//! against the plugin and runs in a headless app; a test also checks that the README still
+//! shows it.
 
 use std::time::Duration;
 
@@ -81,8 +81,8 @@ fn the_readme_snippet_spawns_a_walking_zombie() {
 
 #[test]
 fn the_readme_shows_the_snippet_line_for_line() {
-    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
-    let readme = std::fs::read_to_string(format!("{root}/README.md")).unwrap();
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
     let snippet = include_str!("../docs/readme_snippet.rs");
     let lines: Vec<&str> = snippet.lines().collect();
     let first = lines.iter().position(|l| l.starts_with("use ")).unwrap();
@@ -90,6 +90,6 @@ fn the_readme_shows_the_snippet_line_for_line() {
     let block = format!("```rust\n{}\n```", lines[first..=last].join("\n"));
     assert!(
         readme.contains(&block),
-        "README.md's Bevy block differs from bindings/bevy/docs/readme_snippet.rs"
+        "bindings/bevy/README.md's block differs from bindings/bevy/docs/readme_snippet.rs"
     );
 }
