@@ -175,7 +175,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::ffi::CString::new(model_path.clone())?;
     let mut handle: *mut SinmdmModel = std::ptr::null_mut();
     let status = unsafe { sinmdm_model_open(path.as_ptr(), 0, &mut handle) };
-    assert_eq!(status, SinmdmStatus::SinmdmOk);
+    assert_eq!(status, SinmdmStatus::Ok);
     let joints = model.skeleton().len();
     let frames = 120;
     let (mut root, mut rot, mut trans) = (
@@ -218,12 +218,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         unsafe {
             assert_eq!(
                 sinmdm_generate(handle, &sampling, frames, &mut result),
-                SinmdmStatus::SinmdmOk
+                SinmdmStatus::Ok
             );
-            assert_eq!(
-                sinmdm_result_poses(result, 0, &buffers),
-                SinmdmStatus::SinmdmOk
-            );
+            assert_eq!(sinmdm_result_poses(result, 0, &buffers), SinmdmStatus::Ok);
             sinmdm_result_free(result);
         }
         c.push(t.elapsed().as_secs_f64());

@@ -14,7 +14,7 @@ use crate::run::{SinmdmRun, begin, blocking};
 use crate::sampling::{SinmdmSampling, request};
 use crate::status::{Failure, SinmdmStatus, guard};
 use crate::tasks::{reference_features, sampling_arg};
-use crate::text::{copy_array, handle, slice_arg};
+use crate::text::{copy_array, handle_ref, slice_arg};
 
 /// Keyframe order: each pass over the reference's beats in an order drawn from the seed (the
 /// default).
@@ -155,7 +155,7 @@ pub unsafe extern "C" fn sinmdm_dance_reference_beats(
     needed: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
-        let m = unsafe { handle(model.cast_mut(), "model") }?;
+        let m = unsafe { handle_ref(model, "model") }?;
         let features = unsafe { reference_features(m, reference, "reference") }?;
         let motion = decode(&m.model.metadata().layout, features.view())?;
         let (_, regular) = sinmdm_beats::pulses::motion_beats(&motion)
@@ -179,7 +179,7 @@ pub unsafe extern "C" fn sinmdm_dance_begin(
     unsafe {
         begin(model, out, |m| {
             let sampling = sampling_arg(sampling)?;
-            let dance = *handle(dance.cast_mut(), "dance")?;
+            let dance = *handle_ref(dance, "dance")?;
             let beats = dance_arg(&dance)?;
             let task = Task::Dance {
                 reference: reference_features(m, reference, "reference")?,

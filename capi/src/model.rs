@@ -7,7 +7,7 @@ use sinmdm::{Model, ModelOptions, UpAxis};
 
 use crate::limits::SINMDM_MAX_MODEL_BYTES;
 use crate::status::{Failure, SinmdmStatus, guard, guard_out};
-use crate::text::{copy_array, copy_str, give, handle, slice_arg, str_arg};
+use crate::text::{copy_array, copy_str, give, handle_mut, handle_ref, slice_arg, str_arg};
 
 /// A progress callback: called after each denoising step of a blocking task on the model it was
 /// set on, with the host's `userdata` first, then the steps done and the steps in all. Return
@@ -78,7 +78,7 @@ impl SinmdmModel {
 /// # Safety
 /// `model` is NULL or a live handle from `sinmdm_model_open*`.
 pub(crate) unsafe fn model_arg<'a>(model: *const SinmdmModel) -> Result<&'a Model, Failure> {
-    Ok(&unsafe { handle(model.cast_mut(), "model") }?.model)
+    Ok(&unsafe { handle_ref(model, "model") }?.model)
 }
 
 /// The facts of a model an engine needs to hold its poses.
@@ -140,7 +140,7 @@ pub unsafe extern "C" fn sinmdm_load_onnxruntime(path: *const c_char) -> SinmdmS
         };
         loaded
             .map(|_| ())
-            .map_err(|e| Failure::new(SinmdmStatus::SinmdmRuntimeLibrary, e.to_string()))
+            .map_err(|e| Failure::new(SinmdmStatus::RuntimeLibrary, e.to_string()))
     })
 }
 
@@ -215,7 +215,7 @@ pub unsafe extern "C" fn sinmdm_model_set_progress(
     userdata: *mut c_void,
 ) -> SinmdmStatus {
     guard(|| {
-        let model = unsafe { handle(model, "model") }?;
+        let model = unsafe { handle_mut(model, "model") }?;
         model.progress = Progress { callback, userdata };
         Ok(())
     })
@@ -241,7 +241,7 @@ pub unsafe extern "C" fn sinmdm_model_info(
 ) -> SinmdmStatus {
     guard(|| {
         let model = unsafe { model_arg(model) }?;
-        let info = unsafe { handle(info, "info") }?;
+        let info = unsafe { handle_mut(info, "info") }?;
         let metadata = model.metadata();
         let up: UpAxis = metadata.layout.up;
         *info = SinmdmModelInfo {
@@ -274,7 +274,7 @@ pub unsafe extern "C" fn sinmdm_model_values_per_frame(
 ) -> SinmdmStatus {
     guard(|| {
         let model = unsafe { model_arg(model) }?;
-        let values = unsafe { handle(values, "values") }?;
+        let values = unsafe { handle_mut(values, "values") }?;
         *values = sinmdm::tasks::run_values_per_frame(model.metadata());
         Ok(())
     })
@@ -325,12 +325,12 @@ pub unsafe extern "C" fn sinmdm_model_find_joint(
     guard(|| {
         let model = unsafe { model_arg(model) }?;
         let name = unsafe { str_arg(name, "name") }?;
-        let index = unsafe { handle(index, "index") }?;
+        let index = unsafe { handle_mut(index, "index") }?;
         let skeleton = model.skeleton();
         *index = skeleton.find(name).ok_or_else(|| {
             let names: Vec<&str> = skeleton.joints.iter().map(|j| j.name.as_str()).collect();
             Failure::new(
-                SinmdmStatus::SinmdmUnknownJoint,
+                SinmdmStatus::UnknownJoint,
                 format!(
                     "joint '{name}' is not in the model's skeleton (joints: {})",
                     names.join(", ")

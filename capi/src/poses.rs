@@ -7,7 +7,7 @@ use sinmdm::{Model, Pose, Quaternion, motion_from_poses};
 
 use crate::model::{SinmdmModel, model_arg};
 use crate::status::{Failure, SinmdmStatus, guard};
-use crate::text::{handle, out_slice, slice_arg, str_arg};
+use crate::text::{handle_ref, out_slice, slice_arg, str_arg};
 
 /// Poses given to the library, `frames` of them for the model's `joints` joints, as flat
 /// arrays in the model file's frame and units.
@@ -55,7 +55,7 @@ pub(crate) unsafe fn poses_in(
     poses: *const SinmdmPoses,
     argument: &str,
 ) -> Result<Vec<Pose>, Failure> {
-    let poses = unsafe { handle(poses.cast_mut(), argument) }?;
+    let poses = unsafe { handle_ref(poses, argument) }?;
     let layout = &model.metadata().layout;
     let joints = layout.skeleton.len();
     let frames = poses.frames;
@@ -116,7 +116,7 @@ pub(crate) unsafe fn pose_slices<'a>(
     frames: usize,
     joints: usize,
 ) -> Result<PoseSlices<'a>, Failure> {
-    let b = unsafe { handle(buffers.cast_mut(), "buffers") }?;
+    let b = unsafe { handle_ref(buffers, "buffers") }?;
     let size = |per_frame: usize| {
         per_frame.checked_mul(frames).ok_or_else(|| {
             Failure::invalid(format!(
@@ -203,6 +203,6 @@ pub unsafe extern "C" fn sinmdm_write_bvh(
             poses_in(model, poses, "poses")
         }?)?;
         sinmdm::bvh::write_bvh(path, &motion.to_channels())
-            .map_err(|e| Failure::new(SinmdmStatus::SinmdmIo, e.to_string()))
+            .map_err(|e| Failure::new(SinmdmStatus::Io, e.to_string()))
     })
 }

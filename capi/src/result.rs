@@ -4,7 +4,7 @@ use sinmdm::Generated;
 
 use crate::poses::{SinmdmPoseBuffers, poses_out};
 use crate::status::{Failure, SinmdmStatus, guard};
-use crate::text::handle;
+use crate::text::{handle_mut, handle_ref};
 
 /// A generated batch (opaque).
 pub struct SinmdmResult {
@@ -21,8 +21,8 @@ pub unsafe extern "C" fn sinmdm_result_count(
     count: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
-        let result = unsafe { handle(result.cast_mut(), "result") }?;
-        *unsafe { handle(count, "count") }? = result.generated.count();
+        let result = unsafe { handle_ref(result, "result") }?;
+        *unsafe { handle_mut(count, "count") }? = result.generated.count();
         Ok(())
     })
 }
@@ -37,8 +37,8 @@ pub unsafe extern "C" fn sinmdm_result_frames(
     frames: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
-        let result = unsafe { handle(result.cast_mut(), "result") }?;
-        *unsafe { handle(frames, "frames") }? = result.generated.frames();
+        let result = unsafe { handle_ref(result, "result") }?;
+        *unsafe { handle_mut(frames, "frames") }? = result.generated.frames();
         Ok(())
     })
 }
@@ -54,7 +54,7 @@ pub unsafe extern "C" fn sinmdm_result_poses(
     buffers: *const SinmdmPoseBuffers,
 ) -> SinmdmStatus {
     guard(|| {
-        let result = unsafe { handle(result.cast_mut(), "result") }?;
+        let result = unsafe { handle_ref(result, "result") }?;
         let count = result.generated.count();
         if sample >= count {
             return Err(Failure::invalid(format!(
@@ -69,7 +69,7 @@ pub unsafe extern "C" fn sinmdm_result_poses(
             .generated
             .poses(sample)
             // The batch was made by the network: motion it cannot give is a failed run.
-            .map_err(|e| Failure::new(SinmdmStatus::SinmdmTaskFailed, e.to_string()))?;
+            .map_err(|e| Failure::new(SinmdmStatus::TaskFailed, e.to_string()))?;
         unsafe { poses_out(&poses, joints, buffers) }
     })
 }

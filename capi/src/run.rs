@@ -10,7 +10,7 @@ use sinmdm::Run;
 use crate::model::SinmdmModel;
 use crate::result::SinmdmResult;
 use crate::status::{Failure, SinmdmStatus, guard, guard_out};
-use crate::text::{give, handle};
+use crate::text::{give, handle_mut};
 
 /// A task being run (opaque): it owns its plan, schedule, guidance, noise and sample, not the
 /// model; each step is given the model it was begun on.
@@ -39,7 +39,7 @@ pub(crate) unsafe fn begin(
 ) -> SinmdmStatus {
     unsafe {
         guard_out(out, |out| {
-            let model = handle(model, "model")?;
+            let model = handle_mut(model, "model")?;
             let request = make(model)?;
             let run = sinmdm::plan(model.model.metadata(), &request)?.start()?;
             give(
@@ -69,7 +69,7 @@ pub(crate) unsafe fn blocking(
         guard_out(out, |out| {
             let mut run: *mut SinmdmRun = std::ptr::null_mut();
             let status = begin_task(&mut run);
-            if status != SinmdmStatus::SinmdmOk {
+            if status != SinmdmStatus::Ok {
                 return Err(Failure::new(
                     status,
                     std::ffi::CStr::from_ptr(crate::status::sinmdm_last_error())
@@ -78,7 +78,7 @@ pub(crate) unsafe fn blocking(
                 ));
             }
             let owned = crate::text::take_handle(run);
-            let model = handle(model, "model")?;
+            let model = handle_mut(model, "model")?;
             let progress = model.progress;
             let mut run = owned.run.expect("a run just begun is live");
             let mut stopped = false;
@@ -128,8 +128,8 @@ pub unsafe extern "C" fn sinmdm_run_step(
     total: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
-        let run = unsafe { handle(run, "run") }?;
-        let model = unsafe { handle(model, "model") }?;
+        let run = unsafe { handle_mut(run, "run") }?;
+        let model = unsafe { handle_mut(model, "model") }?;
         model.check_same(run.model, "run")?;
         let progress = run.live()?.step(&mut model.model, max_steps)?;
         if !done.is_null() {
@@ -159,7 +159,7 @@ pub unsafe extern "C" fn sinmdm_run_finish(
 ) -> SinmdmStatus {
     unsafe {
         guard_out(out, |out| {
-            let run = handle(run, "run")?;
+            let run = handle_mut(run, "run")?;
             let live = run.live()?;
             if live.progress().done == 0 {
                 return Err(Failure::invalid(format!(

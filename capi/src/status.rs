@@ -1,10 +1,11 @@
 //! Status codes, the thread-local last error, and the guard every entry point runs in: a panic
-//! is caught and reported as [`SinmdmStatus::SinmdmInternal`], never unwound into the caller.
+//! is caught and reported as [`SinmdmStatus::Internal`], never unwound into the caller.
 
 use std::cell::RefCell;
 use std::ffi::{CString, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+/// cbindgen:rename-all=QualifiedScreamingSnakeCase
 /// What a call did. Every function returns one; on anything but `SINMDM_OK`,
 /// `sinmdm_last_error` says why, in words that name the argument, field or file. One kind of
 /// mistake always gets the same status, whichever function it is made at.
@@ -12,33 +13,33 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SinmdmStatus {
     /// It worked.
-    SinmdmOk = 0,
+    Ok = 0,
     /// A pointer that must not be NULL was NULL.
-    SinmdmNullArgument = 1,
+    NullArgument = 1,
     /// An argument outside its documented range, or malformed: a count, length, step count,
     /// ramp, span, joint index, factor, share or thread count past its bound (`SINMDM_MAX_*`),
     /// an unknown constant, a string that is not UTF-8, poses that do not fit the skeleton, a
     /// handle used with another model, or a call its handle's state does not allow.
-    SinmdmInvalidArgument = 2,
+    InvalidArgument = 2,
     /// An output buffer too small; nothing was written and the message gives the size needed
     /// (pass a NULL buffer to ask for it).
-    SinmdmBufferTooSmall = 3,
+    BufferTooSmall = 3,
     /// A joint name the skeleton does not have.
-    SinmdmUnknownJoint = 4,
+    UnknownJoint = 4,
     /// onnxruntime could not be found or loaded (the message lists where it was looked for).
-    SinmdmRuntimeLibrary = 5,
+    RuntimeLibrary = 5,
     /// A model file that could not be opened or is not a valid model.
-    SinmdmBadModel = 6,
+    BadModel = 6,
     /// A valid request whose run failed inside onnxruntime (out of memory, say).
-    SinmdmTaskFailed = 7,
+    TaskFailed = 7,
     /// Reading or writing a file failed.
-    SinmdmIo = 8,
+    Io = 8,
     /// A bug in the library (a caught panic); the handle involved should be freed.
-    SinmdmInternal = 9,
+    Internal = 9,
     /// A blocking task's progress callback asked to stop, after any step, the last included: the
     /// call gives no result and the model can be used on. Only blocking tasks call the callback,
     /// so a stepped run (`sinmdm_run_step`) never gives this; a host stops one by freeing it.
-    SinmdmCancelled = 10,
+    Cancelled = 10,
 }
 
 /// A failed call: its status and message.
@@ -57,14 +58,11 @@ impl Failure {
     }
 
     pub fn null(argument: &str) -> Failure {
-        Failure::new(
-            SinmdmStatus::SinmdmNullArgument,
-            format!("{argument} is NULL"),
-        )
+        Failure::new(SinmdmStatus::NullArgument, format!("{argument} is NULL"))
     }
 
     pub fn invalid(message: impl Into<String>) -> Failure {
-        Failure::new(SinmdmStatus::SinmdmInvalidArgument, message)
+        Failure::new(SinmdmStatus::InvalidArgument, message)
     }
 }
 
@@ -73,10 +71,10 @@ impl From<sinmdm::TaskError> for Failure {
         use sinmdm::TaskError;
         let status = match &e {
             TaskError::Model(model) => return Failure::from_model(model, e.to_string()),
-            TaskError::UnknownJoint { .. } => SinmdmStatus::SinmdmUnknownJoint,
-            TaskError::Cancelled { .. } => SinmdmStatus::SinmdmCancelled,
+            TaskError::UnknownJoint { .. } => SinmdmStatus::UnknownJoint,
+            TaskError::Cancelled { .. } => SinmdmStatus::Cancelled,
             // Everything else is a request checked before it runs: an argument out of range.
-            _ => SinmdmStatus::SinmdmInvalidArgument,
+            _ => SinmdmStatus::InvalidArgument,
         };
         Failure::new(status, e.to_string())
     }
@@ -93,12 +91,12 @@ impl Failure {
     fn from_model(e: &sinmdm::ModelError, message: String) -> Failure {
         use sinmdm::ModelError;
         let status = match e {
-            ModelError::Runtime(_) => SinmdmStatus::SinmdmRuntimeLibrary,
+            ModelError::Runtime(_) => SinmdmStatus::RuntimeLibrary,
             ModelError::Threads(_)
             | ModelError::FeatureRows { .. }
-            | ModelError::StepCount { .. } => SinmdmStatus::SinmdmInvalidArgument,
-            ModelError::Run { .. } => SinmdmStatus::SinmdmTaskFailed,
-            _ => SinmdmStatus::SinmdmBadModel,
+            | ModelError::StepCount { .. } => SinmdmStatus::InvalidArgument,
+            ModelError::Run { .. } => SinmdmStatus::TaskFailed,
+            _ => SinmdmStatus::BadModel,
         };
         Failure::new(status, message)
     }
@@ -143,7 +141,7 @@ pub(crate) fn guard(body: impl FnOnce() -> Result<(), Failure>) -> SinmdmStatus 
     match catch_unwind(AssertUnwindSafe(body)) {
         Ok(Ok(())) => {
             set_last_error("");
-            SinmdmStatus::SinmdmOk
+            SinmdmStatus::Ok
         }
         Ok(Err(failure)) => {
             set_last_error(&failure.message);
@@ -156,7 +154,7 @@ pub(crate) fn guard(body: impl FnOnce() -> Result<(), Failure>) -> SinmdmStatus 
                 .or_else(|| panic.downcast_ref::<String>().cloned())
                 .unwrap_or_default();
             set_last_error(&format!("internal error (please report it): {what}"));
-            SinmdmStatus::SinmdmInternal
+            SinmdmStatus::Internal
         }
     }
 }

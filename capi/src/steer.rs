@@ -17,7 +17,7 @@ use crate::sampling::{SinmdmSampling, request};
 use crate::status::{Failure, SinmdmStatus, guard};
 use crate::stream::SinmdmStream;
 use crate::tasks::sampling_arg;
-use crate::text::{handle, slice_arg};
+use crate::text::{handle_mut, handle_ref, slice_arg};
 
 /// A frame that asks for nothing: the model goes where it likes.
 pub const SINMDM_STEER_FREE: u32 = 0;
@@ -198,7 +198,7 @@ where
 /// # Safety
 /// `model` is a live handle (or NULL, refused).
 unsafe fn limits_of(model: *const SinmdmModel) -> Result<SteerLimits, Failure> {
-    let m = unsafe { handle(model.cast_mut(), "model") }?;
+    let m = unsafe { handle_ref(model, "model") }?;
     SteerLimits::of(m.model.metadata()).ok_or_else(|| {
         Failure::invalid(
             "the model has no heading-relative root, so it cannot be steered (train it with --root-layout heading)",
@@ -260,7 +260,7 @@ where
     for<'a> &'a T: Into<SinmdmSteerCommand>,
 {
     guard(|| {
-        let stream = unsafe { handle(stream, "stream") }?;
+        let stream = unsafe { handle_mut(stream, "stream") }?;
         let commands = unsafe { commands_arg(commands, count, last_kind) }?;
         stream.stream.steer(&commands)?;
         Ok(())
@@ -285,7 +285,7 @@ pub unsafe extern "C" fn sinmdm_steer_limits(
 ) -> SinmdmStatus {
     guard(|| {
         let limits = unsafe { limits_of(model) }?;
-        let out = unsafe { handle(out, "out") }?;
+        let out = unsafe { handle_mut(out, "out") }?;
         *out = SinmdmSteerLimits {
             forward_min: limits.forward.0,
             forward_max: limits.forward.1,
@@ -449,7 +449,7 @@ pub unsafe extern "C" fn sinmdm_steer_sideways_limits(
 ) -> SinmdmStatus {
     guard(|| {
         let limits = unsafe { limits_of(model) }?;
-        let out = unsafe { handle(out, "out") }?;
+        let out = unsafe { handle_mut(out, "out") }?;
         *out = SinmdmSteerSideways {
             leftward_min: limits.sideways.0,
             leftward_max: limits.sideways.1,

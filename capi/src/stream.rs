@@ -7,13 +7,13 @@ use crate::model::SinmdmModel;
 use crate::poses::{SinmdmPoseBuffers, SinmdmPoses, pose_slices, poses_in, poses_out};
 use crate::sampling::{feet_arg, method_arg, steps_or};
 use crate::status::{Failure, SinmdmStatus, guard, guard_out};
-use crate::text::{give, handle, slice_arg};
+use crate::text::{give, handle_mut, handle_ref, slice_arg};
 
 /// An error of a stream's block, whose arguments were checked when the stream was made: motion
 /// that cannot be decoded came from the network, so it is a failed run, not a bad argument.
 fn made_by_the_run(e: sinmdm::TaskError) -> Failure {
     match e {
-        sinmdm::TaskError::Motion(m) => Failure::new(SinmdmStatus::SinmdmTaskFailed, m.to_string()),
+        sinmdm::TaskError::Motion(m) => Failure::new(SinmdmStatus::TaskFailed, m.to_string()),
         other => Failure::from(other),
     }
 }
@@ -62,8 +62,8 @@ pub unsafe extern "C" fn sinmdm_stream_new(
 ) -> SinmdmStatus {
     unsafe {
         guard_out(out, |out| {
-            let model = handle(model.cast_mut(), "model")?;
-            let o = *handle(options.cast_mut(), "options")?;
+            let model = handle_ref(model, "model")?;
+            let o = *handle_ref(options, "options")?;
             if o.compose_joint_count > SINMDM_MAX_JOINT_INDICES {
                 return Err(Failure::invalid(format!(
                     "compose_joint_count is {}; at most {SINMDM_MAX_JOINT_INDICES} joint indices are taken",
@@ -111,8 +111,8 @@ pub unsafe extern "C" fn sinmdm_stream_supply(
     poses: *const SinmdmPoses,
 ) -> SinmdmStatus {
     guard(|| {
-        let stream = unsafe { handle(stream, "stream") }?;
-        let model = unsafe { handle(model.cast_mut(), "model") }?;
+        let stream = unsafe { handle_mut(stream, "stream") }?;
+        let model = unsafe { handle_ref(model, "model") }?;
         model.check_same(stream.model, "stream")?;
         stream
             .stream
@@ -139,8 +139,8 @@ pub unsafe extern "C" fn sinmdm_stream_next(
     buffers: *const SinmdmPoseBuffers,
 ) -> SinmdmStatus {
     guard(|| {
-        let stream = unsafe { handle(stream, "stream") }?;
-        let model = unsafe { handle(model, "model") }?;
+        let stream = unsafe { handle_mut(stream, "stream") }?;
+        let model = unsafe { handle_mut(model, "model") }?;
         model.check_same(stream.model, "stream")?;
         if frames > SINMDM_MAX_SAMPLE_FRAMES {
             return Err(Failure::invalid(format!(
@@ -181,8 +181,8 @@ pub unsafe extern "C" fn sinmdm_stream_step(
     total: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
-        let stream = unsafe { handle(stream, "stream") }?;
-        let model = unsafe { handle(model, "model") }?;
+        let stream = unsafe { handle_mut(stream, "stream") }?;
+        let model = unsafe { handle_mut(model, "model") }?;
         model.check_same(stream.model, "stream")?;
         if ahead > SINMDM_MAX_SAMPLE_FRAMES {
             return Err(Failure::invalid(format!(

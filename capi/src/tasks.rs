@@ -10,7 +10,7 @@ use crate::result::SinmdmResult;
 use crate::run::{SinmdmRun, begin, blocking};
 use crate::sampling::{SinmdmSampling, SinmdmSpan, request};
 use crate::status::{Failure, SinmdmStatus};
-use crate::text::{handle, slice_arg};
+use crate::text::{handle_ref, slice_arg};
 
 /// The sampling settings behind a pointer.
 ///
@@ -19,7 +19,7 @@ use crate::text::{handle, slice_arg};
 pub(crate) unsafe fn sampling_arg(
     sampling: *const SinmdmSampling,
 ) -> Result<SinmdmSampling, Failure> {
-    Ok(*unsafe { handle(sampling.cast_mut(), "sampling") }?)
+    Ok(*unsafe { handle_ref(sampling, "sampling") }?)
 }
 
 /// Reference poses as raw features in the model's layout.

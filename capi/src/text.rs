@@ -37,7 +37,7 @@ pub(crate) unsafe fn copy_str(
     }
     if capacity < size {
         return Err(Failure::new(
-            SinmdmStatus::SinmdmBufferTooSmall,
+            SinmdmStatus::BufferTooSmall,
             format!("the text needs {size} bytes with its NUL, the buffer holds {capacity}"),
         ));
     }
@@ -110,18 +110,34 @@ pub(crate) unsafe fn out_slice<'a, T>(
     }
     if capacity < needed {
         return Err(Failure::new(
-            SinmdmStatus::SinmdmBufferTooSmall,
+            SinmdmStatus::BufferTooSmall,
             format!("{argument} holds {capacity} values, {needed} are needed"),
         ));
     }
     Ok(unsafe { std::slice::from_raw_parts_mut(data, needed) })
 }
 
-/// The handle behind a pointer.
+/// The handle or struct behind a `const` pointer, shared: what the C signature promises not to
+/// change is never reached through `&mut`.
 ///
 /// # Safety
-/// `handle` is NULL or a live handle of type `T` made by this library.
-pub(crate) unsafe fn handle<'a, T>(handle: *mut T, argument: &str) -> Result<&'a mut T, Failure> {
+/// `handle` is NULL or points to a live `T` (a handle made by this library, or a caller's
+/// struct) that nothing changes during the call.
+pub(crate) unsafe fn handle_ref<'a, T>(handle: *const T, argument: &str) -> Result<&'a T, Failure> {
+    if handle.is_null() {
+        return Err(Failure::null(argument));
+    }
+    Ok(unsafe { &*handle })
+}
+
+/// The handle or out-struct behind a `mut` pointer, exclusive.
+///
+/// # Safety
+/// `handle` is NULL or points to a live `T` that nothing else reaches during the call.
+pub(crate) unsafe fn handle_mut<'a, T>(
+    handle: *mut T,
+    argument: &str,
+) -> Result<&'a mut T, Failure> {
     if handle.is_null() {
         return Err(Failure::null(argument));
     }

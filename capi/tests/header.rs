@@ -32,6 +32,19 @@ fn introduction(crate_dir: &Path) -> String {
     format!("/*\n{}\n */", body.join("\n"))
 }
 
+/// The status codes as C hosts write them: `SINMDM_OK`, not `SINMDM_STATUS_OK`. In Rust they are
+/// `SinmdmStatus::Ok` and so on; cbindgen qualifies each with the whole enum name, and this
+/// shortens the qualifier to the library's prefix.
+fn short_status_names(generated: &str) -> String {
+    const QUALIFIED: &str = "SINMDM_STATUS_";
+    let qualified = generated.matches(QUALIFIED).count();
+    assert_eq!(
+        qualified, 11,
+        "the status enum has 11 codes; cbindgen wrote {qualified}"
+    );
+    generated.replace(QUALIFIED, "SINMDM_")
+}
+
 #[test]
 fn the_committed_header_is_current() {
     let crate_dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
@@ -44,7 +57,7 @@ fn the_committed_header_is_current() {
         .generate()
         .expect("cbindgen could not read the crate")
         .write(&mut generated);
-    let generated = String::from_utf8(generated).unwrap();
+    let generated = short_status_names(&String::from_utf8(generated).unwrap());
     let path = crate_dir.join("include/sinmdm.h");
     if std::env::var_os("SINMDM_BLESS").is_some() {
         std::fs::write(&path, &generated).unwrap();
