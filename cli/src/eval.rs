@@ -112,18 +112,7 @@ struct EvalFile<'a> {
 }
 
 pub(crate) fn run(args: &EvalArgs) -> Result<()> {
-    if args.samples == 0 {
-        bail!("--samples must be at least 1");
-    }
-    if !(args.replay_tolerance.is_finite() && args.replay_tolerance >= 0.0) {
-        bail!(
-            "--replay-tolerance must be a finite number >= 0, got {}",
-            args.replay_tolerance
-        );
-    }
-    if args.threads == Some(0) {
-        bail!("--threads must be at least 1");
-    }
+    check_args(args)?;
     let default_steps = if args.stream {
         DEFAULT_STREAM_STEPS
     } else {
@@ -131,13 +120,6 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     };
     let steps = parse_steps(args.steps.as_deref().unwrap_or(default_steps))?;
     let method = args.method.method()?;
-    let outputs: Vec<PathBuf> = args
-        .json
-        .iter()
-        .chain(args.features_json.iter())
-        .cloned()
-        .collect();
-    check_writable(&outputs)?;
     let mut model = Model::open(
         &args.model,
         &ModelOptions {
@@ -151,20 +133,130 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         bail!("--frames must be at least {COVERAGE_WINDOW} (the coverage window), got {frames}");
     }
     let training = model.metadata().training.clone();
+    note_another_clip(&training, &args.clip, clip_frames);
+    let made = what_to_make(args, &model, &clip, frames)?;
+    let sampling = Sampling {
+        frames,
+        steps,
+        method,
+        threads: args.threads.unwrap_or_else(|| {
+            std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+        }),
+    };
+    let evaluation = sample_and_score(args, &mut model, &clip, &made, &sampling)?;
+    let replay = if args.replay_tolerance == evaluation.replay.tolerance {
+        evaluation.replay.clone()
+    } else {
+        ReplayReport::of_features(
+            evaluation.generated.layout(),
+            clip.view(),
+            evaluation.generated.features.view(),
+            args.replay_tolerance,
+        )
+    };
+    if let Some(commands) = &made.commands {
+        crate::steer::print_following(&evaluation.generated, model.metadata(), commands);
+    }
+    crate::steer::print_facing(&evaluation.generated, clip.view());
+    println!(
+        "model {} ({} training steps), clip {} ({} frames at {} fps)",
+        args.model.display(),
+        training.steps,
+        args.clip.display(),
+        clip_frames,
+        evaluation.generated.layout().fps
+    );
+    println!(
+        "{} samples x {} frames{}, {} {} steps, seed {}: sampled in {:.1} s, scored in {:.1} s",
+        args.samples,
+        frames,
+        if args.stream { " (streamed)" } else { "" },
+        steps_text(steps),
+        method.name(),
+        args.seed,
+        evaluation.sampling_seconds,
+        evaluation.scoring_seconds
+    );
+    print_reports(&evaluation, &replay);
+    let beats = made.dance.as_ref().map(|dance| {
+        let scores = dance.scores(&evaluation.planted, args.seed);
+        println!();
+        crate::dance::print_scores(&scores);
+        sinmdm_eval::mean_beat_scores(&scores)
+    });
+    if let Some(path) = &args.features_json {
+        let generated = &evaluation.generated;
+        write_features(path, generated.layout(), generated.features.view())?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.json {
+        write_json(
+            path,
+            args,
+            &training,
+            &sampling,
+            &evaluation,
+            &replay,
+            beats,
+        )?;
+    }
+    Ok(())
+}
+
+/// Says so when the clip scored against is not the one the model was trained on.
+fn note_another_clip(training: &sinmdm::model_file::TrainingFacts, clip: &Path, frames: usize) {
     let trained_on = Path::new(&training.clip);
-    if args.clip.file_name() != trained_on.file_name() || clip_frames != training.clip_frames {
+    if clip.file_name() != trained_on.file_name() || frames != training.clip_frames {
         eprintln!(
             "note: the model was trained on {} ({} frames); scoring against {} ({} frames)",
             training.clip,
             training.clip_frames,
-            args.clip.display(),
-            clip_frames
+            clip.display(),
+            frames
         );
     }
+}
 
+/// The arguments no clip or model is needed to refuse.
+fn check_args(args: &EvalArgs) -> Result<()> {
+    if args.samples == 0 {
+        bail!("--samples must be at least 1");
+    }
+    if !(args.replay_tolerance.is_finite() && args.replay_tolerance >= 0.0) {
+        bail!(
+            "--replay-tolerance must be a finite number >= 0, got {}",
+            args.replay_tolerance
+        );
+    }
+    if args.threads == Some(0) {
+        bail!("--threads must be at least 1");
+    }
     if args.stream && args.dance.has_music() {
         bail!("--stream and a dance's music (--music, --beats, --bpm) do not go together");
     }
+    let outputs: Vec<PathBuf> = args
+        .json
+        .iter()
+        .chain(args.features_json.iter())
+        .cloned()
+        .collect();
+    check_writable(&outputs)
+}
+
+/// What the samples are asked to be: free motion, a dance to music, or a steered course.
+struct WhatToMake {
+    dance: Option<crate::dance::Dance>,
+    commands: Option<Vec<sinmdm::steer::SteerFrame>>,
+    task: Task,
+}
+
+/// The task of the samples, from the dance and course arguments.
+fn what_to_make(
+    args: &EvalArgs,
+    model: &Model,
+    clip: &ndarray::Array2<f32>,
+    frames: usize,
+) -> Result<WhatToMake> {
     let dance = if args.dance.has_music() {
         let dance = crate::dance::build_dance(
             &model.metadata().layout,
@@ -199,17 +291,40 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         },
         (None, None) => Task::Generate { frames },
     };
-    let request = Request {
+    Ok(WhatToMake {
+        dance,
+        commands,
         task,
-        count: args.samples,
-        seed: args.seed,
+    })
+}
+
+/// How the samples are made: their length, steps, update rule and threads.
+struct Sampling {
+    frames: usize,
+    steps: Option<usize>,
+    method: sinmdm::Method,
+    threads: usize,
+}
+
+/// The step count as the report and the JSON write it.
+fn steps_text(steps: Option<usize>) -> String {
+    steps.map_or("all".to_string(), |s| s.to_string())
+}
+
+/// Makes the samples, in one batched run or as streams, and scores them against the clip.
+fn sample_and_score(
+    args: &EvalArgs,
+    model: &mut Model,
+    clip: &ndarray::Array2<f32>,
+    made: &WhatToMake,
+    sampling: &Sampling,
+) -> Result<ModelEvaluation> {
+    let Sampling {
+        frames,
         steps,
-        feet: Feet::Planted,
         method,
-    };
-    let threads = args.threads.unwrap_or_else(|| {
-        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-    });
+        threads,
+    } = *sampling;
     // The run's step count comes with each progress call: the request is planned once, inside.
     let bar = progress_bar(
         args.quiet,
@@ -231,10 +346,10 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
                 ..StreamOptions::default()
             };
             let mut stream = Stream::new(&metadata, options)?;
-            if let Some(commands) = &commands {
+            if let Some(commands) = &made.commands {
                 stream.steer(commands)?;
             }
-            let chunk = stream.next(&mut model, frames)?;
+            let chunk = stream.next(model, frames)?;
             for warning in stream.warnings() {
                 eprintln!("warning: {warning}");
             }
@@ -251,8 +366,16 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
             started.elapsed().as_secs_f64(),
         )
     } else {
+        let request = Request {
+            task: made.task.clone(),
+            count: args.samples,
+            seed: args.seed,
+            steps,
+            feet: Feet::Planted,
+            method,
+        };
         evaluate_model(
-            &mut model,
+            model,
             &metadata,
             &request,
             clip.view(),
@@ -266,6 +389,11 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     }
     .with_context(|| format!("cannot score against {}", args.clip.display()))?;
     bar.finish_and_clear();
+    Ok(evaluation)
+}
+
+/// The scores' tables: raw, body alone, planted, feet, kinematics and replay.
+fn print_reports(evaluation: &ModelEvaluation, replay: &ReplayReport) {
     let ModelEvaluation {
         generated,
         report,
@@ -274,51 +402,12 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         planted_report,
         feet,
         kinematics,
-        planted,
-        replay,
-        sampling_seconds,
-        scoring_seconds,
+        ..
     } = evaluation;
-    let layout = generated.layout();
-    let replay = if args.replay_tolerance == replay.tolerance {
-        replay
-    } else {
-        ReplayReport::of_features(
-            layout,
-            clip.view(),
-            generated.features.view(),
-            args.replay_tolerance,
-        )
-    };
-
-    if let Some(commands) = &commands {
-        crate::steer::print_following(&generated, model.metadata(), commands);
-    }
-    crate::steer::print_facing(&generated, clip.view());
-    let steps_text = steps.map_or("all".to_string(), |s| s.to_string());
-    println!(
-        "model {} ({} training steps), clip {} ({} frames at {} fps)",
-        args.model.display(),
-        training.steps,
-        args.clip.display(),
-        clip_frames,
-        layout.fps
-    );
-    println!(
-        "{} samples x {} frames{}, {} {} steps, seed {}: sampled in {:.1} s, scored in {:.1} s",
-        args.samples,
-        frames,
-        if args.stream { " (streamed)" } else { "" },
-        steps_text,
-        method.name(),
-        args.seed,
-        sampling_seconds,
-        scoring_seconds
-    );
     println!();
     println!("samples as the network made them (--feet raw):");
     print!("{}", report.markdown_table());
-    print_rarely_made(&report, layout.fps);
+    print_rarely_made(report, generated.layout().fps);
     println!(
         "the body alone (no root rotation, which the root layouts mean differently): coverage {:.1}, \
          global diversity {:.3}, local {:.3}, intra diversity diff {:.3} (clip's own {:.3})",
@@ -343,8 +432,13 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
     println!();
     print!("{}", feet.markdown_table());
     println!();
-    print_kinematics(&kinematics);
+    print_kinematics(kinematics);
     println!();
+    print_replay(replay);
+}
+
+/// The replay line, with the floors the clip itself puts under it.
+fn print_replay(replay: &ReplayReport) {
     print!(
         "replay: the samples' longest verbatim copies of the clip (frames within {} root-mean-square \
          per 6D component) last {:.2} s on average, {:.2} s at most",
@@ -367,47 +461,43 @@ pub(crate) fn run(args: &EvalArgs) -> Result<()> {
         );
     }
     println!();
+}
 
-    let beats = match &dance {
-        Some(dance) => {
-            let scores = dance.scores(&planted, args.seed);
-            println!();
-            crate::dance::print_scores(&scores);
-            Some(sinmdm_eval::mean_beat_scores(&scores))
-        }
-        None => None,
+/// Writes `--json`: the run's arguments and every score.
+fn write_json(
+    path: &Path,
+    args: &EvalArgs,
+    training: &sinmdm::model_file::TrainingFacts,
+    sampling: &Sampling,
+    evaluation: &ModelEvaluation,
+    replay: &ReplayReport,
+    beats: Option<sinmdm_eval::BeatScores>,
+) -> Result<()> {
+    let file = EvalFile {
+        format: "sinmdm-eval",
+        version: 1,
+        model: args.model.display().to_string(),
+        clip: args.clip.display().to_string(),
+        model_training_steps: training.steps,
+        samples: args.samples,
+        frames: sampling.frames,
+        steps: steps_text(sampling.steps),
+        sampler: sampling.method.name(),
+        seed: args.seed,
+        sampling_seconds: evaluation.sampling_seconds,
+        report: &evaluation.report,
+        body_report: &evaluation.body_report,
+        raw_motion_report: &evaluation.raw_motion_report,
+        planted_report: &evaluation.planted_report,
+        feet: &evaluation.feet,
+        kinematics: &evaluation.kinematics,
+        replay,
+        beats,
     };
-    if let Some(path) = &args.features_json {
-        write_features(path, layout, generated.features.view())?;
-        eprintln!("wrote {}", path.display());
-    }
-    if let Some(path) = &args.json {
-        let file = EvalFile {
-            format: "sinmdm-eval",
-            version: 1,
-            model: args.model.display().to_string(),
-            clip: args.clip.display().to_string(),
-            model_training_steps: training.steps,
-            samples: args.samples,
-            frames,
-            steps: steps_text,
-            sampler: method.name(),
-            seed: args.seed,
-            sampling_seconds,
-            report: &report,
-            body_report: &body_report,
-            raw_motion_report: &raw_motion_report,
-            planted_report: &planted_report,
-            feet: &feet,
-            kinematics: &kinematics,
-            replay: &replay,
-            beats,
-        };
-        let text = serde_json::to_string_pretty(&file)?;
-        write_atomically(path, text.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        eprintln!("wrote {}", path.display());
-    }
+    let text = serde_json::to_string_pretty(&file)?;
+    write_atomically(path, text.as_bytes())
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    eprintln!("wrote {}", path.display());
     Ok(())
 }
 
