@@ -8,6 +8,7 @@
 
 mod dance;
 mod generated;
+mod guidance;
 mod joints;
 pub mod mask;
 mod plan;
