@@ -12,8 +12,8 @@ use crate::clip_files::read_motion_file_and_source;
 use sinmdm::files::write_atomically;
 use sinmdm::motion::up::{UP, file_axis_name};
 use sinmdm::motion::{
-    ContactConfig, EncodeOptions, decode, encode, fk, global_poses, math, max_position_error,
-    skeleton::Channel,
+    ChannelClip, ContactConfig, EncodeOptions, EncodedClip, FeatureLayout, Skeleton, decode,
+    encode, fk, global_poses, math, max_position_error, skeleton::Channel,
 };
 
 pub(crate) const EXAMPLES: &str = "Examples:
@@ -83,21 +83,7 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
             return Err(error);
         }
     };
-    let animations = &source.animations;
-    if !animations.is_empty() {
-        println!("animations {}", animations.len());
-        for a in animations {
-            let still = match a.still {
-                Some(true) => " (still: nothing moves)",
-                _ => "",
-            };
-            println!(
-                "  {} {:.2} s{still}",
-                crate::clip_files::describe_animation(a),
-                a.seconds
-            );
-        }
-    }
+    print_animations(&source.animations);
     let options = EncodeOptions {
         fps: args.fps,
         contacts: ContactConfig {
@@ -110,6 +96,41 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     };
     let encoded = encode(&clip, &options)
         .with_context(|| format!("{}: cannot encode the clip", args.clip.display()))?;
+    print!("{}", describe(args, &clip, &encoded));
+    if let Some(path) = &args.positions {
+        let json = positions_json(&clip)?;
+        write_atomically(path, json.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        println!("\npositions  written to {}", path.display());
+    }
+    if let Some(path) = &args.roundtrip {
+        write_roundtrip(path, &clip, &encoded)?;
+    }
+    Ok(())
+}
+
+/// The file's animations, marking those in which nothing moves.
+fn print_animations(animations: &[sinmdm_formats::AnimationInfo]) {
+    if animations.is_empty() {
+        return;
+    }
+    println!("animations {}", animations.len());
+    for a in animations {
+        let still = match a.still {
+            Some(true) => " (still: nothing moves)",
+            _ => "",
+        };
+        println!(
+            "  {} {:.2} s{still}",
+            crate::clip_files::describe_animation(a),
+            a.seconds
+        );
+    }
+}
+
+/// What the model will see of the clip: its frames, joints, up axis, units, root, facing,
+/// contacts and features, then the joint table.
+fn describe(args: &InspectArgs, clip: &ChannelClip, encoded: &EncodedClip) -> String {
     let layout = &encoded.layout;
     let skeleton = &clip.skeleton;
     let frames = clip.frame_count();
@@ -147,63 +168,9 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
     let height = layout.skeleton_height;
     let _ = writeln!(out, "height     {height:.3} file units along {}", layout.up);
     let _ = writeln!(out, "units      {}", units_guess(height));
-    match &layout.root {
-        Some(root) => {
-            let axes: Vec<String> = if root.heading.is_some() {
-                let up = file_axis_name(layout.up, UP);
-                vec![
-                    "forward".into(),
-                    "leftward".into(),
-                    "turn".into(),
-                    format!("height({up})"),
-                ]
-            } else {
-                root.axes
-                    .iter()
-                    .map(|a| {
-                        let name = file_axis_name(layout.up, a.index());
-                        if a.index() == UP {
-                            format!("height({name})")
-                        } else {
-                            format!("d{name}")
-                        }
-                    })
-                    .collect()
-            };
-            let s = root.start_position;
-            let _ = writeln!(
-                out,
-                "root       {} -> {} (start {:.3} {:.3} {:.3}, canonical Y-up)",
-                skeleton.joints[root.joint].name,
-                axes.join(" "),
-                s[0],
-                s[1],
-                s[2]
-            );
-        }
-        None => {
-            let _ = writeln!(
-                out,
-                "root       no position channels: the clip stays in place"
-            );
-        }
-    }
+    let _ = writeln!(out, "root       {}", root_line(layout, skeleton));
     if let Some(h) = layout.root.as_ref().and_then(|r| r.heading.as_ref()) {
-        let _ = writeln!(
-            out,
-            "facing     across {} (left) and {} (right), sides told by {}, smoothed over {} s; starts at {:.1} degrees",
-            skeleton.joints[h.left].name,
-            skeleton.joints[h.right].name,
-            match h.sides {
-                sinmdm::motion::features::heading::SideEvidence::Names => "their names",
-                sinmdm::motion::features::heading::SideEvidence::Travel =>
-                    "the travel (forward is where the clip goes)",
-                sinmdm::motion::features::heading::SideEvidence::Unresolved =>
-                    "nothing: neither names nor travel say, so forward may be the back",
-            },
-            h.smoothing,
-            h.start.to_degrees()
-        );
+        let _ = writeln!(out, "facing     {}", facing_line(h, skeleton));
     }
     let _ = writeln!(
         out,
@@ -240,6 +207,68 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
         layout.position_channels.len(),
         layout.contact_joints.len()
     );
+    out.push_str(&joint_table(skeleton));
+    out
+}
+
+/// The root's joint and feature axes, or that it has no position channels.
+fn root_line(layout: &FeatureLayout, skeleton: &Skeleton) -> String {
+    let Some(root) = &layout.root else {
+        return "no position channels: the clip stays in place".into();
+    };
+    let axes: Vec<String> = if root.heading.is_some() {
+        let up = file_axis_name(layout.up, UP);
+        vec![
+            "forward".into(),
+            "leftward".into(),
+            "turn".into(),
+            format!("height({up})"),
+        ]
+    } else {
+        root.axes
+            .iter()
+            .map(|a| {
+                let name = file_axis_name(layout.up, a.index());
+                if a.index() == UP {
+                    format!("height({name})")
+                } else {
+                    format!("d{name}")
+                }
+            })
+            .collect()
+    };
+    let s = root.start_position;
+    format!(
+        "{} -> {} (start {:.3} {:.3} {:.3}, canonical Y-up)",
+        skeleton.joints[root.joint].name,
+        axes.join(" "),
+        s[0],
+        s[1],
+        s[2]
+    )
+}
+
+/// How a heading-relative root reads the facing: across which joints, told apart by what.
+fn facing_line(h: &sinmdm::motion::features::Heading, skeleton: &Skeleton) -> String {
+    use sinmdm::motion::features::heading::SideEvidence;
+    format!(
+        "across {} (left) and {} (right), sides told by {}, smoothed over {} s; starts at {:.1} degrees",
+        skeleton.joints[h.left].name,
+        skeleton.joints[h.right].name,
+        match h.sides {
+            SideEvidence::Names => "their names",
+            SideEvidence::Travel => "the travel (forward is where the clip goes)",
+            SideEvidence::Unresolved =>
+                "nothing: neither names nor travel say, so forward may be the back",
+        },
+        h.smoothing,
+        h.start.to_degrees()
+    )
+}
+
+/// Every joint with its parent and channels, one line each under a header.
+fn joint_table(skeleton: &Skeleton) -> String {
+    let mut out = String::new();
     let _ = writeln!(
         out,
         "\n  #  joint                      parent                     channels"
@@ -257,34 +286,34 @@ pub(crate) fn run(args: &InspectArgs) -> Result<()> {
             channels.join(" ")
         );
     }
-    print!("{out}");
+    out
+}
 
-    if let Some(path) = &args.positions {
-        let json = positions_json(&clip)?;
-        write_atomically(path, json.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        println!("\npositions  written to {}", path.display());
-    }
-
-    if let Some(path) = &args.roundtrip {
-        let motion = decode(layout, encoded.features.view())?;
-        let written = motion.to_channels();
-        write_bvh(path, &written)?;
-        print!(
-            "\nroundtrip  written to {} at {} fps",
-            path.display(),
-            trim_float(layout.fps)
+/// Writes the clip encoded and decoded again as BVH, with the largest position error when the
+/// frame rate is the clip's own.
+fn write_roundtrip(
+    path: &std::path::Path,
+    clip: &ChannelClip,
+    encoded: &EncodedClip,
+) -> Result<()> {
+    let layout = &encoded.layout;
+    let motion = decode(layout, encoded.features.view())?;
+    let written = motion.to_channels();
+    write_bvh(path, &written)?;
+    print!(
+        "\nroundtrip  written to {} at {} fps",
+        path.display(),
+        trim_float(layout.fps)
+    );
+    if (layout.fps - clip.fps).abs() < 1e-9 {
+        let worst = max_position_error(&clip.to_local(), &written.to_local())
+            .context("the round trip changed the frame or joint count")?;
+        println!(
+            "; largest joint position error {:.2e} x height",
+            worst / layout.skeleton_height.max(1e-12)
         );
-        if (layout.fps - clip.fps).abs() < 1e-9 {
-            let worst = max_position_error(&clip.to_local(), &written.to_local())
-                .context("the round trip changed the frame or joint count")?;
-            println!(
-                "; largest joint position error {:.2e} x height",
-                worst / height.max(1e-12)
-            );
-        } else {
-            println!();
-        }
+    } else {
+        println!();
     }
     Ok(())
 }
