@@ -1,4 +1,4 @@
-"""The rule that reads the clip (train/src/clip_rule.rs): the clip's own intra diversity the
+"""The rule that reads the clip (train/src/clip_rule/): the clip's own intra diversity the
 trainer reads before training, against the benchmark's measure computed with numpy from the
 features `sinmdm encode` writes, and the choice the default makes from it."""
 
@@ -11,8 +11,8 @@ import pytest
 
 from conftest import TRAIN, clips, encoded_clip
 
-# The benchmark's window for the intra diversity, and the rule's numbers (clip_rule.rs,
-# step_ladder.rs).
+# The benchmark's window for the intra diversity, and the rule's numbers (clip_rule/,
+# step_ladder/).
 LOCAL_WINDOW = 15
 CALM_INTRA_BELOW = 0.7
 LADDER_STEPS = [50, 75, 100, 150, 200, 250, 300, 400, 600, 1000]

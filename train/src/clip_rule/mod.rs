@@ -40,18 +40,23 @@
 use crate::clip_data::ClipData;
 use crate::config::{FromClip, TrainConfig};
 
+mod batch_pairing;
+mod calm;
+mod reading;
+mod window_cost;
+
+use batch_pairing::batch_line;
+pub use batch_pairing::{BATCH_ITEMS_MULTIPLE, paired_items};
+use calm::ladder_list;
+pub use calm::{calm_most_steps, calm_warmup_steps, not_calm_after_all};
+pub use reading::ClipReading;
+pub use window_cost::{
+    FITTED_STEPS_ROUNDING, WINDOW_STEP_COST_OFFSET, steps_at_window, window_step_cost,
+};
+
 /// The clip's own intra diversity under which a clip is calm.
 pub const CALM_INTRA_BELOW: f64 = 0.7;
 
-/// Warm-up steps of a calm clip's cosine schedule: a third of its steps.
-pub fn calm_warmup_steps(steps: u64) -> u64 {
-    (steps as f64 / 3.0).round() as u64
-}
-
-/// The most steps a calm clip trains: the step ladder's top rung.
-pub fn calm_most_steps() -> u64 {
-    crate::ladder_settings::LADDER_STEPS[crate::ladder_settings::LADDER_STEPS.len() - 1]
-}
 /// QnA window of a varied clip on two feet or fewer, meant at 30 fps (it follows the frame rate
 /// when the configuration's window does).
 pub const VARIED_WINDOW: usize = 5;
@@ -73,60 +78,6 @@ pub const MANY_FEET_DROPOUT: f64 = 0.3;
 /// the configuration's): a step of 96 channels at window 7 costs about 0.04 s on 2 cores, so the
 /// run takes what 17 000 steps of 64 channels at window 11 took (8.5-9 minutes).
 pub const MANY_FEET_STEPS: u64 = 13_000;
-/// How much of a training step does not grow with the QnA window, in window frames: a step at
-/// window `k` costs about as much as `WINDOW_STEP_COST_OFFSET + k` frames of window
-/// ([`window_step_cost`]). Whole runs of the dog walk with 96 channels on 2 cores took 0.040 s a
-/// step at window 7 (30 fps) and 0.066 s at window 19 (60 fps), 1.65x, against 1.71x here
-/// (docs/TRAINING_EXPERIMENTS.md, "Steps at a higher frame rate").
-pub const WINDOW_STEP_COST_OFFSET: f64 = 10.0;
-/// The steps fitted to a wider window's cost are rounded down to a multiple of this.
-pub const FITTED_STEPS_ROUNDING: u64 = 500;
-/// A varied clip that would train an odd count of copies of the clip a step, 3 or more, trains
-/// an even one: a multiple of this. The trainer shares a step's items among the cores, item by
-/// item, so an odd count leaves one of the two cores of the 10-minute goal's machine idle for
-/// part of every step: 3 items take as long as 4 (the rule's setting trained 13 000 steps of a
-/// dog of 409 frames in 13.2 minutes in 3 items, 7.2 in 2; docs/TRAINING_EXPERIMENTS.md, "Items
-/// in pairs"). A single copy is left alone: pairing it would double a step's frames, unmeasured.
-pub const BATCH_ITEMS_MULTIPLE: usize = 2;
-
-/// What the rule reads from a clip before training.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ClipReading {
-    /// Frames, at the rate the clip trains at.
-    pub frames: usize,
-    /// That rate.
-    pub fps: f64,
-    /// The clip's own intra diversity ([`sinmdm_eval::intra_diversity`] over
-    /// [`sinmdm_eval::LOCAL_WINDOW`]-frame windows of its metric features).
-    pub intra_diversity: f64,
-    /// Its feet: the contact joints its layout found (or the configuration named).
-    pub feet: usize,
-}
-
-impl ClipReading {
-    /// Reads a loaded clip (its normalised features are returned to file units first).
-    pub fn of(data: &ClipData) -> ClipReading {
-        let layout = &data.facts.layout;
-        let raw = data.facts.normalizer.denormalize(data.features.view());
-        let rows = sinmdm_eval::metric_features(layout, raw.view());
-        ClipReading {
-            frames: data.facts.frames,
-            fps: layout.fps,
-            intra_diversity: sinmdm_eval::intra_diversity(rows.view(), sinmdm_eval::LOCAL_WINDOW),
-            feet: layout.contact_joints.len(),
-        }
-    }
-
-    /// Whether the clip stands on [`MANY_FEET`] feet or more.
-    pub fn has_many_feet(&self) -> bool {
-        self.feet >= MANY_FEET
-    }
-
-    /// Whether the clip is calm ([`CALM_INTRA_BELOW`]).
-    pub fn is_calm(&self) -> bool {
-        self.intra_diversity < CALM_INTRA_BELOW
-    }
-}
 
 /// What the rule chose for one clip, and why.
 #[derive(Debug, Clone, PartialEq)]
@@ -171,16 +122,6 @@ pub fn choose(config: &TrainConfig, reading: ClipReading) -> RuleChoice {
         )
     };
     choose_kind(config, reading, calm, kind)
-}
-
-/// The rule's choice for a calm clip that no rung of the step ladder covered: it trains as a
-/// varied clip. `ladder` says how far the ladder got.
-pub fn not_calm_after_all(config: &TrainConfig, reading: ClipReading, ladder: &str) -> RuleChoice {
-    let kind = format!(
-        "varied: its own intra diversity {:.3} is under {CALM_INTRA_BELOW}, but {ladder}",
-        reading.intra_diversity
-    );
-    choose_kind(config, reading, false, kind)
 }
 
 fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: String) -> RuleChoice {
@@ -358,113 +299,14 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
     }
 }
 
-/// The rule's batch line; it sets `out.training.frames_per_step` where it pairs the items.
-fn batch_line(
-    config: &TrainConfig,
-    out: &mut TrainConfig,
-    reading: ClipReading,
-    asked: bool,
-    calm: bool,
-    kept: &str,
-) -> String {
-    let frames = reading.frames;
-    let items = config.training.batch_shape(frames).items;
-    let Some(budget) = config.training.frames_per_step else {
-        return format!(
-            "batch           {items} copies of the whole clip (the configuration's batch_size; it sets no frames_per_step)"
-        );
-    };
-    let noun = if items == 1 { "item" } else { "items" };
-    let theirs =
-        format!("{items} {noun} of the clip's {frames} frames from {budget} frames a step");
-    if !asked {
-        return format!("batch           {theirs} ({kept})");
-    }
-    if calm {
-        return format!(
-            "batch           {theirs} (the configuration's): the rule pairs only a varied clip's items"
-        );
-    }
-    match paired_items(items, frames, budget, config.training.batch_size) {
-        Some(paired) => {
-            out.training.frames_per_step = Some(paired * frames);
-            format!(
-                "batch           {paired} items of the clip's {frames} frames, {} frames a step: the configuration's {budget} would make {items}, and a step's items are shared among the cores, so an odd count leaves one of two cores idle for part of every step",
-                paired * frames
-            )
-        }
-        None if frames > budget => format!(
-            "batch           {theirs} (the configuration's): each item a random window of the longer clip"
-        ),
-        None if items == 1 => format!(
-            "batch           {theirs} (the configuration's): a single copy is left alone, as a second would double a step's frames"
-        ),
-        None => format!(
-            "batch           {theirs} (the configuration's): a multiple of {BATCH_ITEMS_MULTIPLE}, which the cores share evenly"
-        ),
-    }
-}
-
-/// The items a varied clip of `frames` frames trains in a step, a multiple of
-/// [`BATCH_ITEMS_MULTIPLE`], in place of the `items` a budget of `budget` frames a step gives it
-/// (at most `most_items`): of the two multiples next to `items`, the one whose frames come
-/// nearest the budget (the smaller on a tie). `None` where `items` is already a multiple or a
-/// single copy, where the clip is longer than the budget (each item is then a window of it), or
-/// where no multiple fits.
-pub fn paired_items(
-    items: usize,
-    frames: usize,
-    budget: usize,
-    most_items: usize,
-) -> Option<usize> {
-    let unit = BATCH_ITEMS_MULTIPLE;
-    if frames == 0 || frames > budget || items < unit || items.is_multiple_of(unit) {
-        return None;
-    }
-    let lower = items - items % unit;
-    let upper = lower + unit;
-    [lower, upper]
-        .into_iter()
-        .filter(|&n| n <= most_items)
-        .min_by_key(|&n| (n * frames).abs_diff(budget))
-}
-
-/// What a training step costs at QnA window `window`, relative to the rest of the network: the
-/// step grows with the window as `WINDOW_STEP_COST_OFFSET + window`.
-pub fn window_step_cost(window: usize) -> f64 {
-    WINDOW_STEP_COST_OFFSET + window as f64
-}
-
-/// Steps at window `trained` that take the time `steps` take at window `at_30` (the window the
-/// rule chose at 30 fps), rounded down to [`FITTED_STEPS_ROUNDING`]; `steps` where the trained
-/// window is no wider.
-pub fn steps_at_window(steps: u64, at_30: usize, trained: usize) -> u64 {
-    if trained <= at_30 {
-        return steps;
-    }
-    let fitted = steps as f64 * window_step_cost(at_30) / window_step_cost(trained);
-    let unit = FITTED_STEPS_ROUNDING;
-    ((fitted / unit as f64).floor() as u64 * unit).clamp(unit, steps)
-}
-
-/// The ladder's rungs as words: "50, 75, ... and 300".
-fn ladder_list() -> String {
-    let steps: Vec<String> = crate::ladder_settings::LADDER_STEPS
-        .iter()
-        .map(u64::to_string)
-        .collect();
-    let (last, rest) = steps.split_last().expect("the ladder has rungs");
-    format!("{} and {last}", rest.join(", "))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    const DEFAULT: &str = include_str!("../../configs/default.yaml");
-    const TINY: &str = include_str!("../../configs/tiny.yaml");
+    pub(super) const DEFAULT: &str = include_str!("../../../configs/default.yaml");
+    const TINY: &str = include_str!("../../../configs/tiny.yaml");
 
-    fn reading(intra_diversity: f64) -> ClipReading {
+    pub(super) fn reading(intra_diversity: f64) -> ClipReading {
         ClipReading {
             frames: 300,
             fps: 30.0,
@@ -486,155 +328,6 @@ mod tests {
         assert_eq!(config.from_clip, all);
         // A configuration without the section trains its numbers as written.
         assert!(TrainConfig::parse(TINY).unwrap().from_clip.is_off());
-    }
-
-    #[test]
-    fn a_calm_clip_leaves_its_steps_to_the_ladder_and_keeps_the_shape() {
-        let config = TrainConfig::parse(DEFAULT).unwrap();
-        let choice = choose(&config, reading(0.5));
-        let out = &choice.config;
-        assert!(choice.climb_ladder);
-        // Until the ladder chooses, the most it may train.
-        assert_eq!(out.training.steps, 1000);
-        assert_eq!(out.training.warmup_steps, 333);
-        assert_eq!(out.model.window, config.model.window);
-        assert_eq!(out.model.dropout, config.model.dropout);
-        assert!(out.from_clip.is_off());
-        assert!(choice.lines[0].contains("calm: its own intra diversity 0.500 is under 0.7"));
-        assert!(
-            choice.lines[1]
-                .contains("short runs of 50, 75, 100, 150, 200, 250, 300, 400, 600 and 1000 steps"),
-            "{:?}",
-            choice.lines
-        );
-        out.validate().unwrap();
-        // Not asked for the steps, the rule leaves them as written and climbs nothing.
-        let mut fixed = config.clone();
-        fixed.from_clip.steps = false;
-        assert!(!choose(&fixed, reading(0.5)).climb_ladder);
-        assert_eq!(calm_warmup_steps(75), 25);
-    }
-
-    #[test]
-    fn paired_items_take_the_even_count_whose_frames_come_nearest_the_budget() {
-        // (clip frames, batch_size, items in pairs or None), for 1 024 frames a step; worked
-        // out by hand from round(1024 / frames): 409 -> 3 (2 x 409 = 818 is 206 short of the
-        // budget, 4 x 409 = 1 636 is 612 over), 297 -> 3 (594 is 430 short, 1 188 is 164
-        // over), 213 -> 5 (852 is 172 short, 1 278 is 254 over).
-        let cases = [
-            (409, 8, Some(2)),
-            (297, 8, Some(4)),
-            (213, 8, Some(4)),
-            (341, 8, Some(4)), // 3: 682 is 342 short, 1 364 only 340 over
-            (779, 8, None),    // 1: a single copy is left alone
-            (527, 8, None),    // 2 already
-            (180, 8, None),    // 6 already
-            (1054, 8, None),   // longer than the budget: one window of it
-            (100, 8, None),    // 10, held to batch_size 8
-            (100, 7, Some(6)), // 10, held to 7; 8 is over batch_size
-            (300, 3, Some(2)), // 3, held to 3; 4 is over batch_size
-        ];
-        let mut config = TrainConfig::parse(DEFAULT).unwrap().training;
-        config.frames_per_step = Some(1024);
-        for (frames, most, want) in cases {
-            config.batch_size = most;
-            let items = config.batch_shape(frames).items;
-            assert_eq!(
-                paired_items(items, frames, 1024, most),
-                want,
-                "{frames} frames"
-            );
-        }
-    }
-
-    #[test]
-    fn a_varied_clip_trains_its_items_in_pairs_and_a_calm_one_as_configured() {
-        let config = TrainConfig::parse(DEFAULT).unwrap();
-        let budget = config.training.frames_per_step.unwrap();
-        let mut dog = reading(0.8);
-        dog.frames = 409;
-        dog.feet = 4;
-        let choice = choose(&config, dog);
-        assert_eq!(choice.config.training.frames_per_step, Some(818));
-        assert_eq!(choice.config.training.batch_shape(409).items, 2);
-        assert_eq!(
-            config.training.batch_shape(409).items,
-            3,
-            "what it replaces"
-        );
-        let line = choice
-            .lines
-            .iter()
-            .find(|l| l.starts_with("batch"))
-            .unwrap();
-        assert!(
-            line.contains("2 items") && line.contains("would make 3"),
-            "{line}"
-        );
-        // Calm, or not asked for the batch, or already in pairs: the configuration's budget.
-        let mut calm = dog;
-        calm.intra_diversity = 0.5;
-        assert_eq!(
-            choose(&config, calm).config.training.frames_per_step,
-            Some(budget)
-        );
-        // A calm clip that no rung covered trains as a varied one, in pairs.
-        let after_all = not_calm_after_all(&config, calm, "no rung covered it");
-        assert_eq!(after_all.config.training.frames_per_step, Some(818));
-        let mut fixed = config.clone();
-        fixed.from_clip.batch = false;
-        assert_eq!(
-            choose(&fixed, dog).config.training.frames_per_step,
-            Some(budget)
-        );
-        let mut even = dog;
-        even.frames = 527;
-        assert_eq!(
-            choose(&config, even).config.training.frames_per_step,
-            Some(budget)
-        );
-        // Each line says why its count stands: 2 copies of 527 frames are already a pair, 1 of
-        // 818 a single copy, and a clip of 1 054 frames trains one window of it a step.
-        let batch_line_of = |frames: usize| {
-            let clip = ClipReading { frames, ..dog };
-            let choice = choose(&config, clip);
-            assert_eq!(choice.config.training.frames_per_step, Some(budget));
-            choice
-                .lines
-                .into_iter()
-                .find(|l| l.starts_with("batch"))
-                .unwrap()
-        };
-        let line = batch_line_of(527);
-        assert!(
-            line.starts_with("batch           2 items") && line.contains("a multiple of 2"),
-            "{line}"
-        );
-        let line = batch_line_of(818);
-        assert!(
-            line.starts_with("batch           1 item of") && line.contains("a single copy"),
-            "{line}"
-        );
-        let line = batch_line_of(1054);
-        assert!(
-            line.starts_with("batch           1 item of") && line.contains("a random window"),
-            "{line}"
-        );
-    }
-
-    #[test]
-    fn a_calm_clip_no_rung_covers_trains_as_a_varied_one() {
-        let config = TrainConfig::parse(DEFAULT).unwrap();
-        let choice = not_calm_after_all(&config, reading(0.6), "no rung covered it");
-        assert!(!choice.climb_ladder);
-        assert_eq!(choice.config.training.steps, config.training.steps);
-        assert_eq!(choice.config.model.window, VARIED_WINDOW);
-        assert_eq!(choice.config.model.dropout, config.model.dropout);
-        assert!(
-            choice.lines[0].contains("varied") && choice.lines[0].contains("no rung covered it"),
-            "{:?}",
-            choice.lines
-        );
     }
 
     #[test]
@@ -742,64 +435,6 @@ mod tests {
             choose(&config, shorter).config.model.window,
             config.model.window
         );
-    }
-
-    #[test]
-    fn a_varied_clip_at_a_higher_frame_rate_trains_the_steps_that_fit_the_same_time() {
-        let config = TrainConfig::parse(DEFAULT).unwrap();
-        // The most steps, in whole units of the rounding, whose cost at the wider window is
-        // within that of the 30 fps steps.
-        let unit = FITTED_STEPS_ROUNDING;
-        let fits = |steps: u64, at_30: usize, trained: usize, chosen: u64| {
-            let budget = steps as f64 * window_step_cost(at_30);
-            chosen.is_multiple_of(unit)
-                && chosen as f64 * window_step_cost(trained) <= budget
-                && (chosen + unit) as f64 * window_step_cost(trained) > budget
-        };
-        for (feet, at_30, steps) in [(2, VARIED_WINDOW, 17_000), (4, MANY_FEET_WINDOW, 13_000)] {
-            let at_60 = ClipReading {
-                frames: 1054,
-                fps: 60.0,
-                feet,
-                ..reading(0.8)
-            };
-            let choice = choose(&config, at_60);
-            let out = &choice.config;
-            // The window is still the one meant at 30 fps; the run widens it at 60.
-            assert_eq!(out.model.window, at_30);
-            let trained = out.model.at_fps(60.0).window;
-            assert_eq!(trained, if feet == 2 { 15 } else { 19 });
-            assert!(
-                fits(steps, at_30, trained, out.training.steps),
-                "{feet} feet: {} steps",
-                out.training.steps
-            );
-            assert!(out.training.warmup_steps <= out.training.steps / 10);
-            assert!(
-                choice.lines[1].starts_with(&format!("steps           {}:", out.training.steps))
-                    && choice.lines[1].contains(&format!("at 60 fps the window is {trained}"))
-                    && choice.lines[1].contains(&format!("meant at 30 fps, {steps}")),
-                "{:?}",
-                choice.lines
-            );
-            out.validate().unwrap();
-            // At 30 fps, or with a window that does not follow the frame rate, nothing falls.
-            let at_30_fps = ClipReading { fps: 30.0, ..at_60 };
-            assert_eq!(choose(&config, at_30_fps).config.training.steps, steps);
-            let mut fixed = config.clone();
-            fixed.model.window_follows_fps = false;
-            assert_eq!(choose(&fixed, at_60).config.training.steps, steps);
-        }
-        // A calm clip's steps are the ladder's at any rate.
-        let calm = ClipReading {
-            fps: 60.0,
-            ..reading(0.3)
-        };
-        assert_eq!(
-            choose(&config, calm).config.training.steps,
-            calm_most_steps()
-        );
-        assert_eq!(steps_at_window(17_000, 5, 5), 17_000);
     }
 
     #[test]

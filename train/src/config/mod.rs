@@ -7,7 +7,11 @@ use sinmdm::network::{FIXED_RECEPTIVE_HALF_WIDTH, QNA_BLOCKS};
 
 use crate::error::TrainError;
 
+mod resume;
+mod schedule;
 mod validate;
+
+pub use schedule::LrSchedule;
 
 /// A whole training configuration (`configs/*.yaml`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -113,24 +117,6 @@ pub struct BatchShape {
     pub window: Option<usize>,
 }
 
-/// How the learning rate moves over a run.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum LrSchedule {
-    /// Multiplied by `lr_decay` after every step.
-    #[default]
-    Exponential,
-    /// A linear warm-up over `warmup_steps`, then half a cosine from `learning_rate` down to
-    /// zero at `steps`.
-    Cosine,
-}
-
-impl LrSchedule {
-    fn is_exponential(&self) -> bool {
-        *self == LrSchedule::Exponential
-    }
-}
-
 fn is_zero(n: &u64) -> bool {
     *n == 0
 }
@@ -149,33 +135,6 @@ impl TrainingConfig {
                 items: self.batch_size,
                 window: None,
             },
-        }
-    }
-
-    /// The learning rate of step `step` (counting from 0) under the `cosine` schedule.
-    pub fn cosine_rate(&self, step: u64) -> f64 {
-        let peak = self.learning_rate;
-        if step < self.warmup_steps {
-            return peak * (step + 1) as f64 / self.warmup_steps as f64;
-        }
-        let span = self.steps.saturating_sub(self.warmup_steps).max(1) as f64;
-        let progress = ((step - self.warmup_steps) as f64 / span).min(1.0);
-        0.5 * peak * (1.0 + (std::f64::consts::PI * progress).cos())
-    }
-
-    /// The learning rate of the first step.
-    pub fn first_rate(&self) -> f64 {
-        match self.lr_schedule {
-            LrSchedule::Exponential => self.learning_rate,
-            LrSchedule::Cosine => self.cosine_rate(0),
-        }
-    }
-
-    /// The learning rate of the step after `completed` steps, given the rate of the last one.
-    pub fn next_rate(&self, completed: u64, last: f64) -> f64 {
-        match self.lr_schedule {
-            LrSchedule::Exponential => last * self.lr_decay,
-            LrSchedule::Cosine => self.cosine_rate(completed),
         }
     }
 }
@@ -245,57 +204,12 @@ impl FromClip {
 }
 
 impl TrainConfig {
-    /// The configuration `self` asks a run that started as `saved` (on a clip trained at `fps`)
-    /// to continue with: what the rule that reads the clip chose when the run started stands in
-    /// for every part `self.from_clip` leaves to the rule, and so does the root layout `auto`
-    /// chose. Compare it with `saved` by [`TrainConfig::resume_difference`].
-    pub fn for_resume(&self, saved: &TrainConfig, fps: f64) -> TrainConfig {
-        let mut asked = self.clone();
-        let rule = asked.from_clip;
-        if rule.steps {
-            asked.training.steps = saved.training.steps;
-            asked.training.warmup_steps = saved.training.warmup_steps;
-        }
-        if rule.window {
-            asked.model.window = saved.model.window;
-            asked.model.window_follows_fps = false;
-        }
-        if rule.dropout {
-            asked.model.dropout = saved.model.dropout;
-        }
-        if rule.channels {
-            asked.model.channels = saved.model.channels;
-        }
-        if rule.batch {
-            asked.training.frames_per_step = saved.training.frames_per_step;
-        }
-        asked.from_clip = FromClip::default();
-        let mut asked = asked.at_fps(fps);
-        if asked.data.root_layout == sinmdm::motion::RootLayout::Auto {
-            asked.data.root_layout = saved.data.root_layout;
-        }
-        asked
-    }
-
     /// The configuration as trained on a clip at `fps` ([`ModelConfig::at_fps`]).
     pub fn at_fps(&self, fps: f64) -> TrainConfig {
         TrainConfig {
             model: self.model.at_fps(fps),
             ..self.clone()
         }
-    }
-
-    /// Why a checkpoint trained under `self` cannot continue under `asked`: the first setting
-    /// (by its YAML key) that differs, comparing the whole configurations except
-    /// `training.steps` and `training.checkpoint_every`, the only two a resume may change.
-    pub fn resume_difference(&self, asked: &TrainConfig) -> Option<String> {
-        let mut asked = asked.clone();
-        asked.training.steps = self.training.steps;
-        asked.training.checkpoint_every = self.training.checkpoint_every;
-        let as_value = |c: &TrainConfig| serde_json::to_value(c).unwrap_or_default();
-        first_difference(&as_value(self), &as_value(&asked), String::new()).map(|(key, a, b)| {
-            format!("the checkpoint was trained with {key} = {a}, the config asks for {b}")
-        })
     }
 
     /// Reads and checks a YAML file.
@@ -361,36 +275,6 @@ impl ModelConfig {
     }
 }
 
-/// The first leaf (dotted key, saved value, asked value) where two JSON trees differ.
-fn first_difference(
-    a: &serde_json::Value,
-    b: &serde_json::Value,
-    key: String,
-) -> Option<(String, String, String)> {
-    use serde_json::Value;
-    match (a, b) {
-        (Value::Object(x), Value::Object(y)) => {
-            let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
-            keys.sort();
-            keys.dedup();
-            keys.into_iter().find_map(|k| {
-                let child = if key.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{key}.{k}")
-                };
-                first_difference(
-                    x.get(k).unwrap_or(&Value::Null),
-                    y.get(k).unwrap_or(&Value::Null),
-                    child,
-                )
-            })
-        }
-        _ if a == b => None,
-        _ => Some((key, a.to_string(), b.to_string())),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -412,68 +296,6 @@ mod tests {
         assert_eq!(paper.training.batch_size, 64);
         assert_eq!(paper.training.steps, 60_000);
         assert_eq!(paper.model.receptive_field(), 23);
-    }
-
-    /// The default, and what a new run with it on a varied clip of `frames` frames on four feet
-    /// at 30 fps saved: the rule's choices, and the root layout auto chose.
-    fn the_default_and_a_dog_run_it_saved(
-        frames: usize,
-        intra_diversity: f64,
-    ) -> (TrainConfig, TrainConfig) {
-        let default = TrainConfig::parse(include_str!("../../../configs/default.yaml")).unwrap();
-        let dog = crate::clip_rule::ClipReading {
-            frames,
-            fps: 30.0,
-            intra_diversity,
-            feet: 4,
-        };
-        let mut saved = crate::clip_rule::choose(&default, dog).config.at_fps(30.0);
-        saved.data.root_layout = sinmdm::motion::RootLayout::Heading;
-        (default, saved)
-    }
-
-    #[test]
-    fn a_resume_with_the_default_keeps_what_the_rule_chose_for_a_dog() {
-        // The rule's window, channels and steps.
-        let (default, saved) = the_default_and_a_dog_run_it_saved(527, 0.77);
-        assert_eq!(
-            (
-                saved.model.channels,
-                saved.model.window,
-                saved.training.steps
-            ),
-            (96, 7, 13_000)
-        );
-        let asked = default.for_resume(&saved, 30.0);
-        assert_eq!(saved.resume_difference(&asked), None);
-        // A configuration that does not leave the channels to the rule asks for 64: refused,
-        // naming the setting.
-        let mut fixed = default.clone();
-        fixed.from_clip.channels = false;
-        let message = saved
-            .resume_difference(&fixed.for_resume(&saved, 30.0))
-            .unwrap();
-        assert!(message.contains("model.channels = 96"), "{message}");
-    }
-
-    #[test]
-    fn a_resume_with_the_default_keeps_the_batch_the_rule_paired() {
-        // A varied dog of 409 frames: 1 024 frames a step would make 3 copies; the rule made 2.
-        let (default, saved) = the_default_and_a_dog_run_it_saved(409, 0.76);
-        assert_eq!(saved.training.frames_per_step, Some(818));
-        assert_eq!(
-            saved.resume_difference(&default.for_resume(&saved, 30.0)),
-            None
-        );
-        let mut fixed = default.clone();
-        fixed.from_clip.batch = false;
-        let message = saved
-            .resume_difference(&fixed.for_resume(&saved, 30.0))
-            .unwrap();
-        assert!(
-            message.contains("training.frames_per_step = 818"),
-            "{message}"
-        );
     }
 
     #[test]
@@ -531,33 +353,6 @@ mod tests {
             err.contains("training.frames_per_step must be at least"),
             "{err}"
         );
-    }
-
-    #[test]
-    fn the_cosine_schedule_warms_up_then_falls_to_zero() {
-        let mut t = TrainConfig::parse(include_str!("../../../configs/default.yaml"))
-            .unwrap()
-            .training;
-        t.steps = 1100;
-        t.warmup_steps = 100;
-        t.learning_rate = 1.0;
-        assert_eq!(t.lr_schedule, LrSchedule::Cosine);
-        assert!((t.first_rate() - 0.01).abs() < 1e-12);
-        assert!((t.cosine_rate(49) - 0.5).abs() < 1e-12);
-        assert!((t.cosine_rate(100) - 1.0).abs() < 1e-12);
-        // Half way through the cosine part: half the peak; a quarter: (1 + cos(pi/4)) / 2.
-        assert!((t.cosine_rate(600) - 0.5).abs() < 1e-12);
-        let quarter = 0.5 * (1.0 + std::f64::consts::FRAC_1_SQRT_2);
-        assert!((t.cosine_rate(350) - quarter).abs() < 1e-12);
-        assert!(t.cosine_rate(1100).abs() < 1e-12);
-        assert!(t.cosine_rate(5000).abs() < 1e-12);
-        // next_rate follows the formula, not the last rate.
-        assert_eq!(t.next_rate(600, 123.0), t.cosine_rate(600));
-        let mut e = t.clone();
-        e.lr_schedule = LrSchedule::Exponential;
-        e.lr_decay = 0.5;
-        assert_eq!(e.first_rate(), 1.0);
-        assert_eq!(e.next_rate(7, 0.25), 0.125);
     }
 
     #[test]
@@ -662,26 +457,6 @@ mod tests {
             serde_yaml::to_string(&default)
                 .unwrap()
                 .contains("window_follows_fps: true")
-        );
-    }
-
-    #[test]
-    fn resume_compares_every_setting_but_the_step_counts() {
-        let saved = TrainConfig::parse(include_str!("../../../configs/tiny.yaml")).unwrap();
-        let mut asked = saved.clone();
-        asked.training.steps += 100;
-        asked.training.checkpoint_every += 1;
-        assert_eq!(saved.resume_difference(&asked), None);
-        // Any other setting, found by its YAML key.
-        asked.data.contact_speed *= 2.0;
-        let message = saved.resume_difference(&asked).expect("a difference");
-        assert!(message.contains("data.contact_speed"), "{message}");
-        let mut asked = saved.clone();
-        asked.model.heads *= 2;
-        let message = saved.resume_difference(&asked).expect("a difference");
-        assert!(
-            message.starts_with("the checkpoint was trained with model.heads = "),
-            "{message}"
         );
     }
 }

@@ -16,16 +16,21 @@ use crate::clip_data::ClipData;
 use crate::clip_rule::RuleChoice;
 use crate::config::TrainConfig;
 use crate::data::make_batch;
-use crate::error::{TrainError, io};
+use crate::error::TrainError;
 use crate::loss_log::LossLog;
 use crate::model::QnaUnet;
 pub use crate::pace::StepReport;
-use crate::recovery::{NonFinite, RecoveryEvent, RecoveryRecord};
-use crate::run_folder::clip_copy;
+use crate::recovery::RecoveryEvent;
 pub use crate::run_folder::{CLIP_COPY, CONFIG_COPY, LOSS_LOG, saved_clip};
 use crate::step::step_with_fault;
 pub use crate::step::{StepOutcome, new_optimizer, optimisation_step};
 use crate::weight_average::WeightAverage;
+
+mod roll_back;
+mod start;
+mod timing_probe;
+
+pub use timing_probe::seconds_per_step;
 
 /// Steps averaged into `recent_loss`.
 const RECENT_STEPS: usize = 100;
@@ -103,206 +108,7 @@ fn load_parts(
     Ok((model, average, optimizer))
 }
 
-/// The schedule of a configuration.
-fn schedule(config: &TrainConfig) -> Schedule {
-    Schedule::cosine(config.diffusion.steps).expect("validated configuration has T >= 2")
-}
-
 impl Trainer {
-    /// A trainer of the run in `run` from its parts, its state and its open loss log;
-    /// `last_checkpoint` is the one it resumed from.
-    fn assemble(
-        run: &Path,
-        device: Device,
-        (model, average, optimizer): (QnaUnet, Option<WeightAverage>, ModuleOptimizer),
-        clip: ClipData,
-        state: CheckpointState,
-        log: LossLog,
-        last_checkpoint: Option<PathBuf>,
-    ) -> Trainer {
-        Trainer {
-            run: run.to_path_buf(),
-            device,
-            model: Some(model),
-            average,
-            optimizer,
-            schedule: schedule(&state.config),
-            clip,
-            elapsed_before: state.elapsed_seconds,
-            state,
-            recent: VecDeque::new(),
-            log,
-            session_start: Instant::now(),
-            last_checkpoint,
-            injected_faults: BTreeSet::new(),
-            rule: None,
-        }
-    }
-
-    /// An error when the folder `run` already holds a training run.
-    pub fn check_new_run(run: &Path) -> Result<(), TrainError> {
-        if checkpoint::latest(run)?.is_some() || run.join(LOSS_LOG).exists() {
-            return Err(TrainError::Checkpoint {
-                path: run.to_path_buf(),
-                message: "already holds a training run; pass --resume to continue it, or choose another --out".into(),
-            });
-        }
-        Ok(())
-    }
-
-    /// Starts a new run of `config` on `clip` in the folder `run` (created if needed; it must
-    /// not already hold a run).
-    pub fn start(
-        clip: &Path,
-        config: TrainConfig,
-        run: &Path,
-        device: Device,
-    ) -> Result<Trainer, TrainError> {
-        Trainer::check_new_run(run)?;
-        let data = ClipData::load(clip, &config.data, &config.model)?;
-        Trainer::start_loaded(clip, data, config, run, device)
-    }
-
-    /// [`Trainer::start`] for a clip already read: `data` is `clip` as [`ClipData::load`] read
-    /// it with `config`'s data section.
-    pub fn start_loaded(
-        clip: &Path,
-        data: ClipData,
-        config: TrainConfig,
-        run: &Path,
-        device: Device,
-    ) -> Result<Trainer, TrainError> {
-        // (The steps of a calm clip are left to the step ladder, which `step_ladder::start_run`
-        // climbs before it starts the run; called directly, a calm clip trains the ladder's most.)
-        match crate::clip_rule::apply(&config, &data) {
-            Some(choice) => Trainer::start_chosen(clip, data, choice, run, device),
-            None => Trainer::begin(clip, data, config, None, run, device),
-        }
-    }
-
-    /// [`Trainer::start_loaded`] once the rule that reads the clip has chosen: `choice.config`
-    /// trains, and `choice` is what the run says the rule chose.
-    pub fn start_chosen(
-        clip: &Path,
-        data: ClipData,
-        choice: RuleChoice,
-        run: &Path,
-        device: Device,
-    ) -> Result<Trainer, TrainError> {
-        let config = choice.config.clone();
-        Trainer::begin(clip, data, config, Some(choice), run, device)
-    }
-
-    /// Starts a new run of `config` (the rule, if any, applied) on the clip `data` was read from.
-    fn begin(
-        clip: &Path,
-        data: ClipData,
-        config: TrainConfig,
-        rule: Option<RuleChoice>,
-        run: &Path,
-        device: Device,
-    ) -> Result<Trainer, TrainError> {
-        Trainer::check_new_run(run)?;
-        // The run saves the numbers it trains: what the rule that reads the clip chose, a
-        // window that follows the frame rate and a root layout chosen from the clip, resolved.
-        let mut config = config.at_fps(data.facts.layout.fps);
-        config.data.root_layout = data.facts.root_layout();
-        std::fs::create_dir_all(run).map_err(io("create the output folder", run))?;
-        let yaml = serde_yaml::to_string(&config).expect("config serialises");
-        sinmdm::files::write_atomically(&run.join(CONFIG_COPY), yaml.as_bytes())
-            .map_err(io("write into the output folder", run))?;
-        let clip_bytes = std::fs::read(clip).map_err(io("read the clip", clip))?;
-        sinmdm::files::write_atomically(&clip_copy(run, clip), &clip_bytes)
-            .map_err(io("write into the output folder", run))?;
-        let log = LossLog::create(&run.join(LOSS_LOG))?;
-        let features = data.features.nrows();
-        let (model, average, optimizer) = fresh_parts(&config, features, &device);
-        let state = CheckpointState {
-            step: 0,
-            learning_rate: config.training.first_rate(),
-            loss: f64::NAN,
-            recent_loss: f64::NAN,
-            elapsed_seconds: 0.0,
-            parameters: model.num_params(),
-            features,
-            clip: data.facts.clone(),
-            batch: Some(config.training.batch_shape(data.features.ncols())),
-            started: crate::clock::now(),
-            recovery: RecoveryRecord::default(),
-            config: config.clone(),
-        };
-        let parts = (model, average, optimizer);
-        let mut trainer = Trainer::assemble(run, device, parts, data, state, log, None);
-        trainer.rule = rule;
-        Ok(trainer)
-    }
-
-    /// Continues the run in `run` from its newest checkpoint. A `config`, when given, must
-    /// describe the same model and training (only `training.steps` and
-    /// `training.checkpoint_every` may change); a `clip`, when given, must be the same file.
-    pub fn resume(
-        run: &Path,
-        clip: Option<&Path>,
-        config: Option<TrainConfig>,
-        device: Device,
-    ) -> Result<Trainer, TrainError> {
-        let dir = checkpoint::latest(run)?.ok_or_else(|| TrainError::Checkpoint {
-            path: run.to_path_buf(),
-            message: "holds no checkpoint to resume from".into(),
-        })?;
-        let mut state = checkpoint::load_state(&dir)?;
-        if let Some(asked) = &config {
-            let asked = asked.for_resume(&state.config, state.clip.layout.fps);
-            if let Some(message) = state.config.resume_difference(&asked) {
-                return Err(TrainError::Checkpoint { path: dir, message });
-            }
-            state.config.training.steps = asked.training.steps;
-            state.config.training.checkpoint_every = asked.training.checkpoint_every;
-        }
-        let clip_path = match clip {
-            Some(p) => p.to_path_buf(),
-            None => saved_clip(run).ok_or_else(|| TrainError::Checkpoint {
-                path: run.to_path_buf(),
-                message: format!(
-                    "holds no copy of its clip ({CLIP_COPY}.bvh, .glb, .gltf or .fbx); pass the clip"
-                ),
-            })?,
-        };
-        let data = ClipData::load(&clip_path, &state.config.data, &state.config.model)?;
-        if data.facts.sha256 != state.clip.sha256 {
-            return Err(TrainError::Checkpoint {
-                path: clip_path,
-                message: format!(
-                    "is not the clip this run learns ({}, SHA-256 {})",
-                    state.clip.name, state.clip.sha256
-                ),
-            });
-        }
-        if data.features.nrows() != state.features {
-            return Err(TrainError::Checkpoint {
-                path: dir,
-                message: format!(
-                    "the model reads {} feature rows, the clip gives {}",
-                    state.features,
-                    data.features.nrows()
-                ),
-            });
-        }
-        let (model, average, optimizer) = load_parts(&dir, &state, &device)?;
-        let log = LossLog::resume(&run.join(LOSS_LOG), state.step)?;
-        state.batch = Some(state.config.training.batch_shape(data.features.ncols()));
-        let parts = (model, average, optimizer);
-        Ok(Trainer::assemble(
-            run,
-            device,
-            parts,
-            data,
-            state,
-            log,
-            Some(dir),
-        ))
-    }
-
     /// The checkpoint state as of now.
     pub fn state(&self) -> &CheckpointState {
         &self.state
@@ -427,80 +233,6 @@ impl Trainer {
         }
     }
 
-    /// A step whose update was skipped: recorded, then either passed over (its batch dropped,
-    /// no row in the loss log) or, when skips repeat, the run rolled back.
-    fn skip(&mut self, loss: f64, cause: NonFinite) -> Result<StepReport, TrainError> {
-        let learning_rate = self.state.learning_rate;
-        let at = self.state.step + 1;
-        if self.state.recovery.skip(at, cause) {
-            let event = self.roll_back(at)?;
-            return Ok(self.report(loss, learning_rate, Some(event)));
-        }
-        self.advance();
-        let event = RecoveryEvent::Skipped { step: at, cause };
-        Ok(self.report(loss, learning_rate, Some(event)))
-    }
-
-    /// Goes back to the last good checkpoint (or the start, before the first), lowers the
-    /// learning rate, and saves that point with the record at once, so a resume starts from it.
-    fn roll_back(&mut self, at: u64) -> Result<RecoveryEvent, TrainError> {
-        let checkpoint = match &self.last_checkpoint {
-            Some(dir) => Some(dir.clone()),
-            None => checkpoint::latest(&self.run)?,
-        };
-        let target = match &checkpoint {
-            Some(dir) => checkpoint::load_state(dir)?,
-            None => CheckpointState {
-                step: 0,
-                learning_rate: self.state.config.training.first_rate(),
-                loss: f64::NAN,
-                recent_loss: f64::NAN,
-                recovery: RecoveryRecord::default(),
-                ..self.state.clone()
-            },
-        };
-        let mut record = self.state.recovery.clone();
-        if !record.may_roll_back_to(target.step) {
-            return Err(TrainError::Unrecoverable {
-                step: at,
-                to: target.step,
-                tried: record.summary(),
-                last_checkpoint: checkpoint,
-            });
-        }
-        let (model, average, optimizer) = match &checkpoint {
-            Some(dir) => load_parts(dir, &target, &self.device)?,
-            None => fresh_parts(&target.config, target.features, &self.device),
-        };
-        let event = record.roll_back(at, target.step);
-        let elapsed = self.elapsed();
-        self.state = CheckpointState {
-            learning_rate: target.learning_rate / target.recovery.rate_scale * record.rate_scale,
-            recovery: record,
-            elapsed_seconds: elapsed,
-            // The run's configuration as it is now: a resume may have raised its step count
-            // since the checkpoint was written.
-            config: self.state.config.clone(),
-            ..target
-        };
-        self.model = Some(model);
-        self.average = average;
-        self.optimizer = optimizer;
-        self.log = LossLog::resume(&self.run.join(LOSS_LOG), self.state.step)?;
-        self.recent.clear();
-        self.elapsed_before = elapsed;
-        self.session_start = Instant::now();
-        self.save()?;
-        Ok(event)
-    }
-
-    /// Makes the gradients of the given steps (1-based, as in the loss log) NaN, once each: a
-    /// test's stand-in for a numerical failure, met by the same checks.
-    #[doc(hidden)]
-    pub fn inject_non_finite_gradients(&mut self, steps: impl IntoIterator<Item = u64>) {
-        self.injected_faults.extend(steps);
-    }
-
     /// Writes a checkpoint of the current step and flushes the loss log.
     pub fn save(&mut self) -> Result<PathBuf, TrainError> {
         self.log.flush()?;
@@ -558,37 +290,4 @@ impl Trainer {
     pub fn loss_log(&self) -> &Path {
         self.log.path()
     }
-}
-
-/// Seconds one optimiser step of `config` on `clip` takes on `device`: the mean of `steps`
-/// timed steps (after two untimed ones) of a throw-away run in a temporary folder. The mean,
-/// not the median: each step stretches the clip by its own random factor, and a budget is
-/// spent on the sum of the steps, slow ones included. This is what a time budget
-/// (`sinmdm-train --minutes`) turns into a step count.
-pub fn seconds_per_step(
-    clip: &Path,
-    config: &TrainConfig,
-    device: Device,
-    steps: u64,
-) -> Result<f64, TrainError> {
-    let folder = std::env::temp_dir().join(format!("sinmdm-timing-probe-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&folder);
-    let mut probe_config = config.clone();
-    probe_config.training.steps = steps + 2;
-    probe_config.training.warmup_steps = 0;
-    probe_config.from_clip.steps = false;
-    let measured = (|| {
-        let mut trainer = Trainer::start(clip, probe_config, &folder, device)?;
-        let mut times = Vec::new();
-        for i in 0..steps + 2 {
-            let begun = Instant::now();
-            trainer.step()?;
-            if i >= 2 {
-                times.push(begun.elapsed().as_secs_f64());
-            }
-        }
-        Ok(times.iter().sum::<f64>() / times.len().max(1) as f64)
-    })();
-    let _ = std::fs::remove_dir_all(&folder);
-    measured
 }

@@ -1,0 +1,84 @@
+//! A calm clip's part of the rule: its steps are the step ladder's, and a calm clip that no
+//! rung covers trains as a varied one.
+
+use super::{CALM_INTRA_BELOW, ClipReading, RuleChoice, choose_kind};
+use crate::config::TrainConfig;
+
+/// Warm-up steps of a calm clip's cosine schedule: a third of its steps.
+pub fn calm_warmup_steps(steps: u64) -> u64 {
+    (steps as f64 / 3.0).round() as u64
+}
+
+/// The most steps a calm clip trains: the step ladder's top rung.
+pub fn calm_most_steps() -> u64 {
+    crate::ladder_settings::LADDER_STEPS[crate::ladder_settings::LADDER_STEPS.len() - 1]
+}
+
+/// The rule's choice for a calm clip that no rung of the step ladder covered: it trains as a
+/// varied clip. `ladder` says how far the ladder got.
+pub fn not_calm_after_all(config: &TrainConfig, reading: ClipReading, ladder: &str) -> RuleChoice {
+    let kind = format!(
+        "varied: its own intra diversity {:.3} is under {CALM_INTRA_BELOW}, but {ladder}",
+        reading.intra_diversity
+    );
+    choose_kind(config, reading, false, kind)
+}
+
+/// The ladder's rungs as words: "50, 75, ... and 300".
+pub(super) fn ladder_list() -> String {
+    let steps: Vec<String> = crate::ladder_settings::LADDER_STEPS
+        .iter()
+        .map(u64::to_string)
+        .collect();
+    let (last, rest) = steps.split_last().expect("the ladder has rungs");
+    format!("{} and {last}", rest.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::clip_rule::tests::{DEFAULT, reading};
+    use crate::clip_rule::{VARIED_WINDOW, choose};
+
+    #[test]
+    fn a_calm_clip_leaves_its_steps_to_the_ladder_and_keeps_the_shape() {
+        let config = TrainConfig::parse(DEFAULT).unwrap();
+        let choice = choose(&config, reading(0.5));
+        let out = &choice.config;
+        assert!(choice.climb_ladder);
+        // Until the ladder chooses, the most it may train.
+        assert_eq!(out.training.steps, 1000);
+        assert_eq!(out.training.warmup_steps, 333);
+        assert_eq!(out.model.window, config.model.window);
+        assert_eq!(out.model.dropout, config.model.dropout);
+        assert!(out.from_clip.is_off());
+        assert!(choice.lines[0].contains("calm: its own intra diversity 0.500 is under 0.7"));
+        assert!(
+            choice.lines[1]
+                .contains("short runs of 50, 75, 100, 150, 200, 250, 300, 400, 600 and 1000 steps"),
+            "{:?}",
+            choice.lines
+        );
+        out.validate().unwrap();
+        // Not asked for the steps, the rule leaves them as written and climbs nothing.
+        let mut fixed = config.clone();
+        fixed.from_clip.steps = false;
+        assert!(!choose(&fixed, reading(0.5)).climb_ladder);
+        assert_eq!(calm_warmup_steps(75), 25);
+    }
+
+    #[test]
+    fn a_calm_clip_no_rung_covers_trains_as_a_varied_one() {
+        let config = TrainConfig::parse(DEFAULT).unwrap();
+        let choice = not_calm_after_all(&config, reading(0.6), "no rung covered it");
+        assert!(!choice.climb_ladder);
+        assert_eq!(choice.config.training.steps, config.training.steps);
+        assert_eq!(choice.config.model.window, VARIED_WINDOW);
+        assert_eq!(choice.config.model.dropout, config.model.dropout);
+        assert!(
+            choice.lines[0].contains("varied") && choice.lines[0].contains("no rung covered it"),
+            "{:?}",
+            choice.lines
+        );
+    }
+}
