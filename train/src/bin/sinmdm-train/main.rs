@@ -1,20 +1,18 @@
 //! `sinmdm-train`: fit the denoiser on one clip (BVH, glTF or FBX).
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result, bail};
-use burn::module::Module;
 use burn::tensor::Device;
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use sinmdm_train::clip_data::ClipData;
-use sinmdm_train::clip_rule;
-use sinmdm_train::motion_span;
-use sinmdm_train::{QnaUnet, RunEnd, TrainConfig, Trainer};
+use sinmdm_train::{RunEnd, TrainConfig, Trainer};
+
+mod dry_run;
 
 /// Fit the single-motion QnA-UNet denoiser on one clip (BVH, glTF .glb/.gltf, or FBX).
 ///
@@ -159,7 +157,7 @@ fn device(name: &str) -> Result<Device> {
 
 /// The built-in default configuration (`configs/default.yaml`).
 fn default_config() -> TrainConfig {
-    TrainConfig::parse(include_str!("../../../configs/default.yaml"))
+    TrainConfig::parse(include_str!("../../../../configs/default.yaml"))
         .expect("the shipped default configuration is valid")
 }
 
@@ -235,109 +233,6 @@ fn fit_to_budget(
     Ok(())
 }
 
-fn dry_run(args: &Args) -> Result<()> {
-    let Some(clip) = &args.clip else {
-        bail!("--dry-run needs a CLIP");
-    };
-    let config = new_run_config(args)?;
-    let data = ClipData::load(clip, &config.data, &config.model)?;
-    let (config, rule, ladder, window_from_clip) = match clip_rule::apply(&config, &data) {
-        Some(choice) => (
-            choice.config,
-            Some(choice.lines),
-            choice.climb_ladder,
-            choice.window_from_clip,
-        ),
-        None => (config, None, false, false),
-    };
-    let config = config.at_fps(data.facts.layout.fps);
-    let features = data.features.nrows();
-    let model = QnaUnet::new(features, &config.model, &Device::flex());
-    println!(
-        "clip            {} ({} frames at {} fps)",
-        clip.display(),
-        data.facts.frames,
-        data.facts.layout.fps
-    );
-    if let Some(source) = &data.facts.source {
-        println!(
-            "source          {} animation {} (one of {})",
-            source.format,
-            source.animation.as_deref().unwrap_or("?"),
-            source.animations
-        );
-    }
-    println!("up axis         {}", data.facts.up);
-    if data.facts.in_place {
-        println!("cycle           in place: contacts measured against the treadmill");
-    }
-    println!("features F      {features}");
-    let layout = &data.facts.layout;
-    let feet: Vec<&str> = layout
-        .contact_joints
-        .iter()
-        .map(|&j| layout.skeleton.joints[j].name.as_str())
-        .collect();
-    println!(
-        "feet            {} ({}): {}",
-        feet.len(),
-        feet.join(", "),
-        if config.data.contact_joints.is_some() {
-            "data.contact_joints in the config"
-        } else {
-            "the chain ends that touch the ground (data.contact_joints overrides)"
-        }
-    );
-    println!("root            {}", data.facts.root);
-    println!("channels C      {}", config.model.channels);
-    println!("parameters      {}", model.num_params());
-    println!(
-        "receptive field {} frames (QnA window {})",
-        config.model.receptive_field(),
-        config.model.window
-    );
-    let fps = data.facts.layout.fps;
-    match motion_span::decorrelation_frames(data.features.view(), fps) {
-        Some(frames) => {
-            println!(
-                "motion span     {:.2} s (the lag at which the features' autocorrelation first falls below zero)",
-                frames as f64 / fps
-            );
-            // The rule's window is chosen from the clip; a hint would second-guess it.
-            let hint = (!window_from_clip)
-                .then(|| motion_span::wider_window_hint(frames, fps, &config.model))
-                .flatten();
-            if let Some(hint) = hint {
-                println!("hint            {hint}");
-            }
-        }
-        None => println!("motion span     longer than half the clip or 10 s"),
-    }
-    match &rule {
-        Some(lines) => {
-            println!(
-                "the rule that reads the clip (from_clip; --config, --window and --minutes override it):"
-            );
-            for line in lines {
-                println!("  {line}");
-            }
-        }
-        None => println!("from_clip       off: the configuration's numbers train as written"),
-    }
-    let shape = config.training.batch_shape(data.features.ncols());
-    let window = match shape.window {
-        Some(w) if w < data.features.ncols() => format!("random windows of {w} frames"),
-        _ => "the whole clip".into(),
-    };
-    println!(
-        "steps           {}{} (batch {} x {window})",
-        if ladder { "up to " } else { "" },
-        config.training.steps,
-        shape.items
-    );
-    Ok(())
-}
-
 fn main() -> Result<()> {
     sinmdm_train::memory::keep_freed_memory();
     let args = Args::parse();
@@ -351,7 +246,7 @@ fn main() -> Result<()> {
             .context("setting the thread count")?;
     }
     if args.dry_run {
-        return dry_run(&args);
+        return dry_run::dry_run(&args);
     }
     if let Some(manifest) = &args.manifest {
         if args.allow_outside_folder {
@@ -363,18 +258,7 @@ fn main() -> Result<()> {
         bail!("--out is required: the run folder for checkpoints and logs");
     };
     if let Some(file) = &args.export {
-        let dir = file.parent().filter(|p| !p.as_os_str().is_empty());
-        if let Some(dir) = dir {
-            std::fs::create_dir_all(dir).with_context(|| {
-                format!("--export: cannot create the folder '{}'", dir.display())
-            })?;
-        }
-        if file.is_dir() {
-            bail!(
-                "--export '{}' is a folder; give a file name such as model.onnx",
-                file.display()
-            );
-        }
+        check_export(file)?;
     }
     let device = device(&args.device)?.autodiff();
     if args.resume && args.minutes.is_some() {
@@ -389,56 +273,87 @@ fn main() -> Result<()> {
             .context("installing the Ctrl-C handler")?;
     }
     let mut trainer = if args.resume {
-        if args.fps.is_some() {
-            bail!("--fps sets the frame rate of a new run; a resumed run keeps its own");
-        }
-        if args.window.is_some() {
-            bail!("--window sets the QnA window of a new run; a resumed run keeps its own");
-        }
-        if args.root_layout.is_some() {
-            bail!("--root-layout sets the root layout of a new run; a resumed run keeps its own");
-        }
-        if args.clip_anim.is_some() {
-            bail!("--clip-anim picks the animation of a new run; a resumed run keeps its own");
-        }
-        if args.allow_outside_folder {
-            bail!(
-                "--allow-outside-folder reads a new run's clip; a resumed run reads its own copy"
-            );
-        }
-        let config = args.config.as_deref().map(TrainConfig::load).transpose()?;
-        Trainer::resume(out, args.clip.as_deref(), config, device)?
+        resumed(&args, out, device)?
     } else {
-        let Some(clip) = &args.clip else {
-            bail!("a CLIP to train on is required (or --resume an existing run)");
-        };
-        let mut config = new_run_config(&args)?;
-        if let Some(minutes) = args.minutes {
-            fit_to_budget(clip, &mut config, &device, minutes)?;
-        }
-        let mut on_rung = |rung: &sinmdm_train::step_ladder::RungCheck| {
-            eprintln!("step ladder: {}", rung.line());
-        };
-        match sinmdm_train::step_ladder::start_run(
-            clip,
-            config,
-            out,
-            device,
-            &sinmdm_train::step_ladder::Ladder::default(),
-            &stop,
-            &mut on_rung,
-        )? {
-            Some(trainer) => trainer,
-            None => {
-                eprintln!(
-                    "interrupted while the step ladder chose the steps; the same command starts again and keeps the rungs finished (in {})",
-                    sinmdm_train::step_ladder::folder(out).display()
-                );
-                std::process::exit(130);
-            }
-        }
+        started(&args, out, device, &stop)?
     };
+    print_start(&trainer, out);
+    let end = train(&mut trainer, &stop)?;
+    finish(&args, &trainer, end, out)
+}
 
+/// Makes `--export`'s folder, and refuses a folder given as the file.
+fn check_export(file: &Path) -> Result<()> {
+    let dir = file.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(dir) = dir {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("--export: cannot create the folder '{}'", dir.display()))?;
+    }
+    if file.is_dir() {
+        bail!(
+            "--export '{}' is a folder; give a file name such as model.onnx",
+            file.display()
+        );
+    }
+    Ok(())
+}
+
+/// The run in `out` resumed, refusing the flags only a new run takes.
+fn resumed(args: &Args, out: &Path, device: Device) -> Result<Trainer> {
+    if args.fps.is_some() {
+        bail!("--fps sets the frame rate of a new run; a resumed run keeps its own");
+    }
+    if args.window.is_some() {
+        bail!("--window sets the QnA window of a new run; a resumed run keeps its own");
+    }
+    if args.root_layout.is_some() {
+        bail!("--root-layout sets the root layout of a new run; a resumed run keeps its own");
+    }
+    if args.clip_anim.is_some() {
+        bail!("--clip-anim picks the animation of a new run; a resumed run keeps its own");
+    }
+    if args.allow_outside_folder {
+        bail!("--allow-outside-folder reads a new run's clip; a resumed run reads its own copy");
+    }
+    let config = args.config.as_deref().map(TrainConfig::load).transpose()?;
+    Ok(Trainer::resume(out, args.clip.as_deref(), config, device)?)
+}
+
+/// A new run on the clip, its steps from `--minutes` or the step ladder where the rule asks;
+/// exits with 130 when Ctrl-C stops the ladder.
+fn started(args: &Args, out: &Path, device: Device, stop: &Arc<AtomicBool>) -> Result<Trainer> {
+    let Some(clip) = &args.clip else {
+        bail!("a CLIP to train on is required (or --resume an existing run)");
+    };
+    let mut config = new_run_config(args)?;
+    if let Some(minutes) = args.minutes {
+        fit_to_budget(clip, &mut config, &device, minutes)?;
+    }
+    let mut on_rung = |rung: &sinmdm_train::step_ladder::RungCheck| {
+        eprintln!("step ladder: {}", rung.line());
+    };
+    match sinmdm_train::step_ladder::start_run(
+        clip,
+        config,
+        out,
+        device,
+        &sinmdm_train::step_ladder::Ladder::default(),
+        stop,
+        &mut on_rung,
+    )? {
+        Some(trainer) => Ok(trainer),
+        None => {
+            eprintln!(
+                "interrupted while the step ladder chose the steps; the same command starts again and keeps the rungs finished (in {})",
+                sinmdm_train::step_ladder::folder(out).display()
+            );
+            std::process::exit(130);
+        }
+    }
+}
+
+/// What is trained, from which step, and what the rule chose.
+fn print_start(trainer: &Trainer, out: &Path) {
     let state = trainer.state().clone();
     eprintln!(
         "training {} ({} frames, F {}, {} parameters) into {}, from step {} of {}",
@@ -468,6 +383,12 @@ fn main() -> Result<()> {
     {
         eprintln!("hint: {hint}");
     }
+}
+
+/// Trains to the end or to Ctrl-C, with a progress bar on a terminal and a line every 5 % of
+/// the steps elsewhere.
+fn train(trainer: &mut Trainer, stop: &Arc<AtomicBool>) -> Result<RunEnd> {
+    let state = trainer.state().clone();
     let bar = ProgressBar::new(state.config.training.steps);
     if !std::io::stderr().is_terminal() {
         bar.set_draw_target(ProgressDrawTarget::hidden());
@@ -480,7 +401,7 @@ fn main() -> Result<()> {
     bar.reset_eta();
     let quiet_every = (state.config.training.steps / 20).max(1);
     let terminal = std::io::stderr().is_terminal();
-    let end = trainer.run(&stop, |report| {
+    let end = trainer.run(stop, |report| {
         if let Some(event) = &report.event {
             bar.suspend(|| eprintln!("recovery: {event}"));
         }
@@ -503,7 +424,12 @@ fn main() -> Result<()> {
         }
     });
     bar.finish_and_clear();
-    let end = end?;
+    Ok(end?)
+}
+
+/// The run's ending: the loss curve, recovery and export when finished; how to continue when
+/// interrupted (exit code 130).
+fn finish(args: &Args, trainer: &Trainer, end: RunEnd, out: &Path) -> Result<()> {
     let state = trainer.state();
     match end {
         RunEnd::Finished(dir) => {
