@@ -61,6 +61,22 @@ impl BareSession {
     }
 }
 
+/// Times drawing one step's noise, for a batch of 1 and of 16.
+fn time_noise(f: usize, frames: usize) {
+    for batch in [1, 16] {
+        let mut buffer = vec![0.0f32; batch * f * frames];
+        let start = Instant::now();
+        for stream in 0..50 {
+            sinmdm::diffusion::noise::fill_normals(1, stream, &mut buffer);
+        }
+        println!(
+            "noise for one step of batch {batch} ({} normals): {:.3} ms on one thread",
+            buffer.len(),
+            start.elapsed().as_secs_f64() / 50.0 * 1e3
+        );
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args()
         .skip(1)
@@ -91,18 +107,7 @@ fn main() {
         model.metadata().network.parameters,
         size as f64 / 1e6
     );
-    for batch in [1, 16] {
-        let mut buffer = vec![0.0f32; batch * f * frames];
-        let start = Instant::now();
-        for stream in 0..50 {
-            sinmdm::diffusion::noise::fill_normals(1, stream, &mut buffer);
-        }
-        println!(
-            "noise for one step of batch {batch} ({} normals): {:.3} ms on one thread",
-            buffer.len(),
-            start.elapsed().as_secs_f64() / 50.0 * 1e3
-        );
-    }
+    time_noise(f, frames);
     // A bare call follows every step of the sampling loop (from its progress callback, when the
     // noise thread is idle), so a slow spell of the machine hits the loop's steps and the bare
     // calls alike. A round is one sampling run; its overhead is (loop time without the

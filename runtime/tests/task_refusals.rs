@@ -106,6 +106,13 @@ fn bad_requests_are_refused_with_what_is_wrong() {
         matches!(e, TaskError::JointIndex { index: 999, .. }),
         "{e:?}"
     );
+}
+
+#[test]
+fn sizes_at_the_edge_of_usize_and_wide_ramps_are_refused() {
+    let m = model();
+    let reference = walk(&m, 100);
+    let message = |e: TaskError| e.to_string();
     // Sizes at the edge of usize are refused, never wrapped round or panicked on.
     for (prefix, suffix) in [
         (usize::MAX, 0),

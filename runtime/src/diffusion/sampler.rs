@@ -212,19 +212,7 @@ impl Sampler {
                 frames: self.shape.2,
             }));
         }
-        if let Some(steer) = &self.guidance.steering {
-            for row in x0.outer_iter_mut() {
-                steer.apply(row);
-            }
-        }
-        if let Some(inpaint) = &self.guidance.inpainting {
-            for mut row in x0.outer_iter_mut() {
-                Zip::from(&mut row)
-                    .and(&inpaint.mask)
-                    .and(&inpaint.reference)
-                    .for_each(|p, &m, &y| *p = *p * (1.0 - m) + y * m);
-            }
-        }
+        self.guide_prediction(&mut x0);
         let (c0, ct) = (c.x0 as f32, c.xt as f32);
         match (eps, &self.x0_prev) {
             (Some(eps), _) => {
@@ -247,32 +235,57 @@ impl Sampler {
                 .for_each(|x, &p| *x = c0 * p + ct * *x),
         }
         self.spare = self.x0_prev.replace(x0);
-        if let Some(h) = &self.guidance.harmonization
-            && harmonizing
-        {
-            // After the last step the sample is clean, so the target is the clean content.
-            let (a, s) = if k > 0 {
-                self.schedule.q_sample_coefficients(k - 1)
-            } else {
-                (1.0, 0.0)
-            };
-            let (a, s) = (a as f32, s as f32);
-            let mut noisy = harmonize_eps.unwrap_or_else(|| Array3::zeros(self.shape));
-            for mut row in noisy.outer_iter_mut() {
-                Zip::from(&mut row)
-                    .and(&h.content)
-                    .for_each(|e, &y| *e = a * y + s * *e);
-            }
-            let ours = low_pass(self.x.view(), h.factor);
-            let theirs = low_pass(noisy.view(), h.factor);
-            Zip::from(&mut self.x)
-                .and(&ours)
-                .and(&theirs)
-                .for_each(|x, &o, &c| *x = *x - o + c);
-            self.noise.recycle(noisy);
+        if harmonizing {
+            self.harmonize(k, harmonize_eps);
         }
         self.done += 1;
         Ok(())
+    }
+
+    /// Steering, then the inpainting mask, on the network's clean prediction `x0`.
+    fn guide_prediction(&self, x0: &mut Array3<f32>) {
+        if let Some(steer) = &self.guidance.steering {
+            for row in x0.outer_iter_mut() {
+                steer.apply(row);
+            }
+        }
+        if let Some(inpaint) = &self.guidance.inpainting {
+            for mut row in x0.outer_iter_mut() {
+                Zip::from(&mut row)
+                    .and(&inpaint.mask)
+                    .and(&inpaint.reference)
+                    .for_each(|p, &m, &y| *p = *p * (1.0 - m) + y * m);
+            }
+        }
+    }
+
+    /// Harmonization after step `k`: the sample's low frequencies replaced by the content's,
+    /// noised to the next step's level with `eps` (none after the last step: the sample is
+    /// clean, so the target is the clean content).
+    fn harmonize(&mut self, k: usize, eps: Option<Array3<f32>>) {
+        let Some(h) = &self.guidance.harmonization else {
+            return;
+        };
+        // After the last step the sample is clean, so the target is the clean content.
+        let (a, s) = if k > 0 {
+            self.schedule.q_sample_coefficients(k - 1)
+        } else {
+            (1.0, 0.0)
+        };
+        let (a, s) = (a as f32, s as f32);
+        let mut noisy = eps.unwrap_or_else(|| Array3::zeros(self.shape));
+        for mut row in noisy.outer_iter_mut() {
+            Zip::from(&mut row)
+                .and(&h.content)
+                .for_each(|e, &y| *e = a * y + s * *e);
+        }
+        let ours = low_pass(self.x.view(), h.factor);
+        let theirs = low_pass(noisy.view(), h.factor);
+        Zip::from(&mut self.x)
+            .and(&ours)
+            .and(&theirs)
+            .for_each(|x, &o, &c| *x = *x - o + c);
+        self.noise.recycle(noisy);
     }
 }
 

@@ -10,6 +10,7 @@ use crate::limits::{
     MAX_DIFFUSION_STEPS, MAX_FEATURES, MAX_FPS, MAX_JOINTS, MAX_NAME_BYTES, MAX_NETWORK_CHANNELS,
     MAX_SAMPLE_FRAMES, MAX_WINDOW,
 };
+use crate::motion::features::{FeatureLayout, RootFeatures};
 use crate::motion::math::{self, Mat3};
 use crate::motion::skeleton::{Channel, Skeleton};
 
@@ -146,60 +147,7 @@ fn layout(p: &mut Problems, m: &ModelMetadata) {
         p.finite(&format!("layout.rest_translations[{i}]"), &t.0);
     }
     if let Some(root) = &l.root {
-        if root.joint >= n {
-            p.add(format!(
-                "layout.root.joint is {}; the skeleton has {n} joints",
-                root.joint
-            ));
-        }
-        let axes: HashSet<_> = root.axes.iter().collect();
-        if root.axes.is_empty() || axes.len() != root.axes.len() {
-            p.add(format!(
-                "layout.root.axes is {:?}; it must list 1 to 3 distinct axes",
-                root.axes
-            ));
-        }
-        p.finite("layout.root.start_position", &root.start_position.0);
-        if let Some(h) = &root.heading {
-            for (field, j) in [("left", h.left), ("right", h.right)] {
-                if j >= n {
-                    p.add(format!(
-                        "layout.root.heading.{field} is {j}; the skeleton has {n} joints"
-                    ));
-                }
-            }
-            if h.left == h.right {
-                p.add(format!(
-                    "layout.root.heading.left and .right are both {}; they must differ",
-                    h.left
-                ));
-            }
-            if !(h.smoothing.is_finite() && (0.0..=10.0).contains(&h.smoothing)) {
-                p.add(format!(
-                    "layout.root.heading.smoothing is {}; it must be 0 to 10 seconds",
-                    h.smoothing
-                ));
-            }
-            p.finite("layout.root.heading.start", &[h.start]);
-            if root.axes.len() != 3 {
-                p.add(format!(
-                    "layout.root.axes is {:?}; a heading-relative root moves on all three",
-                    root.axes
-                ));
-            }
-            if root.joint < n && !l.rotation_joints.contains(&root.joint) {
-                p.add(format!(
-                    "layout.root.joint {} has no rotation column; a heading-relative root turns",
-                    root.joint
-                ));
-            }
-        }
-        if !is_rotation(&root.frame) {
-            p.add(format!(
-                "layout.root.frame is {:?}; it must be a rotation matrix",
-                root.frame
-            ));
-        }
+        root_layout(p, l, root);
     }
     let mut seen = HashSet::new();
     for (i, &j) in l.rotation_joints.iter().enumerate() {
@@ -237,6 +185,65 @@ fn layout(p: &mut Problems, m: &ModelMetadata) {
         } else if !seen.insert(j) {
             p.add(format!("{field}: joint {j} is listed twice"));
         }
+    }
+}
+
+/// The root's fields: its joint, axes, start, frame and a heading-relative root's facts.
+fn root_layout(p: &mut Problems, l: &FeatureLayout, root: &RootFeatures) {
+    let n = l.skeleton.joints.len();
+    if root.joint >= n {
+        p.add(format!(
+            "layout.root.joint is {}; the skeleton has {n} joints",
+            root.joint
+        ));
+    }
+    let axes: HashSet<_> = root.axes.iter().collect();
+    if root.axes.is_empty() || axes.len() != root.axes.len() {
+        p.add(format!(
+            "layout.root.axes is {:?}; it must list 1 to 3 distinct axes",
+            root.axes
+        ));
+    }
+    p.finite("layout.root.start_position", &root.start_position.0);
+    if let Some(h) = &root.heading {
+        for (field, j) in [("left", h.left), ("right", h.right)] {
+            if j >= n {
+                p.add(format!(
+                    "layout.root.heading.{field} is {j}; the skeleton has {n} joints"
+                ));
+            }
+        }
+        if h.left == h.right {
+            p.add(format!(
+                "layout.root.heading.left and .right are both {}; they must differ",
+                h.left
+            ));
+        }
+        if !(h.smoothing.is_finite() && (0.0..=10.0).contains(&h.smoothing)) {
+            p.add(format!(
+                "layout.root.heading.smoothing is {}; it must be 0 to 10 seconds",
+                h.smoothing
+            ));
+        }
+        p.finite("layout.root.heading.start", &[h.start]);
+        if root.axes.len() != 3 {
+            p.add(format!(
+                "layout.root.axes is {:?}; a heading-relative root moves on all three",
+                root.axes
+            ));
+        }
+        if root.joint < n && !l.rotation_joints.contains(&root.joint) {
+            p.add(format!(
+                "layout.root.joint {} has no rotation column; a heading-relative root turns",
+                root.joint
+            ));
+        }
+    }
+    if !is_rotation(&root.frame) {
+        p.add(format!(
+            "layout.root.frame is {:?}; it must be a rotation matrix",
+            root.frame
+        ));
     }
 }
 

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::motion::clip::LocalMotion;
 use crate::motion::contacts::travelling_root;
-use crate::motion::fk::global_poses;
+use crate::motion::fk::{GlobalPose, global_poses};
 use crate::motion::math::Vec3;
 use crate::motion::skeleton::Skeleton;
 use crate::motion::up::UpAxis;
@@ -139,48 +139,14 @@ pub fn detect_up(motion: &LocalMotion) -> UpDetection {
     let mut hang = Vec3::ZERO;
     let mut size = 0.0;
     for pose in &poses {
-        // The body's centre: bone midpoints weighted by bone length.
-        let mut centre = Vec3::ZERO;
-        let mut mass = 0.0;
-        for (j, joint) in skeleton.joints.iter().enumerate() {
-            if let Some(p) = joint.parent.filter(|_| j != top && in_body[j]) {
-                let length = (pose.joints[j] - pose.joints[p]).norm();
-                let mid = (pose.joints[j] + pose.joints[p]) * 0.5;
-                centre += mid * length;
-                mass += length;
-            }
-        }
-        let centre = if mass > 0.0 {
-            centre * (1.0 / mass)
-        } else {
-            pose.joints.first().copied().unwrap_or(Vec3::ZERO)
-        };
+        let centre = body_centre(skeleton, pose, top, &in_body);
         if total_weight > 0.0 {
             for &(leaf, weight) in &weights {
                 let d = pose.contact_point(leaf) - centre;
                 hang += d * (weight / total_weight);
             }
         }
-        let (mut lo, mut hi) = (Vec3([f64::INFINITY; 3]), Vec3([f64::NEG_INFINITY; 3]));
-        let body = pose
-            .joints
-            .iter()
-            .enumerate()
-            .filter(|&(j, _)| in_body[j])
-            .map(|(_, p)| *p)
-            .chain(
-                pose.end_sites
-                    .iter()
-                    .filter(|(j, _)| in_body[*j])
-                    .map(|(_, p)| *p),
-            );
-        for p in body {
-            for i in 0..3 {
-                lo[i] = lo[i].min(p[i]);
-                hi[i] = hi[i].max(p[i]);
-            }
-        }
-        size += (hi - lo).norm();
+        size += body_size(pose, &in_body);
     }
     let frames = poses.len();
     let (hang, size) = if frames > 0 {
@@ -240,6 +206,50 @@ pub fn detect_up(motion: &LocalMotion) -> UpDetection {
         frames,
         doubts,
     }
+}
+
+/// The body's centre in one pose: bone midpoints weighted by bone length (the bones below
+/// `top`), or the first joint where no bone has a length.
+fn body_centre(skeleton: &Skeleton, pose: &GlobalPose, top: usize, in_body: &[bool]) -> Vec3 {
+    let mut centre = Vec3::ZERO;
+    let mut mass = 0.0;
+    for (j, joint) in skeleton.joints.iter().enumerate() {
+        if let Some(p) = joint.parent.filter(|_| j != top && in_body[j]) {
+            let length = (pose.joints[j] - pose.joints[p]).norm();
+            let mid = (pose.joints[j] + pose.joints[p]) * 0.5;
+            centre += mid * length;
+            mass += length;
+        }
+    }
+    if mass > 0.0 {
+        centre * (1.0 / mass)
+    } else {
+        pose.joints.first().copied().unwrap_or(Vec3::ZERO)
+    }
+}
+
+/// The diagonal of the box around the body's joints and End Sites in one pose.
+fn body_size(pose: &GlobalPose, in_body: &[bool]) -> f64 {
+    let (mut lo, mut hi) = (Vec3([f64::INFINITY; 3]), Vec3([f64::NEG_INFINITY; 3]));
+    let body = pose
+        .joints
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| in_body[j])
+        .map(|(_, p)| *p)
+        .chain(
+            pose.end_sites
+                .iter()
+                .filter(|(j, _)| in_body[*j])
+                .map(|(_, p)| *p),
+        );
+    for p in body {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    (hi - lo).norm()
 }
 
 /// The up axis to use for a clip: `explicit` when given, else the detected one.

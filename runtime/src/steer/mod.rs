@@ -182,89 +182,15 @@ pub fn plan_steering(
     check_commands(metadata, commands)?;
     let layout = &metadata.layout;
     let fps = layout.fps;
-    let to_canonical = layout.up.canonical_from_file();
     let mut warnings = Vec::new();
-    let mut warn = |line: String| {
-        if !warnings.contains(&line) {
-            warnings.push(line);
-        }
-    };
-    let goals: Vec<Goal> = commands
-        .iter()
-        .map(|c| match *c {
-            SteerFrame::Free => Goal::Free,
-            SteerFrame::Velocity { forward, turn } => {
-                let (lo, hi) = limits.forward;
-                let f = forward.clamp(lo, hi);
-                if f != forward {
-                    warn(format!(
-                        "forward speeds beyond the clip's {lo:.3} to {hi:.3} units/s were clamped"
-                    ));
-                }
-                let t = turn.clamp(-limits.turn, limits.turn);
-                if t != turn {
-                    warn(format!(
-                        "turn rates beyond the clip's {:.0} degrees/s were clamped",
-                        limits.turn.to_degrees()
-                    ));
-                }
-                Goal::Velocity {
-                    forward: f / fps,
-                    turn: t / fps,
-                }
-            }
-            SteerFrame::Position(_) | SteerFrame::Facing(_) | SteerFrame::PositionFacing { .. } => {
-                let position = c.position().map(|p| {
-                    let mut q = to_canonical * p;
-                    q[UP] = 0.0;
-                    q
-                });
-                let facing = c.facing().and_then(|d| facing_of_direction(metadata, d));
-                Goal::Course { position, facing }
-            }
-        })
-        .collect();
+    let goals = goals_of(metadata, commands, &limits, &mut warnings);
     // A path faster than the clip ever went is followed at the clip's top speed.
     let top = limits.forward.1.max(0.0);
-    for pair in goals.windows(2) {
-        if let (Some(a), Some(b)) = (pair[0].position(), pair[1].position())
-            && (b - a).norm() * fps > top * 1.0001
-        {
-            warn(format!(
-                "the path goes faster than the clip's {top:.3} units/s; it is followed at that speed"
-            ));
-            break;
-        }
-    }
     // A path with a facing of its own asks for travel in the facing's frame: sideways or
     // backwards faster than the clip went is followed at the clip's pace.
     let sideways = (limits.sideways.0.min(0.0), limits.sideways.1.max(0.0));
     let slowest = limits.forward.0.min(0.0);
-    for pair in goals.windows(2) {
-        if let (
-            Some(a),
-            Goal::Course {
-                position: Some(b),
-                facing: Some(h),
-            },
-        ) = (pair[0].position(), pair[1])
-        {
-            let local = yaw(h).transpose() * (b - a);
-            let (f, l) = (local[2] * fps, local[0] * fps);
-            let (lo, hi) = sideways;
-            let beyond = |v: f64, bound: f64| (v - bound).abs() > 1e-4 * bound.abs() + 1e-12;
-            if (l < lo && beyond(l, lo)) || (l > hi && beyond(l, hi)) {
-                warn(format!(
-                    "the path with its facing asks for sideways speeds beyond the clip's {lo:.3} to {hi:.3} units/s; they are clamped, so the path is followed more slowly"
-                ));
-            }
-            if f < slowest && beyond(f, slowest) {
-                warn(format!(
-                    "the path with its facing asks for backward speeds beyond the clip's slowest {slowest:.3} units/s; they are clamped, so the path is followed more slowly"
-                ));
-            }
-        }
-    }
+    warn_of_fast_paths(&goals, fps, top, (sideways, slowest), &mut warnings);
     let asked: Vec<bool> = goals
         .iter()
         .enumerate()
@@ -319,6 +245,110 @@ pub fn plan_steering(
     })
 }
 
+/// Adds `line` to `warnings` unless it is there already.
+fn warn_once(warnings: &mut Vec<String>, line: String) {
+    if !warnings.contains(&line) {
+        warnings.push(line);
+    }
+}
+
+/// Each command as a goal in the canonical frame, per frame; speeds and turns beyond the
+/// clip's `limits` clamped, with a warning.
+fn goals_of(
+    metadata: &ModelMetadata,
+    commands: &[SteerFrame],
+    limits: &SteerLimits,
+    warnings: &mut Vec<String>,
+) -> Vec<Goal> {
+    let fps = metadata.layout.fps;
+    let to_canonical = metadata.layout.up.canonical_from_file();
+    let mut warn = |line: String| warn_once(warnings, line);
+    commands
+        .iter()
+        .map(|c| match *c {
+            SteerFrame::Free => Goal::Free,
+            SteerFrame::Velocity { forward, turn } => {
+                let (lo, hi) = limits.forward;
+                let f = forward.clamp(lo, hi);
+                if f != forward {
+                    warn(format!(
+                        "forward speeds beyond the clip's {lo:.3} to {hi:.3} units/s were clamped"
+                    ));
+                }
+                let t = turn.clamp(-limits.turn, limits.turn);
+                if t != turn {
+                    warn(format!(
+                        "turn rates beyond the clip's {:.0} degrees/s were clamped",
+                        limits.turn.to_degrees()
+                    ));
+                }
+                Goal::Velocity {
+                    forward: f / fps,
+                    turn: t / fps,
+                }
+            }
+            SteerFrame::Position(_) | SteerFrame::Facing(_) | SteerFrame::PositionFacing { .. } => {
+                let position = c.position().map(|p| {
+                    let mut q = to_canonical * p;
+                    q[UP] = 0.0;
+                    q
+                });
+                let facing = c.facing().and_then(|d| facing_of_direction(metadata, d));
+                Goal::Course { position, facing }
+            }
+        })
+        .collect()
+}
+
+/// Warns of a path faster than the clip's `top` speed, and of a path with a facing of its own
+/// that asks for sideways or backward speeds beyond the clip's (`pace`: the sideways range and
+/// the slowest forward speed, each taking in 0).
+fn warn_of_fast_paths(
+    goals: &[Goal],
+    fps: f64,
+    top: f64,
+    pace: ((f64, f64), f64),
+    warnings: &mut Vec<String>,
+) {
+    let (sideways, slowest) = pace;
+    let mut warn = |line: String| warn_once(warnings, line);
+    for pair in goals.windows(2) {
+        if let (Some(a), Some(b)) = (pair[0].position(), pair[1].position())
+            && (b - a).norm() * fps > top * 1.0001
+        {
+            warn(format!(
+                "the path goes faster than the clip's {top:.3} units/s; it is followed at that speed"
+            ));
+            break;
+        }
+    }
+    for pair in goals.windows(2) {
+        if let (
+            Some(a),
+            Goal::Course {
+                position: Some(b),
+                facing: Some(h),
+            },
+        ) = (pair[0].position(), pair[1])
+        {
+            let local = yaw(h).transpose() * (b - a);
+            let (f, l) = (local[2] * fps, local[0] * fps);
+            let (lo, hi) = sideways;
+            let beyond = |v: f64, bound: f64| (v - bound).abs() > 1e-4 * bound.abs() + 1e-12;
+            if (l < lo && beyond(l, lo)) || (l > hi && beyond(l, hi)) {
+                warn(format!(
+                    "the path with its facing asks for sideways speeds beyond the clip's {lo:.3} to {hi:.3} units/s; they are clamped, so the path is followed more slowly"
+                ));
+            }
+            if f < slowest && beyond(f, slowest) {
+                warn(format!(
+                    "the path with its facing asks for backward speeds beyond the clip's slowest {slowest:.3} units/s; they are clamped, so the path is followed more slowly"
+                ));
+            }
+        }
+    }
+}
+
 impl Steering {
     /// Frames of the window it steers.
     pub fn frames(&self) -> usize {
@@ -354,6 +384,40 @@ impl Steering {
         for _ in 0..STEER_PASSES {
             self.pass(x0.view_mut());
         }
+    }
+
+    /// The direction a path span without a facing leaves in at frame `i` (standing at `p`):
+    /// its first step, or, standing still, its step to the next frame, or the facing before.
+    fn leading_direction(&self, i: usize, p: Vec3, path_step: Vec3, heading_before: f64) -> f64 {
+        let mut lead = path_step;
+        if lead.norm() <= 1e-12
+            && let Some(next) = self.goals.get(i + 1).and_then(Goal::position)
+        {
+            lead = next - p;
+            lead[UP] = 0.0;
+        }
+        if lead.norm() > 1e-12 {
+            lead[0].atan2(lead[2])
+        } else {
+            heading_before
+        }
+    }
+
+    /// The forward and leftward step that makes the ground step `want` facing `heading`, no
+    /// faster than the clip goes; with a facing of its own (`own_facing`) no more sideways or
+    /// backwards than the clip went.
+    fn travel(&self, mut want: Vec3, heading: f64, own_facing: bool) -> (f64, f64) {
+        let speed = want.norm();
+        if speed > self.max_step && speed > 0.0 {
+            want = want * (self.max_step / speed);
+        }
+        let local = yaw(heading).transpose() * want;
+        let (mut ahead, mut aside) = (local[2], local[0]);
+        if own_facing {
+            ahead = ahead.max(self.backward_floor);
+            aside = aside.max(self.sideways_range.0).min(self.sideways_range.1);
+        }
+        (ahead, aside)
     }
 
     fn pass(&self, mut x0: ArrayViewMut2<'_, f32>) {
@@ -412,21 +476,7 @@ impl Steering {
                             // still).
                             let direction = match facing {
                                 Some(f) => f,
-                                None => {
-                                    let mut lead = path_step;
-                                    if lead.norm() <= 1e-12
-                                        && let Some(next) =
-                                            self.goals.get(i + 1).and_then(Goal::position)
-                                    {
-                                        lead = next - p;
-                                        lead[UP] = 0.0;
-                                    }
-                                    if lead.norm() > 1e-12 {
-                                        lead[0].atan2(lead[2])
-                                    } else {
-                                        heading[i - 1]
-                                    }
-                                }
+                                None => self.leading_direction(i, p, path_step, heading[i - 1]),
                             };
                             last_direction = heading[i - 1] + wrap(direction - heading[i - 1]);
                             let mut offset = before - position[i - 1];
@@ -442,19 +492,8 @@ impl Steering {
                     if goal_position.is_some() {
                         // The wanted step: the path's, less the part of the offset this frame
                         // takes away; no faster than the clip goes.
-                        let mut want = path_step + offset * (then - now);
-                        let speed = want.norm();
-                        if speed > self.max_step && speed > 0.0 {
-                            want = want * (self.max_step / speed);
-                        }
-                        let local = yaw(heading[i]).transpose() * want;
-                        let (mut ahead, mut aside) = (local[2], local[0]);
-                        if facing.is_some() {
-                            // Walked in a facing of its own: no more sideways or backwards
-                            // than the clip went.
-                            ahead = ahead.max(self.backward_floor);
-                            aside = aside.max(self.sideways_range.0).min(self.sideways_range.1);
-                        }
+                        let want = path_step + offset * (then - now);
+                        let (ahead, aside) = self.travel(want, heading[i], facing.is_some());
                         targets[FORWARD][i] = Some(ahead);
                         targets[LEFTWARD][i] = Some(aside);
                     }

@@ -7,6 +7,7 @@ use super::{Frame, Stream, block_seed};
 use crate::diffusion::sampler::{Guidance, Inpainting, Sampler};
 use crate::motion::features::heading::yaw;
 use crate::motion::feet::{Anchor, Feet, Kept, PlantOptions, plant_feet};
+use crate::motion::math::Vec3;
 use crate::motion::up::UP;
 use crate::motion::{LocalMotion, RootStart, decode, decode_from, root_track};
 use crate::steer::plan_steering;
@@ -132,6 +133,45 @@ impl Stream {
         let layout = &self.metadata.layout;
         let joints = layout.skeleton.len();
         let rows = raw.slice(s![.., ..done.end]);
+        let (motion, last_root, last_course) = self.carry_root_on(layout, rows, &done)?;
+        let motion = if self.feet == Feet::Planted {
+            self.plant(layout, motion, raw.view(), &done, &travel_commanded)?
+        } else {
+            motion
+        };
+        self.carried = Some(carried);
+        self.last_root = last_root;
+        self.last_course = last_course;
+        for frame in done.clone() {
+            let range = frame * joints..(frame + 1) * joints;
+            self.ready.push_back(Frame {
+                features: raw.column(frame).to_vec(),
+                rotations: motion.rotations[range.clone()].to_vec(),
+                translations: motion.translations[range].to_vec(),
+            });
+        }
+        let tail_from = (done.end - sizes.context) * joints;
+        self.tail = Some(LocalMotion {
+            skeleton: layout.skeleton.clone(),
+            fps: layout.fps,
+            rotations: motion.rotations[tail_from..].to_vec(),
+            translations: motion.translations[tail_from..].to_vec(),
+        });
+        self.blocks += 1;
+        Ok(())
+    }
+
+    /// Decodes the finalised rows with the root carried on from the last chunk: a
+    /// heading-relative root's course turned and moved to go on from the last final frame's
+    /// position and facing, a world root shifted to it. Gives the motion and the new last root
+    /// and course (the stream itself is not changed).
+    fn carry_root_on(
+        &self,
+        layout: &crate::motion::FeatureLayout,
+        rows: ndarray::ArrayView2<'_, f32>,
+        done: &std::ops::Range<usize>,
+    ) -> Result<(LocalMotion, Option<Vec3>, Option<RootStart>), TaskError> {
+        let joints = layout.skeleton.len();
         let mut last_root = self.last_root;
         let mut last_course = self.last_course;
         let mut motion = match RootStart::of(layout) {
@@ -174,53 +214,45 @@ impl Stream {
             }
             last_root = Some(motion.translations[(done.end - 1) * joints + r]);
         }
-        if self.feet == Feet::Planted {
-            if let Some(tail) = &self.tail {
-                // What was handed out stays as it was.
-                let kept = done.start * joints;
-                motion.rotations[..kept].copy_from_slice(&tail.rotations);
-                motion.translations[..kept].copy_from_slice(&tail.translations);
-            }
-            let labels: Vec<Vec<f32>> = layout
-                .contact_rows()
-                .into_iter()
-                .map(|row| raw.row(row).slice(s![..done.end]).to_vec())
-                .collect();
-            let kept = Kept {
-                joints: (0..done.end)
-                    .map(|frame| vec![frame < done.start; joints])
-                    .collect(),
-                root: (0..done.end)
-                    .map(|frame| {
-                        frame < done.start || travel_commanded.get(frame).copied() == Some(true)
-                    })
-                    .collect(),
-            };
-            let options = PlantOptions {
-                anchor: Anchor::Landing,
-                ..PlantOptions::default()
-            };
-            motion = plant_feet(layout, &motion, &labels, &kept, &options)?.0;
+        Ok((motion, last_root, last_course))
+    }
+
+    /// Plants the feet of the decoded frames, keeping the frames handed out as they were and
+    /// the roots steering commanded where it put them.
+    fn plant(
+        &self,
+        layout: &crate::motion::FeatureLayout,
+        mut motion: LocalMotion,
+        raw: ndarray::ArrayView2<'_, f32>,
+        done: &std::ops::Range<usize>,
+        travel_commanded: &[bool],
+    ) -> Result<LocalMotion, TaskError> {
+        let joints = layout.skeleton.len();
+        if let Some(tail) = &self.tail {
+            // What was handed out stays as it was.
+            let kept = done.start * joints;
+            motion.rotations[..kept].copy_from_slice(&tail.rotations);
+            motion.translations[..kept].copy_from_slice(&tail.translations);
         }
-        self.carried = Some(carried);
-        self.last_root = last_root;
-        self.last_course = last_course;
-        for frame in done.clone() {
-            let range = frame * joints..(frame + 1) * joints;
-            self.ready.push_back(Frame {
-                features: raw.column(frame).to_vec(),
-                rotations: motion.rotations[range.clone()].to_vec(),
-                translations: motion.translations[range].to_vec(),
-            });
-        }
-        let tail_from = (done.end - sizes.context) * joints;
-        self.tail = Some(LocalMotion {
-            skeleton: layout.skeleton.clone(),
-            fps: layout.fps,
-            rotations: motion.rotations[tail_from..].to_vec(),
-            translations: motion.translations[tail_from..].to_vec(),
-        });
-        self.blocks += 1;
-        Ok(())
+        let labels: Vec<Vec<f32>> = layout
+            .contact_rows()
+            .into_iter()
+            .map(|row| raw.row(row).slice(s![..done.end]).to_vec())
+            .collect();
+        let kept = Kept {
+            joints: (0..done.end)
+                .map(|frame| vec![frame < done.start; joints])
+                .collect(),
+            root: (0..done.end)
+                .map(|frame| {
+                    frame < done.start || travel_commanded.get(frame).copied() == Some(true)
+                })
+                .collect(),
+        };
+        let options = PlantOptions {
+            anchor: Anchor::Landing,
+            ..PlantOptions::default()
+        };
+        Ok(plant_feet(layout, &motion, &labels, &kept, &options)?.0)
     }
 }

@@ -145,24 +145,7 @@ pub fn decode_from(
         row += 6;
     }
     if let Some((joint, headings)) = &facing {
-        for (f, &h) in headings.iter().enumerate() {
-            let k = f * joints + joint;
-            rotations[k] = yaw(h) * rotations[k];
-        }
-        // The joints above the motion root were taken relative to the first facing.
-        let first = layout
-            .root
-            .as_ref()
-            .and_then(|r| r.heading.as_ref())
-            .map_or(0.0, |h| h.start);
-        for above in layout.skeleton.ancestors(*joint) {
-            if layout.rotation_joints.contains(&above) {
-                for f in 0..frames {
-                    let k = f * joints + above;
-                    rotations[k] = yaw(first) * rotations[k];
-                }
-            }
-        }
+        turn_back_to_facing(layout, *joint, headings, &mut rotations);
     }
     for &(joint, axis) in &layout.position_channels {
         for f in 0..frames {
@@ -185,4 +168,34 @@ pub fn decode_from(
         translations,
     };
     Ok(to_file(&canonical, layout.up))
+}
+
+/// Turns the motion root's rotation by its facing per frame, and the rotating joints above it
+/// by the first facing (they were taken relative to it).
+fn turn_back_to_facing(
+    layout: &FeatureLayout,
+    joint: usize,
+    headings: &[f64],
+    rotations: &mut [Mat3],
+) {
+    let joints = layout.skeleton.len();
+    let frames = headings.len();
+    for (f, &h) in headings.iter().enumerate() {
+        let k = f * joints + joint;
+        rotations[k] = yaw(h) * rotations[k];
+    }
+    // The joints above the motion root were taken relative to the first facing.
+    let first = layout
+        .root
+        .as_ref()
+        .and_then(|r| r.heading.as_ref())
+        .map_or(0.0, |h| h.start);
+    for above in layout.skeleton.ancestors(joint) {
+        if layout.rotation_joints.contains(&above) {
+            for f in 0..frames {
+                let k = f * joints + above;
+                rotations[k] = yaw(first) * rotations[k];
+            }
+        }
+    }
 }

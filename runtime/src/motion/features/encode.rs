@@ -114,22 +114,7 @@ fn check_resampled_length(clip: &ChannelClip, fps: f64) -> Result<(), MotionErro
 /// Turns a clip into features: resampled to `options.fps`, root displacement and height, 6D
 /// rotations, varying positions and contact labels.
 pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip, MotionError> {
-    if clip.frame_count() == 0 {
-        return Err(MotionError::NoFrames);
-    }
-    let fps = options.fps.unwrap_or(clip.fps);
-    if !(fps.is_finite() && fps > 0.0) {
-        return Err(MotionError::BadFrameRate(fps));
-    }
-    for (what, value) in [
-        ("speed threshold", options.contacts.speed_threshold),
-        ("ground fraction", options.contacts.ground_fraction),
-    ] {
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(MotionError::BadContactSetting { what, value });
-        }
-    }
-    check_resampled_length(clip, fps)?;
+    let fps = checked_fps(clip, options)?;
     let skeleton = &clip.skeleton;
     let varies = varying_channels(clip);
     let starts = skeleton.channel_starts();
@@ -155,66 +140,9 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
     let local = to_canonical(&resample(&file_local, fps), up);
     let joints = skeleton.len();
 
-    let first = clip.frame(0);
-    let rest_translations: Vec<Vec3> = skeleton
-        .joints
-        .iter()
-        .enumerate()
-        .map(|(j, joint)| {
-            let mut translation = joint.offset;
-            for (c, channel) in joint.channels.iter().enumerate() {
-                if let Channel::Position(axis) = channel {
-                    translation[axis.index()] = first[starts[j] + c];
-                }
-            }
-            if joint.parent.is_none() {
-                translation = canonical_from_file * translation;
-            }
-            translation
-        })
-        .collect();
-    // A motion root below the top joint sits in its container's frame; take that frame (at
-    // frame 0: the container is static) to the canonical one.
-    // Entries within 1e-9 of 0 or +-1 are snapped, so a container turned by a quarter turn
-    // written as text (cos 90 = 6e-17) gives an exact axis permutation.
-    let frame = match skeleton.joints[root_joint].parent {
-        Some(parent) => {
-            let frame = global_pose(&local, 0).rotations[parent];
-            Mat3::from_fn(|r, c| {
-                let v = frame[r][c];
-                if (v - v.round()).abs() < 1e-9 {
-                    v.round() + 0.0
-                } else {
-                    v
-                }
-            })
-        }
-        None => IDENTITY,
-    };
-    let to_canonical_axes = if root_joint == 0 {
-        canonical_from_file
-    } else {
-        frame
-    };
-    let mut root_axes: Vec<usize> = skeleton.joints[root_joint]
-        .position_axes()
-        .iter()
-        .map(|a| {
-            let column = [0, 1, 2].map(|i| to_canonical_axes[i][a.index()].abs());
-            (0..3)
-                .max_by(|&x, &y| column[x].total_cmp(&column[y]))
-                .unwrap_or(a.index())
-        })
-        .collect();
-    root_axes.sort_unstable();
-    root_axes.dedup();
-    let root = (!root_axes.is_empty()).then(|| RootFeatures {
-        joint: root_joint,
-        axes: root_axes.into_iter().map(Axis::from_index).collect(),
-        start_position: (frame * local.translations[root_joint]),
-        frame,
-        heading: None,
-    });
+    let rest_translations = rest_translations(clip, canonical_from_file);
+    let frame = container_frame(skeleton, root_joint, &local);
+    let root = root_features(skeleton, root_joint, canonical_from_file, frame, &local);
     let rotation_joints: Vec<usize> = (0..joints)
         .filter(|&j| skeleton.joints[j].rotates())
         .collect();
@@ -230,25 +158,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
 
     let poses = global_poses(&local);
     let height = skeleton_height(&poses);
-    let contact_joints = match &options.contacts.joints {
-        Some(names) => names
-            .iter()
-            .map(|name| {
-                skeleton
-                    .find(name)
-                    .ok_or_else(|| MotionError::UnknownContactJoint {
-                        name: name.clone(),
-                        available: skeleton
-                            .joints
-                            .iter()
-                            .map(|j| j.name.as_str())
-                            .collect::<Vec<_>>()
-                            .join(", "),
-                    })
-            })
-            .collect::<Result<Vec<_>, _>>()?,
-        None => choose_contact_joints(skeleton, &poses, height, options.contacts.ground_fraction),
-    };
+    let contact_joints = contact_joints(skeleton, &options.contacts, &poses, height)?;
 
     let layout = FeatureLayout {
         skeleton: skeleton.clone(),
@@ -267,32 +177,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         ground: Some(ground_level(&layout.contact_joints, &poses)),
         ..layout
     };
-    let mut world_root_reason = None;
-    let heading = match options.root {
-        RootLayout::World => None,
-        RootLayout::Heading => Some(choose_heading(&layout, &local, &poses)?),
-        RootLayout::Auto => {
-            let travel = layout.root.as_ref().map_or(0.0, |r| {
-                median_travel(&poses, r.joint, layout.fps, layout.skeleton_height)
-            });
-            if travel < HEADING_MIN_TRAVEL {
-                world_root_reason = Some(format!(
-                    "its root travels {travel:.2} heights/s (the median over 1-second windows), \
-                     under the {HEADING_MIN_TRAVEL} of locomotion, so there is nothing to steer"
-                ));
-                None
-            } else {
-                match choose_heading(&layout, &local, &poses) {
-                    Ok(heading) => Some(heading),
-                    Err(MotionError::Heading(why)) => {
-                        world_root_reason = Some(why);
-                        None
-                    }
-                    Err(e) => return Err(e),
-                }
-            }
-        }
-    };
+    let (heading, world_root_reason) = root_heading(options.root, &layout, &local, &poses)?;
     if let Some(heading) = heading
         && let Some(root) = layout.root.as_mut()
     {
@@ -309,6 +194,175 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         in_place: filled.in_place,
         world_root_reason,
     })
+}
+
+/// The frame rate to encode at, after checking the options against the clip.
+fn checked_fps(clip: &ChannelClip, options: &EncodeOptions) -> Result<f64, MotionError> {
+    if clip.frame_count() == 0 {
+        return Err(MotionError::NoFrames);
+    }
+    let fps = options.fps.unwrap_or(clip.fps);
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(MotionError::BadFrameRate(fps));
+    }
+    for (what, value) in [
+        ("speed threshold", options.contacts.speed_threshold),
+        ("ground fraction", options.contacts.ground_fraction),
+    ] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(MotionError::BadContactSetting { what, value });
+        }
+    }
+    check_resampled_length(clip, fps)?;
+    Ok(fps)
+}
+
+/// Each joint's translation in the clip's first frame: its offset, with the position channels
+/// it has; a top joint's turned to the canonical frame.
+fn rest_translations(clip: &ChannelClip, canonical_from_file: Mat3) -> Vec<Vec3> {
+    let skeleton = &clip.skeleton;
+    let starts = skeleton.channel_starts();
+    let first = clip.frame(0);
+    skeleton
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(j, joint)| {
+            let mut translation = joint.offset;
+            for (c, channel) in joint.channels.iter().enumerate() {
+                if let Channel::Position(axis) = channel {
+                    translation[axis.index()] = first[starts[j] + c];
+                }
+            }
+            if joint.parent.is_none() {
+                translation = canonical_from_file * translation;
+            }
+            translation
+        })
+        .collect()
+}
+
+/// The canonical frame of the motion root's container (at frame 0: the container is static);
+/// the identity for a top joint.
+fn container_frame(skeleton: &Skeleton, root_joint: usize, local: &LocalMotion) -> Mat3 {
+    // A motion root below the top joint sits in its container's frame; take that frame (at
+    // frame 0: the container is static) to the canonical one.
+    // Entries within 1e-9 of 0 or +-1 are snapped, so a container turned by a quarter turn
+    // written as text (cos 90 = 6e-17) gives an exact axis permutation.
+    match skeleton.joints[root_joint].parent {
+        Some(parent) => {
+            let frame = global_pose(local, 0).rotations[parent];
+            Mat3::from_fn(|r, c| {
+                let v = frame[r][c];
+                if (v - v.round()).abs() < 1e-9 {
+                    v.round() + 0.0
+                } else {
+                    v
+                }
+            })
+        }
+        None => IDENTITY,
+    }
+}
+
+/// The root's features: the canonical axes its position channels move along, its start and
+/// frame; none for a root without position channels.
+fn root_features(
+    skeleton: &Skeleton,
+    root_joint: usize,
+    canonical_from_file: Mat3,
+    frame: Mat3,
+    local: &LocalMotion,
+) -> Option<RootFeatures> {
+    let to_canonical_axes = if root_joint == 0 {
+        canonical_from_file
+    } else {
+        frame
+    };
+    let mut root_axes: Vec<usize> = skeleton.joints[root_joint]
+        .position_axes()
+        .iter()
+        .map(|a| {
+            let column = [0, 1, 2].map(|i| to_canonical_axes[i][a.index()].abs());
+            (0..3)
+                .max_by(|&x, &y| column[x].total_cmp(&column[y]))
+                .unwrap_or(a.index())
+        })
+        .collect();
+    root_axes.sort_unstable();
+    root_axes.dedup();
+    (!root_axes.is_empty()).then(|| RootFeatures {
+        joint: root_joint,
+        axes: root_axes.into_iter().map(Axis::from_index).collect(),
+        start_position: (frame * local.translations[root_joint]),
+        frame,
+        heading: None,
+    })
+}
+
+/// The contact joints: the ones named in the options, or chosen from the poses.
+fn contact_joints(
+    skeleton: &Skeleton,
+    contacts: &ContactConfig,
+    poses: &[crate::motion::fk::GlobalPose],
+    height: f64,
+) -> Result<Vec<usize>, MotionError> {
+    Ok(match &contacts.joints {
+        Some(names) => names
+            .iter()
+            .map(|name| {
+                skeleton
+                    .find(name)
+                    .ok_or_else(|| MotionError::UnknownContactJoint {
+                        name: name.clone(),
+                        available: skeleton
+                            .joints
+                            .iter()
+                            .map(|j| j.name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?,
+        None => choose_contact_joints(skeleton, poses, height, contacts.ground_fraction),
+    })
+}
+
+/// The heading-relative root's facts when the root layout asks for one (for `Auto`, a clip
+/// whose root travels), or why the root stays in world axes.
+fn root_heading(
+    root_layout: RootLayout,
+    layout: &FeatureLayout,
+    local: &LocalMotion,
+    poses: &[crate::motion::fk::GlobalPose],
+) -> Result<(Option<Heading>, Option<String>), MotionError> {
+    let mut world_root_reason = None;
+    let heading = match root_layout {
+        RootLayout::World => None,
+        RootLayout::Heading => Some(choose_heading(layout, local, poses)?),
+        RootLayout::Auto => {
+            let travel = layout.root.as_ref().map_or(0.0, |r| {
+                median_travel(poses, r.joint, layout.fps, layout.skeleton_height)
+            });
+            if travel < HEADING_MIN_TRAVEL {
+                world_root_reason = Some(format!(
+                    "its root travels {travel:.2} heights/s (the median over 1-second windows), \
+                     under the {HEADING_MIN_TRAVEL} of locomotion, so there is nothing to steer"
+                ));
+                None
+            } else {
+                match choose_heading(layout, local, poses) {
+                    Ok(heading) => Some(heading),
+                    Err(MotionError::Heading(why)) => {
+                        world_root_reason = Some(why);
+                        None
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
+        }
+    };
+    Ok((heading, world_root_reason))
 }
 
 /// The heading-relative root's facts for a clip (see [`super::heading`]), or why it has none.
