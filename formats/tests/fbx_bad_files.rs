@@ -43,14 +43,20 @@ fn error(bytes: &[u8], name: &str) -> String {
     }
 }
 
+/// The fixture as it is reads, so each edit below is what fails.
 #[test]
-fn each_kind_of_problem_is_named() {
+fn the_unedited_fixture_reads() {
     let text = mixamo_text();
     assert_eq!(
         read(text.as_bytes(), "fine.fbx", &ReadOptions::default()),
         Ok(31)
     );
+}
 
+/// Files that are not FBX, or are damaged or cut short, are refused as such.
+#[test]
+fn files_that_are_not_sound_fbx_are_named() {
+    let text = mixamo_text();
     // Not FBX at all, and an empty file.
     let message = error(b"solid cube\nendsolid cube\n", "not_fbx.fbx");
     assert!(message.contains("not an FBX file"), "{message}");
@@ -86,7 +92,12 @@ fn each_kind_of_problem_is_named() {
         message.contains("cut short") || message.contains("damaged"),
         "{message}"
     );
+}
 
+/// A file with no bones, or with two skeletons, is refused as such.
+#[test]
+fn a_missing_or_split_skeleton_is_named() {
+    let text = mixamo_text();
     // No bones: every limb node made a plain null.
     let message = error(
         text.replace("\"LimbNode\" {", "\"Null\" {").as_bytes(),
@@ -115,7 +126,12 @@ fn each_kind_of_problem_is_named() {
         message.contains("2 root bones") && message.contains("LHipJoint"),
         "{message}"
     );
+}
 
+/// A file with no animation stack, or without the one asked for, is refused as such.
+#[test]
+fn a_missing_animation_stack_is_named() {
+    let text = mixamo_text();
     // No animation stack.
     let start = text.find("\tAnimationStack:").unwrap();
     let end = start + text[start..].find("\n\t}\n").unwrap() + 4;
@@ -141,7 +157,12 @@ fn each_kind_of_problem_is_named() {
     };
     let message = read(text.as_bytes(), "no_3.fbx", &by_index).unwrap_err();
     assert!(message.contains("no animation stack 3"), "{message}");
+}
 
+/// A frame rate that is no rate, or that makes the clip too long, is refused as such.
+#[test]
+fn a_bad_frame_rate_is_named() {
+    let text = mixamo_text();
     // A frame rate that is no rate, and one that makes the clip absurdly long.
     let zero_fps = ReadOptions {
         animation: None,
@@ -155,7 +176,12 @@ fn each_kind_of_problem_is_named() {
     };
     let message = read(text.as_bytes(), "huge_fps.fbx", &huge_fps).unwrap_err();
     assert!(message.contains("--fps"), "{message}");
+}
 
+/// A bone with a non-uniform scale is refused as such.
+#[test]
+fn a_non_uniform_scale_is_named() {
+    let text = mixamo_text();
     // A bone squashed by a non-uniform scale.
     let squashed = text.replacen(
         "P: \"Lcl Scaling\", \"Lcl Scaling\", \"\", \"A\",1,1,1",
@@ -164,7 +190,12 @@ fn each_kind_of_problem_is_named() {
     );
     let message = error(squashed.as_bytes(), "squashed.fbx");
     assert!(message.contains("scale"), "{message}");
+}
 
+/// A stack with no declared time range still reads.
+#[test]
+fn a_stack_with_no_time_range_reads() {
+    let text = mixamo_text();
     // A stack that declares no time range is read from its first key to its last.
     let no_range: String = text
         .lines()
@@ -175,7 +206,12 @@ fn each_kind_of_problem_is_named() {
         read(no_range.as_bytes(), "no_range.fbx", &ReadOptions::default()),
         Ok(31)
     );
+}
 
+/// FBX bytes under another extension are refused by name.
+#[test]
+fn another_extension_is_refused_by_name() {
+    let text = mixamo_text();
     // The extension decides: FBX bytes under another name are refused by name.
     let path = scratch("walk.fbz");
     std::fs::write(&path, text.as_bytes()).unwrap();

@@ -205,50 +205,14 @@ pub(super) fn retargeted(
     }
     // In the character's hierarchy order, so a bone's paired ancestor comes first.
     pairs.sort_by_key(|&(node, _)| target.depth(node));
-    let paired_parent: Vec<Option<usize>> = pairs
-        .iter()
-        .map(|&(node, _)| {
-            let mut at = target.parents[node];
-            let mut steps = 0;
-            while let Some(a) = at {
-                if let Some(k) = pairs.iter().position(|&(n, _)| n == a) {
-                    return Some(k);
-                }
-                steps += 1;
-                if steps > target.parents.len() {
-                    break;
-                }
-                at = target.parents[a];
-            }
-            None
-        })
-        .collect();
+    let paired_parent = paired_parents(&pairs, target);
     // The bone that carries the body: the top paired bone following the highest joint.
     let top = (0..pairs.len())
         .filter(|&k| paired_parent[k].is_none())
         .min_by_key(|&k| source.depth(pairs[k].1))
         .unwrap_or(0);
     // Each bone's rest alignment, from the directions to its paired children.
-    let mut align: Vec<Mat3> = Vec::with_capacity(pairs.len());
-    for (k, &(node, joint)) in pairs.iter().enumerate() {
-        let directions: Vec<(Vec3, Vec3)> = (0..pairs.len())
-            .filter(|&c| paired_parent[c] == Some(k))
-            .map(|c| {
-                let (child_node, child_joint) = pairs[c];
-                (
-                    rest[child_node].translation - rest[node].translation,
-                    model[child_joint].1 - model[joint].1,
-                )
-            })
-            .filter(|(a, b)| a.norm() > 1e-9 && b.norm() > 1e-9)
-            .collect();
-        let a = if directions.is_empty() {
-            paired_parent[k].map_or(math::IDENTITY, |p| align[p])
-        } else {
-            fitted_rotation(&directions)
-        };
-        align.push(a);
-    }
+    let align = rest_alignments(&pairs, &paired_parent, model, rest);
     // Hip heights above the lowest paired bone, at rest.
     let lowest_target = pairs
         .iter()
@@ -306,4 +270,58 @@ pub(super) fn retargeted(
         }),
         driven,
     })
+}
+
+/// For each pair, the index of the pair holding its nearest paired ancestor in the character's
+/// hierarchy, if any.
+fn paired_parents(pairs: &[(usize, usize)], target: &Rig) -> Vec<Option<usize>> {
+    pairs
+        .iter()
+        .map(|&(node, _)| {
+            let mut at = target.parents[node];
+            let mut steps = 0;
+            while let Some(a) = at {
+                if let Some(k) = pairs.iter().position(|&(n, _)| n == a) {
+                    return Some(k);
+                }
+                steps += 1;
+                if steps > target.parents.len() {
+                    break;
+                }
+                at = target.parents[a];
+            }
+            None
+        })
+        .collect()
+}
+
+/// Each paired bone's rest alignment, from the directions to its paired children (or its
+/// paired parent's alignment when it has none).
+fn rest_alignments(
+    pairs: &[(usize, usize)],
+    paired_parent: &[Option<usize>],
+    model: &[(Mat3, Vec3)],
+    rest: &[Similarity],
+) -> Vec<Mat3> {
+    let mut align: Vec<Mat3> = Vec::with_capacity(pairs.len());
+    for (k, &(node, joint)) in pairs.iter().enumerate() {
+        let directions: Vec<(Vec3, Vec3)> = (0..pairs.len())
+            .filter(|&c| paired_parent[c] == Some(k))
+            .map(|c| {
+                let (child_node, child_joint) = pairs[c];
+                (
+                    rest[child_node].translation - rest[node].translation,
+                    model[child_joint].1 - model[joint].1,
+                )
+            })
+            .filter(|(a, b)| a.norm() > 1e-9 && b.norm() > 1e-9)
+            .collect();
+        let a = if directions.is_empty() {
+            paired_parent[k].map_or(math::IDENTITY, |p| align[p])
+        } else {
+            fitted_rotation(&directions)
+        };
+        align.push(a);
+    }
+    align
 }

@@ -2,6 +2,7 @@
 //! from motions.
 
 mod accessor;
+mod animate;
 pub mod container;
 mod drive;
 mod nodes;

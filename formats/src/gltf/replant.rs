@@ -44,14 +44,7 @@ pub(super) fn character_motion(
 ) -> Option<CharacterMotion> {
     let top = drive.driven.iter().find(|d| d.moves)?;
     // The carrying bone's subtree, breadth first: parents before children.
-    let mut nodes = vec![top.node];
-    let mut next = 0;
-    while next < nodes.len() {
-        let n = nodes[next];
-        nodes.extend((0..parent.len()).filter(|&c| parent[c] == Some(n)));
-        next += 1;
-    }
-    let index = |n: usize| nodes.iter().position(|&m| m == n);
+    let nodes = subtree(top.node, parent);
     let above = match parent[top.node] {
         Some(p) => {
             let rig = Rig {
@@ -65,39 +58,7 @@ pub(super) fn character_motion(
         }
         None => Similarity::IDENTITY,
     };
-    let rotations_only = || {
-        [Axis::Z, Axis::X, Axis::Y]
-            .into_iter()
-            .map(Channel::Rotation)
-            .collect::<Vec<_>>()
-    };
-    let joints: Vec<Joint> = nodes
-        .iter()
-        .enumerate()
-        .map(|(k, &n)| {
-            let (parent_index, offset, channels) = if k == 0 {
-                let mut channels: Vec<Channel> = [Axis::X, Axis::Y, Axis::Z]
-                    .into_iter()
-                    .map(Channel::Position)
-                    .collect();
-                channels.extend(rotations_only());
-                (None, Vec3::ZERO, channels)
-            } else {
-                let p = parent[n].expect("below the carrying bone");
-                let offset =
-                    rest[p].rotation.transpose() * (rest[n].translation - rest[p].translation);
-                (index(p), offset, rotations_only())
-            };
-            Joint {
-                name: names[n].clone(),
-                parent: parent_index,
-                offset,
-                channels,
-                end_site: None,
-            }
-        })
-        .collect();
-    let skeleton = Skeleton { joints };
+    let skeleton = subtree_skeleton(&nodes, (parent, rest, names));
     let rest_local: Vec<Mat3> = nodes
         .iter()
         .map(|&n| match parent[n] {
@@ -156,6 +117,60 @@ pub(super) fn character_motion(
         motion,
         planted,
     })
+}
+
+/// The subtree of `parent`'s hierarchy under node `top`, breadth first: parents before children.
+fn subtree(top: usize, parent: &[Option<usize>]) -> Vec<usize> {
+    let mut nodes = vec![top];
+    let mut next = 0;
+    while next < nodes.len() {
+        let n = nodes[next];
+        nodes.extend((0..parent.len()).filter(|&c| parent[c] == Some(n)));
+        next += 1;
+    }
+    nodes
+}
+
+/// The skeleton of `nodes` (a subtree, parents first): the first joint moves and turns, the
+/// others turn about their rest offsets from their parents.
+fn subtree_skeleton(
+    nodes: &[usize],
+    (parent, rest, names): (&[Option<usize>], &[Similarity], &[String]),
+) -> Skeleton {
+    let index = |n: usize| nodes.iter().position(|&m| m == n);
+    let rotations_only = || {
+        [Axis::Z, Axis::X, Axis::Y]
+            .into_iter()
+            .map(Channel::Rotation)
+            .collect::<Vec<_>>()
+    };
+    let joints: Vec<Joint> = nodes
+        .iter()
+        .enumerate()
+        .map(|(k, &n)| {
+            let (parent_index, offset, channels) = if k == 0 {
+                let mut channels: Vec<Channel> = [Axis::X, Axis::Y, Axis::Z]
+                    .into_iter()
+                    .map(Channel::Position)
+                    .collect();
+                channels.extend(rotations_only());
+                (None, Vec3::ZERO, channels)
+            } else {
+                let p = parent[n].expect("below the carrying bone");
+                let offset =
+                    rest[p].rotation.transpose() * (rest[n].translation - rest[p].translation);
+                (index(p), offset, rotations_only())
+            };
+            Joint {
+                name: names[n].clone(),
+                parent: parent_index,
+                offset,
+                channels,
+                end_site: None,
+            }
+        })
+        .collect();
+    Skeleton { joints }
 }
 
 /// A leg of the character that follows one of the clip's: its hip, knee and ankle joints, and

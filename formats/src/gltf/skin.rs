@@ -40,19 +40,7 @@ pub(super) fn skin_joints(
     rest: &[Trs],
 ) -> Result<SkinJoints, FormatError> {
     let bad = |part: Part, message: String| FormatError::bad(path, part, message);
-    // The skin: the one with the most joints.
-    let skins = json.get("skins").and_then(Value::as_array);
-    let (skin_index, skin) = skins
-    .into_iter()
-    .flatten()
-    .enumerate()
-    .max_by_key(|(_, s)| s.get("joints").and_then(Value::as_array).map_or(0, Vec::len))
-    .ok_or_else(|| {
-        bad(
-            Part::Json,
-            "has no skin, so no skeleton: export the armature with its skin (a skinned mesh or the armature's bones)".into(),
-        )
-    })?;
+    let (skin_index, skin) = largest_skin(path, json)?;
     let joint_nodes: Vec<usize> = skin
         .get("joints")
         .and_then(Value::as_array)
@@ -100,52 +88,12 @@ pub(super) fn skin_joints(
         ));
     }
     // Depth-first order from the root, children in file order.
-    let mut order = Vec::with_capacity(joint_nodes.len());
-    let mut stack = vec![roots[0]];
-    while let Some(n) = stack.pop() {
-        if is_joint(n) {
-            order.push(n);
-        }
-        let children: Vec<usize> = nodes[n]
-            .get("children")
-            .and_then(Value::as_array)
-            .into_iter()
-            .flatten()
-            .filter_map(|c| c.as_u64().map(|c| c as usize))
-            .collect();
-        stack.extend(children.into_iter().rev());
-    }
+    let order = depth_first_joints(nodes, roots[0], &joint_nodes);
     // The non-joint nodes above each joint, folded into one transform.
     let mut pre: Vec<Similarity> = Vec::with_capacity(order.len());
     for &n in &order {
         let stop = joint_parent(n);
-        let mut fold = Similarity::IDENTITY;
-        let mut at = parent[n];
-        while at.is_some() && at != stop {
-            let p = at.expect("checked");
-            let trs = rest[p];
-            let scale = uniform(trs.scale).ok_or_else(|| {
-                bad(
-                    Part::Node(p, node_name(&nodes[p])),
-                    format!("has a non-uniform scale {:?} above a joint", trs.scale),
-                )
-            })?;
-            if stop.is_some() && (scale - 1.0).abs() > 1e-4 {
-                return Err(bad(
-                    Part::Node(p, node_name(&nodes[p])),
-                    format!(
-                        "scales by {scale} between two joints; only nodes above the root may scale"
-                    ),
-                ));
-            }
-            fold = Similarity {
-                rotation: trs.rotation,
-                translation: trs.translation,
-                scale,
-            }
-            .then(&fold);
-            at = parent[p];
-        }
+        let fold = fold_above(path, nodes, (parent, rest), n, stop)?;
         pre.push(fold);
     }
     // The scale of the nodes above the root multiplies every translation below it.
@@ -162,6 +110,83 @@ pub(super) fn skin_joints(
         pre,
         unit,
     })
+}
+
+/// The skin with the most joints, and its index; an error when the file has no skin.
+fn largest_skin<'a>(path: &Path, json: &'a Value) -> Result<(usize, &'a Value), FormatError> {
+    let bad = |part: Part, message: String| FormatError::bad(path, part, message);
+    let skins = json.get("skins").and_then(Value::as_array);
+    skins
+    .into_iter()
+    .flatten()
+    .enumerate()
+    .max_by_key(|(_, s)| s.get("joints").and_then(Value::as_array).map_or(0, Vec::len))
+    .ok_or_else(|| {
+        bad(
+            Part::Json,
+            "has no skin, so no skeleton: export the armature with its skin (a skinned mesh or the armature's bones)".into(),
+        )
+    })
+}
+
+/// The joint nodes under `root` in depth-first order, children in file order.
+fn depth_first_joints(nodes: &[Value], root: usize, joint_nodes: &[usize]) -> Vec<usize> {
+    let mut order = Vec::with_capacity(joint_nodes.len());
+    let mut stack = vec![root];
+    while let Some(n) = stack.pop() {
+        if joint_nodes.contains(&n) {
+            order.push(n);
+        }
+        let children: Vec<usize> = nodes[n]
+            .get("children")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+            .filter_map(|c| c.as_u64().map(|c| c as usize))
+            .collect();
+        stack.extend(children.into_iter().rev());
+    }
+    order
+}
+
+/// The non-joint nodes between node `n` and its joint parent `stop` (or the top of the
+/// hierarchy), folded into one transform; an error for a scale they may not have.
+fn fold_above(
+    path: &Path,
+    nodes: &[Value],
+    (parent, rest): (&[Option<usize>], &[Trs]),
+    n: usize,
+    stop: Option<usize>,
+) -> Result<Similarity, FormatError> {
+    let bad = |part: Part, message: String| FormatError::bad(path, part, message);
+    let mut fold = Similarity::IDENTITY;
+    let mut at = parent[n];
+    while at.is_some() && at != stop {
+        let p = at.expect("checked");
+        let trs = rest[p];
+        let scale = uniform(trs.scale).ok_or_else(|| {
+            bad(
+                Part::Node(p, node_name(&nodes[p])),
+                format!("has a non-uniform scale {:?} above a joint", trs.scale),
+            )
+        })?;
+        if stop.is_some() && (scale - 1.0).abs() > 1e-4 {
+            return Err(bad(
+                Part::Node(p, node_name(&nodes[p])),
+                format!(
+                    "scales by {scale} between two joints; only nodes above the root may scale"
+                ),
+            ));
+        }
+        fold = Similarity {
+            rotation: trs.rotation,
+            translation: trs.translation,
+            scale,
+        }
+        .then(&fold);
+        at = parent[p];
+    }
+    Ok(fold)
 }
 
 /// The joints' names as the nodes hold them (`None` for unnamed nodes).

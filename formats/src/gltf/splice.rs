@@ -6,15 +6,14 @@
 use std::path::Path;
 
 use serde_json::{Value, json};
-use sinmdm::motion::ground::{GROUND_PERCENTILE, percentile};
-use sinmdm::motion::math::{self, Vec3};
-use sinmdm::motion::{GlobalPose, LocalMotion, UpAxis, global_poses, up};
+use sinmdm::motion::math::{self, Mat3, Vec3};
+use sinmdm::motion::{LocalMotion, Skeleton, UpAxis};
 
+use super::animate::{retargeted_animation, spliced_animation};
 use super::container::{Asset, glb_bytes, parse_glb};
-use super::drive::{Drive, Driven, Pairing, Retargeted, by_frames, model_rest, retargeted};
+use super::drive::{Drive, Pairing, Retargeted, by_frames, model_rest, retargeted};
 use super::nodes::{Similarity, node_name, node_trs, parents, uniform};
-use super::replant::{CharacterMotion, character_motion};
-use super::write::{Binary, quaternion_xyzw, unit_f32};
+use super::write::Binary;
 use crate::error::{FormatError, Part};
 use crate::retarget::bone_map::{check_chains, pairs_by_name, pairs_by_role};
 use crate::retarget::{BoneMatch, Rig};
@@ -127,27 +126,8 @@ pub fn splice_retargeted(
     up_axis: UpAxis,
     bones: &BoneMatch,
 ) -> Result<SpliceReport, FormatError> {
-    let bytes = crate::files::read_file(character, crate::files::GLTF_LIMIT)?;
-    if !super::container::is_glb(&bytes) {
-        return Err(FormatError::Unsupported {
-            path: character.to_path_buf(),
-            message: "is not a .glb: the character file is read as binary glTF (.glb), whose mesh and skin travel in one file; export it as glTF Binary (.glb), e.g. from Blender (File > Export > glTF 2.0, Format: glTF Binary)".into(),
-        });
-    }
-    let Asset {
-        mut json, buffers, ..
-    } = parse_glb(character, &bytes)?;
+    let (mut json, buffers) = read_character(character)?;
     let bad = |part: Part, message: String| FormatError::bad(character, part, message);
-    if buffers.len() > 1
-        || json["buffers"]
-            .get(0)
-            .is_some_and(|b| b.get("uri").is_some())
-    {
-        return Err(bad(
-            Part::Json,
-            "keeps its data outside the GLB's binary chunk; re-export it as one .glb".into(),
-        ));
-    }
     let Some((_, first)) = motions.first() else {
         return Err(FormatError::Write {
             path: path.to_path_buf(),
@@ -175,61 +155,13 @@ pub fn splice_retargeted(
         parents: &source_parents,
     };
     let model = model_rest(skeleton, up_axis);
-    let pairing = match bones {
-        BoneMatch::Names => {
-            // Our joints by name among the character's nodes: the same name, or else the one
-            // node whose name is it after a namespace (a model read from Mixamo's FBX has
-            // `Hips` where the character's GLB has `mixamorig:Hips`).
-            let pairs = pairs_by_name(&target, &source);
-            let mut mapped = vec![usize::MAX; skeleton.len()];
-            for &(node, joint) in &pairs {
-                mapped[joint] = node;
-            }
-            if let Some(missing) = mapped.iter().position(|&n| n == usize::MAX) {
-                return Err(bad(
-                    Part::Skeleton,
-                    format!(
-                        "has no node named '{}', a joint of the model's skeleton; for a rig with other bone names pass --retarget auto (or a bone map: --retarget MAP.yaml)",
-                        skeleton.joints[missing].name
-                    ),
-                ));
-            }
-            match by_frames(skeleton, &model, &rest, &mapped) {
-                Ok(drive) => Ok(drive),
-                Err(misfit) => Err(Pairing {
-                    pairs,
-                    reason: format!(
-                        "its bones have the model's names but it is another rig: {misfit}"
-                    ),
-                    conventions: None,
-                }),
-            }
-        }
-        BoneMatch::Auto => {
-            let found = pairs_by_role(&target, &source).map_err(|m| bad(Part::Skeleton, m))?;
-            Err(Pairing {
-                pairs: found.pairs,
-                reason: format!(
-                    "--retarget auto: the character's bones read as {}, the model's as {}",
-                    found.target, found.source
-                ),
-                conventions: Some((found.target, found.source)),
-            })
-        }
-        BoneMatch::Map(map, file) => Err(Pairing {
-            pairs: map.indices(&target, &source, file)?,
-            reason: format!("--retarget {}", file.display()),
-            conventions: None,
-        }),
-    };
-    let drive = match pairing {
-        Ok(drive) => drive,
-        Err(pairing) => {
-            check_chains(&pairing.pairs, &target, &source).map_err(|m| bad(Part::Skeleton, m))?;
-            retargeted(pairing, (&target, &source), &model, &rest)
-                .map_err(|m| bad(Part::Skeleton, m))?
-        }
-    };
+    let drive = character_drive(
+        character,
+        bones,
+        skeleton,
+        (&target, &source),
+        (&model, &rest),
+    )?;
     let scale = drive.scale;
     if !(scale.is_finite() && scale > 0.0) {
         return Err(bad(
@@ -279,21 +211,7 @@ pub fn splice_retargeted(
             )),
         }
     }
-    // Append: the arrays grow, nothing else of the document changes but the buffer's length.
-    for (key, items) in [
-        ("accessors", std::mem::take(&mut binary.accessors)),
-        ("bufferViews", std::mem::take(&mut binary.views)),
-        ("animations", animations),
-    ] {
-        match json[key].as_array_mut() {
-            Some(array) => array.extend(items),
-            None => json[key] = Value::Array(items),
-        }
-    }
-    if json["buffers"].as_array().is_none_or(Vec::is_empty) {
-        json["buffers"] = json!([{}]);
-    }
-    json["buffers"][0]["byteLength"] = json!(binary.bytes.len());
+    append_animations(&mut json, &mut binary, animations);
     let out = glb_bytes(&json, &binary.bytes);
     sinmdm::files::write_atomically(path, &out).map_err(|reason| FormatError::Io {
         path: path.to_path_buf(),
@@ -309,197 +227,114 @@ pub fn splice_retargeted(
     })
 }
 
-/// The motion's canonical global poses with its travel scaled to the character's units, and
-/// the lift from its ground to the character's (none unless retargeted onto a standing rig).
-fn scaled_poses(motion: &LocalMotion, up_axis: UpAxis, drive: &Drive) -> (Vec<GlobalPose>, Vec3) {
-    let mut canonical = up::to_canonical(motion, up_axis);
-    for t in &mut canonical.translations {
-        *t = *t * drive.scale;
+/// The JSON and buffers of the character file `character`, which must be a `.glb` whose data
+/// all lies in its binary chunk.
+fn read_character(character: &Path) -> Result<(Value, Vec<Vec<u8>>), FormatError> {
+    let bytes = crate::files::read_file(character, crate::files::GLTF_LIMIT)?;
+    if !super::container::is_glb(&bytes) {
+        return Err(FormatError::Unsupported {
+            path: character.to_path_buf(),
+            message: "is not a .glb: the character file is read as binary glTF (.glb), whose mesh and skin travel in one file; export it as glTF Binary (.glb), e.g. from Blender (File > Export > glTF 2.0, Format: glTF Binary)".into(),
+        });
     }
-    let poses = global_poses(&canonical);
-    // From the motions' ground to the character's, for a retargeted character.
-    let lift = drive.grounds.as_ref().map_or(0.0, |(ground, joints)| {
-        let mut lowest: Vec<f64> = poses
-            .iter()
-            .map(|p| {
-                joints
-                    .iter()
-                    .map(|&j| p.joints[j][1])
-                    .fold(f64::INFINITY, f64::min)
+    let Asset { json, buffers, .. } = parse_glb(character, &bytes)?;
+    let bad = |part: Part, message: String| FormatError::bad(character, part, message);
+    if buffers.len() > 1
+        || json["buffers"]
+            .get(0)
+            .is_some_and(|b| b.get("uri").is_some())
+    {
+        return Err(bad(
+            Part::Json,
+            "keeps its data outside the GLB's binary chunk; re-export it as one .glb".into(),
+        ));
+    }
+    Ok((json, buffers))
+}
+
+/// How the character's nodes are driven by the model's joints, its bones matched to them as
+/// `bones` says: by the same frames when they fit, else retargeted.
+fn character_drive(
+    character: &Path,
+    bones: &BoneMatch,
+    skeleton: &Skeleton,
+    (target, source): (&Rig, &Rig),
+    (model, rest): (&[(Mat3, Vec3)], &[Similarity]),
+) -> Result<Drive, FormatError> {
+    let bad = |part: Part, message: String| FormatError::bad(character, part, message);
+    let pairing = match bones {
+        BoneMatch::Names => {
+            // Our joints by name among the character's nodes: the same name, or else the one
+            // node whose name is it after a namespace (a model read from Mixamo's FBX has
+            // `Hips` where the character's GLB has `mixamorig:Hips`).
+            let pairs = pairs_by_name(target, source);
+            let mut mapped = vec![usize::MAX; skeleton.len()];
+            for &(node, joint) in &pairs {
+                mapped[joint] = node;
+            }
+            if let Some(missing) = mapped.iter().position(|&n| n == usize::MAX) {
+                return Err(bad(
+                    Part::Skeleton,
+                    format!(
+                        "has no node named '{}', a joint of the model's skeleton; for a rig with other bone names pass --retarget auto (or a bone map: --retarget MAP.yaml)",
+                        skeleton.joints[missing].name
+                    ),
+                ));
+            }
+            match by_frames(skeleton, model, rest, &mapped) {
+                Ok(drive) => Ok(drive),
+                Err(misfit) => Err(Pairing {
+                    pairs,
+                    reason: format!(
+                        "its bones have the model's names but it is another rig: {misfit}"
+                    ),
+                    conventions: None,
+                }),
+            }
+        }
+        BoneMatch::Auto => {
+            let found = pairs_by_role(target, source).map_err(|m| bad(Part::Skeleton, m))?;
+            Err(Pairing {
+                pairs: found.pairs,
+                reason: format!(
+                    "--retarget auto: the character's bones read as {}, the model's as {}",
+                    found.target, found.source
+                ),
+                conventions: Some((found.target, found.source)),
             })
-            .collect();
-        lowest.sort_by(f64::total_cmp);
-        ground - percentile(&lowest, GROUND_PERCENTILE)
-    });
-    (poses, Vec3::new(0.0, lift, 0.0))
+        }
+        BoneMatch::Map(map, file) => Err(Pairing {
+            pairs: map.indices(target, source, file)?,
+            reason: format!("--retarget {}", file.display()),
+            conventions: None,
+        }),
+    };
+    Ok(match pairing {
+        Ok(drive) => drive,
+        Err(pairing) => {
+            check_chains(&pairing.pairs, target, source).map_err(|m| bad(Part::Skeleton, m))?;
+            retargeted(pairing, (target, source), model, rest)
+                .map_err(|m| bad(Part::Skeleton, m))?
+        }
+    })
 }
 
-/// One motion as an animation of a retargeted character: its bones' rotations (the legs'
-/// turned so the feet stand still again) and the carrying bone's translation, every frame.
-fn retargeted_animation(
-    binary: &mut Binary,
-    (name, motion): (&str, &LocalMotion),
-    up_axis: UpAxis,
-    drive: &Drive,
-    (parent, rest, names): (&[Option<usize>], &[Similarity], &[String]),
-) -> Option<(Value, Vec<String>)> {
-    let (poses, lift) = scaled_poses(motion, up_axis, drive);
-    let character = character_motion(
-        &motion.skeleton,
-        &poses,
-        lift,
-        motion.fps,
-        drive,
-        (parent, rest, names),
-    )?;
-    let CharacterMotion {
-        nodes,
-        above,
-        motion: played,
-        planted,
-    } = character;
-    let frames = played.frame_count();
-    let count = nodes.len();
-    let input = binary.key_times(frames, played.fps);
-    let mut samplers = Vec::new();
-    let mut channels = Vec::new();
-    let inverse_above = above.rotation.transpose();
-    for (k, &node) in nodes.iter().enumerate() {
-        let rest_local = match parent[node] {
-            Some(p) => rest[p].rotation.transpose() * rest[node].rotation,
-            None => rest[node].rotation,
-        };
-        let local = |f: usize| {
-            let r = played.rotations[f * count + k];
-            if k == 0 { inverse_above * r } else { r }
-        };
-        let driven = drive.driven.iter().any(|d| d.node == node);
-        let turned = (0..frames).any(|f| math::mat_max_abs_diff(&local(f), &rest_local) > 1e-9);
-        if !(driven || turned) {
-            continue;
-        }
-        let mut rotations = Vec::with_capacity(frames * 4);
-        let mut previous = None;
-        for f in 0..frames {
-            let q = quaternion_xyzw(&local(f), previous);
-            previous = Some(q);
-            rotations.extend(unit_f32(q));
-        }
-        let output = binary.accessor(&rotations, "VEC4", 4, false);
-        samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-        channels.push(
-            json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": "rotation"}}),
-        );
-        if k == 0 {
-            let mut translations = Vec::with_capacity(frames * 3);
-            for f in 0..frames {
-                let world = played.translations[f * count];
-                let local = (inverse_above * (world - above.translation)) * (1.0 / above.scale);
-                translations.extend(local.map(|v| v as f32));
-            }
-            let output = binary.accessor(&translations, "VEC3", 3, false);
-            samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-            channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": "translation"}}));
+/// Appends the new accessors, buffer views and animations to the document's arrays and sets
+/// its buffer's length to the binary's.
+fn append_animations(json: &mut Value, binary: &mut Binary, animations: Vec<Value>) {
+    // Append: the arrays grow, nothing else of the document changes but the buffer's length.
+    for (key, items) in [
+        ("accessors", std::mem::take(&mut binary.accessors)),
+        ("bufferViews", std::mem::take(&mut binary.views)),
+        ("animations", animations),
+    ] {
+        match json[key].as_array_mut() {
+            Some(array) => array.extend(items),
+            None => json[key] = Value::Array(items),
         }
     }
-    let feet = planted.iter().map(|&k| names[nodes[k]].clone()).collect();
-    Some((
-        json!({"name": name, "samplers": samplers, "channels": channels}),
-        feet,
-    ))
-}
-
-/// One motion as an animation of the character's nodes: each driven node's rotation (and the
-/// translation of those that move) every frame.
-fn spliced_animation(
-    binary: &mut Binary,
-    name: &str,
-    motion: &LocalMotion,
-    up_axis: UpAxis,
-    drive: &Drive,
-    (parent, rest): (&[Option<usize>], &[Similarity]),
-) -> Value {
-    let (poses, lift) = scaled_poses(motion, up_axis, drive);
-    let frames = motion.frame_count();
-    let input = binary.key_times(frames, motion.fps);
-    let mut samplers = Vec::new();
-    let mut channels = Vec::new();
-    for driven in &drive.driven {
-        let node = driven.node;
-        let mut rotations = Vec::with_capacity(frames * 4);
-        let mut translations = Vec::with_capacity(frames * 3);
-        let (anchor, fixed) = parent_frame(node, parent, rest, &drive.driven);
-        let mut previous = None;
-        for pose in &poses {
-            let parent_global = match anchor {
-                Some((above, p)) => Similarity {
-                    rotation: (pose.rotations[above.joint] * above.turn),
-                    translation: pose.joints[above.joint] + lift,
-                    scale: rest[p].scale,
-                }
-                .then(&fixed),
-                None => fixed,
-            };
-            let inverse_parent = parent_global.rotation.transpose();
-            let global_rotation = pose.rotations[driven.joint] * driven.turn;
-            let local_rotation = inverse_parent * global_rotation;
-            let q = quaternion_xyzw(&local_rotation, previous);
-            previous = Some(q);
-            rotations.extend(unit_f32(q));
-            if driven.moves {
-                let world = pose.joints[driven.joint] + lift;
-                let local = (inverse_parent * (world - parent_global.translation))
-                    * (1.0 / parent_global.scale);
-                translations.extend(local.map(|v| v as f32));
-            }
-        }
-        let output = binary.accessor(&rotations, "VEC4", 4, false);
-        samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-        channels.push(
-            json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": "rotation"}}),
-        );
-        if driven.moves {
-            let output = binary.accessor(&translations, "VEC3", 3, false);
-            samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-            channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": "translation"}}));
-        }
+    if json["buffers"].as_array().is_none_or(Vec::is_empty) {
+        json["buffers"] = json!([{}]);
     }
-    json!({"name": name, "samplers": samplers, "channels": channels})
-}
-
-/// How the global transform of node `n`'s parent is had at any frame: the nearest driven node
-/// above it (how it is driven, and the node) followed by the fixed rest transforms of the
-/// nodes between; or, with no driven node above, that parent's fixed global rest transform.
-fn parent_frame(
-    n: usize,
-    parent: &[Option<usize>],
-    rest: &[Similarity],
-    driven: &[Driven],
-) -> (Option<(Driven, usize)>, Similarity) {
-    let mut chain: Vec<usize> = Vec::new();
-    let mut at = parent[n];
-    while let Some(p) = at {
-        if let Some(above) = driven.iter().find(|d| d.node == p) {
-            let fixed = chain.iter().rev().fold(Similarity::IDENTITY, |g, &c| {
-                let above = rest[parent[c].expect("a node below a joint has a parent")];
-                g.then(&relative(&above, &rest[c]))
-            });
-            return (Some((*above, p)), fixed);
-        }
-        chain.push(p);
-        at = parent[p];
-    }
-    let fixed = chain.first().map_or(Similarity::IDENTITY, |&c| rest[c]);
-    (None, fixed)
-}
-
-/// `local` as a transform relative to `above` (both global): `above^-1 local`.
-fn relative(above: &Similarity, local: &Similarity) -> Similarity {
-    let inverse_rotation = above.rotation.transpose();
-    Similarity {
-        rotation: (inverse_rotation * local.rotation),
-        translation: ((inverse_rotation * (local.translation - above.translation))
-            * (1.0 / above.scale)),
-        scale: local.scale / above.scale,
-    }
+    json["buffers"][0]["byteLength"] = json!(binary.bytes.len());
 }

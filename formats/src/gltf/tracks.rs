@@ -173,81 +173,100 @@ pub(super) fn read_tracks(
                 format!("names sampler {s}, which does not exist"),
             )
         })?;
-        let interpolation = match sampler
-            .get("interpolation")
-            .and_then(Value::as_str)
-            .unwrap_or("LINEAR")
-        {
-            "LINEAR" => Interpolation::Linear,
-            "STEP" => Interpolation::Step,
-            "CUBICSPLINE" => Interpolation::CubicSpline,
-            other => {
-                return Err(bad(
-                    Part::Sampler(chosen, s),
-                    format!("has interpolation '{other}'"),
-                ));
-            }
-        };
-        let sampler_error = |(part, message): (Part, String)| {
-            bad(Part::Sampler(chosen, s), format!("{part}: {message}"))
-        };
-        let times = read_floats(
+        tracks.push(sampler_track(
+            path,
             asset,
-            field_usize(sampler, "input").unwrap_or(usize::MAX),
-            1,
-        )
-        .map_err(sampler_error)?;
-        let width = property.width();
-        let values = read_floats(
-            asset,
-            field_usize(sampler, "output").unwrap_or(usize::MAX),
-            width,
-        )
-        .map_err(sampler_error)?;
-        if times.is_empty() {
-            return Err(bad(Part::Sampler(chosen, s), "has no keys".into()));
-        }
-        if times.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(bad(
-                Part::Sampler(chosen, s),
-                "has key times that do not increase".into(),
-            ));
-        }
-        let per_key = if interpolation == Interpolation::CubicSpline {
-            3
-        } else {
-            1
-        };
-        if values.len() != times.len() * width * per_key {
-            return Err(bad(
-                Part::Sampler(chosen, s),
-                format!(
-                    "has {} keys but {} output values ({} expected for {} {:?})",
-                    times.len(),
-                    values.len() / width,
-                    times.len() * per_key,
-                    if per_key == 3 {
-                        "CUBICSPLINE"
-                    } else {
-                        "keys of"
-                    },
-                    property
-                ),
-            ));
-        }
-        tracks.push(Track {
-            joint,
-            property,
-            times,
-            values,
-            interpolation,
-        });
+            (chosen, s),
+            sampler,
+            (joint, property),
+        )?);
     }
     if tracks.is_empty() {
         return Err(bad(animation_part, "moves no joint of the skin".into()));
     }
 
     Ok(tracks)
+}
+
+/// The track of sampler `s` of animation `chosen` for `joint`'s `property`, checked: a known
+/// interpolation, readable accessors, increasing key times, as many values as keys.
+fn sampler_track(
+    path: &Path,
+    asset: &Asset,
+    (chosen, s): (usize, usize),
+    sampler: &Value,
+    (joint, property): (usize, Property),
+) -> Result<Track, FormatError> {
+    let bad = |part: Part, message: String| FormatError::bad(path, part, message);
+    let interpolation = match sampler
+        .get("interpolation")
+        .and_then(Value::as_str)
+        .unwrap_or("LINEAR")
+    {
+        "LINEAR" => Interpolation::Linear,
+        "STEP" => Interpolation::Step,
+        "CUBICSPLINE" => Interpolation::CubicSpline,
+        other => {
+            return Err(bad(
+                Part::Sampler(chosen, s),
+                format!("has interpolation '{other}'"),
+            ));
+        }
+    };
+    let sampler_error = |(part, message): (Part, String)| {
+        bad(Part::Sampler(chosen, s), format!("{part}: {message}"))
+    };
+    let times = read_floats(
+        asset,
+        field_usize(sampler, "input").unwrap_or(usize::MAX),
+        1,
+    )
+    .map_err(sampler_error)?;
+    let width = property.width();
+    let values = read_floats(
+        asset,
+        field_usize(sampler, "output").unwrap_or(usize::MAX),
+        width,
+    )
+    .map_err(sampler_error)?;
+    if times.is_empty() {
+        return Err(bad(Part::Sampler(chosen, s), "has no keys".into()));
+    }
+    if times.windows(2).any(|w| w[1] <= w[0]) {
+        return Err(bad(
+            Part::Sampler(chosen, s),
+            "has key times that do not increase".into(),
+        ));
+    }
+    let per_key = if interpolation == Interpolation::CubicSpline {
+        3
+    } else {
+        1
+    };
+    if values.len() != times.len() * width * per_key {
+        return Err(bad(
+            Part::Sampler(chosen, s),
+            format!(
+                "has {} keys but {} output values ({} expected for {} {:?})",
+                times.len(),
+                values.len() / width,
+                times.len() * per_key,
+                if per_key == 3 {
+                    "CUBICSPLINE"
+                } else {
+                    "keys of"
+                },
+                property
+            ),
+        ));
+    }
+    Ok(Track {
+        joint,
+        property,
+        times,
+        values,
+        interpolation,
+    })
 }
 
 /// The first key time, the frame rate (`asked`, or the median key spacing snapped to a whole

@@ -231,6 +231,99 @@ fn inverse_bind_matrices(skeleton: &Skeleton, rest: &[(Mat3, Vec3)]) -> Vec<f32>
     out
 }
 
+/// One glTF node per joint: its name, rest transform (the top joints turned into +Y up),
+/// children, and the channels and End Site this crate records in its extras.
+fn joint_nodes(
+    skeleton: &Skeleton,
+    rest: &[(Mat3, Vec3)],
+    options: &GltfWriteOptions,
+) -> Vec<Value> {
+    skeleton
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(j, joint)| {
+            let (r, t) = rest[j];
+            let mut node = json!({
+                "name": joint.name,
+                "translation": t.map(|v| v as f32),
+            });
+            if joint.parent.is_none() {
+                node["rotation"] = json!(unit_f32(quaternion_xyzw(&r, None)));
+            }
+            let children = skeleton.children(j);
+            if !children.is_empty() {
+                node["children"] = json!(children);
+            }
+            let channels: Vec<String> = joint.channels.iter().map(|c| c.to_string()).collect();
+            let mut extras = json!({ "channels": channels });
+            if let Some(end) = joint.end_site {
+                extras["end_site"] = json!((end * options.metres_per_unit));
+            }
+            node["extras"] = json!({ EXTRAS_KEY: extras });
+            node
+        })
+        .collect()
+}
+
+/// The animation of motion `name`, its rotation and translation keys (for the joints that
+/// `animated` says rotate and move) appended to `binary`; an error for a motion with no frames
+/// or no valid frame rate.
+fn motion_animation(
+    binary: &mut Binary,
+    (name, motion): (&str, &LocalMotion),
+    animated: &[(bool, bool)],
+    joints: usize,
+    options: &GltfWriteOptions,
+) -> Result<Value, String> {
+    let frames = motion.frame_count();
+    if frames == 0 {
+        return Err(format!("motion '{name}' has no frames"));
+    }
+    if !(motion.fps.is_finite() && motion.fps > 0.0) {
+        return Err(format!(
+            "motion '{name}' has a frame rate of {}",
+            motion.fps
+        ));
+    }
+    let canonical = up::to_canonical(motion, options.up);
+    let input = binary.key_times(frames, motion.fps);
+    let mut samplers = Vec::new();
+    let mut channels = Vec::new();
+    for (j, &(rotates, moves)) in animated.iter().enumerate() {
+        if rotates {
+            let mut previous = None;
+            let mut values = Vec::with_capacity(frames * 4);
+            for f in 0..frames {
+                let q = quaternion_xyzw(&canonical.rotations[f * joints + j], previous);
+                previous = Some(q);
+                values.extend(unit_f32(q));
+            }
+            let output = binary.accessor(&values, "VEC4", 4, false);
+            samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
+            channels.push(json!({
+                "sampler": samplers.len() - 1,
+                "target": {"node": j, "path": "rotation"},
+            }));
+        }
+        if moves {
+            let values: Vec<f32> = (0..frames)
+                .flat_map(|f| {
+                    (canonical.translations[f * joints + j] * options.metres_per_unit)
+                        .map(|v| v as f32)
+                })
+                .collect();
+            let output = binary.accessor(&values, "VEC3", 3, false);
+            samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
+            channels.push(json!({
+                "sampler": samplers.len() - 1,
+                "target": {"node": j, "path": "translation"},
+            }));
+        }
+    }
+    Ok(json!({"name": name, "samplers": samplers, "channels": channels}))
+}
+
 /// The glTF document and binary buffer of `motions` (name and motion), which must share one
 /// skeleton: the nodes, the skin, and one animation per motion.
 pub fn gltf_document(
@@ -266,32 +359,7 @@ pub fn gltf_document(
     }
     let mut binary = Binary::default();
     let rest = rest_transforms(skeleton, options);
-    let nodes: Vec<Value> = skeleton
-        .joints
-        .iter()
-        .enumerate()
-        .map(|(j, joint)| {
-            let (r, t) = rest[j];
-            let mut node = json!({
-                "name": joint.name,
-                "translation": t.map(|v| v as f32),
-            });
-            if joint.parent.is_none() {
-                node["rotation"] = json!(unit_f32(quaternion_xyzw(&r, None)));
-            }
-            let children = skeleton.children(j);
-            if !children.is_empty() {
-                node["children"] = json!(children);
-            }
-            let channels: Vec<String> = joint.channels.iter().map(|c| c.to_string()).collect();
-            let mut extras = json!({ "channels": channels });
-            if let Some(end) = joint.end_site {
-                extras["end_site"] = json!((end * options.metres_per_unit));
-            }
-            node["extras"] = json!({ EXTRAS_KEY: extras });
-            node
-        })
-        .collect();
+    let nodes = joint_nodes(skeleton, &rest, options);
     let roots: Vec<usize> = (0..skeleton.len())
         .filter(|&j| skeleton.joints[j].parent.is_none())
         .collect();
@@ -299,52 +367,13 @@ pub fn gltf_document(
     let joints = skeleton.len();
     let mut animations = Vec::with_capacity(motions.len());
     for (name, motion) in motions {
-        let frames = motion.frame_count();
-        if frames == 0 {
-            return Err(format!("motion '{name}' has no frames"));
-        }
-        if !(motion.fps.is_finite() && motion.fps > 0.0) {
-            return Err(format!(
-                "motion '{name}' has a frame rate of {}",
-                motion.fps
-            ));
-        }
-        let canonical = up::to_canonical(motion, options.up);
-        let input = binary.key_times(frames, motion.fps);
-        let mut samplers = Vec::new();
-        let mut channels = Vec::new();
-        for (j, &(rotates, moves)) in animated.iter().enumerate() {
-            if rotates {
-                let mut previous = None;
-                let mut values = Vec::with_capacity(frames * 4);
-                for f in 0..frames {
-                    let q = quaternion_xyzw(&canonical.rotations[f * joints + j], previous);
-                    previous = Some(q);
-                    values.extend(unit_f32(q));
-                }
-                let output = binary.accessor(&values, "VEC4", 4, false);
-                samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-                channels.push(json!({
-                    "sampler": samplers.len() - 1,
-                    "target": {"node": j, "path": "rotation"},
-                }));
-            }
-            if moves {
-                let values: Vec<f32> = (0..frames)
-                    .flat_map(|f| {
-                        (canonical.translations[f * joints + j] * options.metres_per_unit)
-                            .map(|v| v as f32)
-                    })
-                    .collect();
-                let output = binary.accessor(&values, "VEC3", 3, false);
-                samplers.push(json!({"input": input, "output": output, "interpolation": "LINEAR"}));
-                channels.push(json!({
-                    "sampler": samplers.len() - 1,
-                    "target": {"node": j, "path": "translation"},
-                }));
-            }
-        }
-        animations.push(json!({"name": name, "samplers": samplers, "channels": channels}));
+        animations.push(motion_animation(
+            &mut binary,
+            (name.as_str(), *motion),
+            &animated,
+            joints,
+            options,
+        )?);
     }
     let mut nodes = nodes;
     let mut scene_nodes = roots.clone();
