@@ -14,7 +14,7 @@ use std::ops::ControlFlow;
 use std::time::Instant;
 
 use sinmdm::motion::{LocalMotion, encode_for_model, global_poses};
-use sinmdm::{Feet, Model, ModelOptions, Request, Stream, StreamOptions, Task};
+use sinmdm::{FeatureLayout, Feet, Model, ModelOptions, Request, Stream, StreamOptions, Task};
 use sinmdm_c::{
     SINMDM_FEET_PLANTED, SinmdmModel, SinmdmPoseBuffers, SinmdmResult, SinmdmSampling,
     SinmdmStatus, sinmdm_generate, sinmdm_model_free, sinmdm_model_open, sinmdm_result_free,
@@ -73,7 +73,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         block_seconds.map_or("the clip's length".into(), |b| format!("{b} s"))
     );
 
-    // Speed and memory: `minutes` of motion in 1-second chunks.
+    let (stream, first_minute) = speed_and_memory(&mut model, &options, second, minutes)?;
+    seams(first_minute, stream.sizes().block);
+    quality(&mut model, &layout, &options, &clip_path, second)?;
+    c_abi_overhead(&mut model, &model_path)?;
+    Ok(())
+}
+
+/// Speed and memory: `minutes` of motion in 1-second chunks of `second` frames, printed; returns
+/// the stream and its first minute of motion.
+fn speed_and_memory(
+    model: &mut Model,
+    options: &StreamOptions,
+    second: usize,
+    minutes: usize,
+) -> Result<(Stream, Option<LocalMotion>), Box<dyn std::error::Error>> {
     let mut stream = Stream::new(model.metadata(), options.clone())?;
     let mut times = Vec::new();
     let mut first_minute: Option<LocalMotion> = None;
@@ -81,7 +95,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let started = Instant::now();
     for chunk in 0..minutes * 60 {
         let t = Instant::now();
-        let out = stream.next(&mut model, second)?;
+        let out = stream.next(model, second)?;
         times.push(t.elapsed().as_secs_f64());
         if chunk < 60 {
             append(&mut first_minute, out.motion);
@@ -105,11 +119,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "resident memory: {rss_after_minute:.1} MiB after 1 min, {rss_end:.1} MiB after {minutes} min (growth {:.2} MiB)",
         rss_end - rss_after_minute
     );
+    Ok((stream, first_minute))
+}
 
-    // Seams: joint acceleration at block boundaries against inside blocks.
+/// Seams: joint acceleration of `first_minute` at the boundaries of blocks of `block` frames
+/// against inside blocks, printed.
+fn seams(first_minute: Option<LocalMotion>, block: usize) {
     let motion = first_minute.expect("a minute of motion");
     let poses = global_poses(&motion);
-    let block = stream.sizes().block;
     let (mut seam, mut inside) = (Vec::new(), Vec::new());
     for i in 1..poses.len() - 1 {
         let a: f64 = (0..poses[i].joints.len())
@@ -133,10 +150,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "joint acceleration p99: at seams {s99:.4}, inside blocks {i99:.4} (ratio {:.2})",
         s99 / i99
     );
+}
 
-    // Quality: 60 s streamed against 60 s in one shot, three seeds each.
-    let clip = encode_for_model(&sinmdm::bvh::read_bvh(&clip_path)?, &layout, None)?.features;
-    let clip_metric = metric_features(&layout, clip.view());
+/// Quality: 60 s streamed against 60 s in one shot, three seeds each, printed.
+fn quality(
+    model: &mut Model,
+    layout: &FeatureLayout,
+    options: &StreamOptions,
+    clip_path: &str,
+    second: usize,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let clip = encode_for_model(&sinmdm::bvh::read_bvh(clip_path)?, layout, None)?.features;
+    let clip_metric = metric_features(layout, clip.view());
     let frames = 60 * second;
     let (mut streamed, mut one_shot) = (Vec::new(), Vec::new());
     for seed in 0..3u64 {
@@ -148,8 +173,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ..options.clone()
             },
         )?;
-        let features = s.next(&mut model, frames)?.features;
-        streamed.push(metric_features(&layout, features.view()));
+        let features = s.next(model, frames)?.features;
+        streamed.push(metric_features(layout, features.view()));
         let request = Request {
             task: Task::Generate { frames },
             count: 1,
@@ -158,9 +183,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             feet: Feet::Raw,
             method: Default::default(),
         };
-        let generated = sinmdm::run(&mut model, &request, &mut |_, _| ControlFlow::Continue(()))?;
+        let generated = sinmdm::run(model, &request, &mut |_, _| ControlFlow::Continue(()))?;
         one_shot.push(metric_features(
-            &layout,
+            layout,
             generated.features.index_axis(ndarray::Axis(0), 0),
         ));
     }
@@ -170,9 +195,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "60 s streamed: coverage {:.1}, global diversity {:.3}; one-shot: coverage {:.1}, global diversity {:.3}",
         a.coverage.mean, a.global_diversity.mean, b.coverage.mean, b.global_diversity.mean
     );
+    Ok(())
+}
 
-    // The C ABI against the Rust call: generate + poses, interleaved.
-    let path = std::ffi::CString::new(model_path.clone())?;
+/// The C ABI against the Rust call: generate + poses, interleaved, printed.
+fn c_abi_overhead(model: &mut Model, model_path: &str) -> Result<(), Box<dyn std::error::Error>> {
+    let path = std::ffi::CString::new(model_path)?;
     let mut handle: *mut SinmdmModel = std::ptr::null_mut();
     let status = unsafe { sinmdm_model_open(path.as_ptr(), 0, &mut handle) };
     assert_eq!(status, SinmdmStatus::Ok);
@@ -210,7 +238,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (mut rust, mut c) = (Vec::new(), Vec::new());
     for _ in 0..15 {
         let t = Instant::now();
-        let generated = sinmdm::run(&mut model, &request, &mut |_, _| ControlFlow::Continue(()))?;
+        let generated = sinmdm::run(model, &request, &mut |_, _| ControlFlow::Continue(()))?;
         std::hint::black_box(generated.poses(0)?);
         rust.push(t.elapsed().as_secs_f64());
         let t = Instant::now();

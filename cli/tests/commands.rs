@@ -232,8 +232,42 @@ fn run_text(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// Asserts that the `encode` output of a BVH clip and of its GLB have the same columns, and 6D
+/// rotations that agree to f32 rounding.
+fn assert_same_rotations(bvh: &serde_json::Value, glb: &serde_json::Value) {
+    let values = |v: &serde_json::Value| -> Vec<f64> {
+        v["samples"][0]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|row| row.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()))
+            .collect()
+    };
+    assert_eq!(bvh["columns"], glb["columns"]);
+    let (a, b) = (values(bvh), values(glb));
+    assert_eq!(a.len(), b.len());
+    // 6D rotations agree to f32 rounding; root travel is in metres against CMU units, so the
+    // comparison is of rotations (columns with "rot6d").
+    let columns: Vec<String> = bvh["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap().to_string())
+        .collect();
+    let frames = a.len() / columns.len();
+    for (c, name) in columns.iter().enumerate() {
+        if !name.contains("rot6d") {
+            continue;
+        }
+        for f in 0..frames {
+            let (x, y) = (a[c * frames + f], b[c * frames + f]);
+            assert!((x - y).abs() < 1e-5, "{name} frame {f}: {x} against {y}");
+        }
+    }
+}
+
 #[test]
-fn every_command_that_reads_a_clip_reads_gltf_and_fbx_and_names_what_it_refuses() {
+fn every_command_that_reads_a_clip_reads_gltf_and_names_what_it_refuses() {
     let dir = std::env::temp_dir().join(format!("sinmdm-gltf-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = |name: &str| dir.join(name).to_string_lossy().into_owned();
@@ -255,35 +289,7 @@ fn every_command_that_reads_a_clip_reads_gltf_and_fbx_and_names_what_it_refuses(
         serde_json::from_str(&std::fs::read_to_string(dir.join(name)).unwrap()).unwrap()
     };
     let (bvh, glb) = (read("bvh.json"), read("glb.json"));
-    let values = |v: &serde_json::Value| -> Vec<f64> {
-        v["samples"][0]
-            .as_array()
-            .unwrap()
-            .iter()
-            .flat_map(|row| row.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()))
-            .collect()
-    };
-    assert_eq!(bvh["columns"], glb["columns"]);
-    let (a, b) = (values(&bvh), values(&glb));
-    assert_eq!(a.len(), b.len());
-    // 6D rotations agree to f32 rounding; root travel is in metres against CMU units, so the
-    // comparison is of rotations (columns with "rot6d").
-    let columns: Vec<String> = bvh["columns"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| c.as_str().unwrap().to_string())
-        .collect();
-    let frames = a.len() / columns.len();
-    for (c, name) in columns.iter().enumerate() {
-        if !name.contains("rot6d") {
-            continue;
-        }
-        for f in 0..frames {
-            let (x, y) = (a[c * frames + f], b[c * frames + f]);
-            assert!((x - y).abs() < 1e-5, "{name} frame {f}: {x} against {y}");
-        }
-    }
+    assert_same_rotations(&bvh, &glb);
     // inspect, render, reorient and a task's reference take the GLB.
     let (ok, out, err) = run_text(&["inspect", &path("walk.glb")]);
     assert!(
@@ -324,6 +330,17 @@ fn every_command_that_reads_a_clip_reads_gltf_and_fbx_and_names_what_it_refuses(
         !ok && err.contains("walk.glb") && err.contains("no animation named 'Run'"),
         "{err}"
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_fbx_clip_is_read_and_what_the_commands_refuse_is_named() {
+    let dir = std::env::temp_dir().join(format!("sinmdm-fbx-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    let walk = repo_file("tests/data/bvh/human_walk_cmu_131_01.bvh");
+    let walk = walk.to_str().unwrap();
+    // Refusals name the file and the problem; nothing is written.
     std::fs::write(dir.join("clip.fbx"), b"Kaydara FBX Binary").unwrap();
     let (ok, _, err) = run_text(&["inspect", &path("clip.fbx")]);
     assert!(

@@ -12,9 +12,14 @@ use ndarray::{Array2, ArrayView2};
 use sinmdm::bvh::read_bvh;
 use sinmdm::features_file::read_features;
 use sinmdm::motion::feet::{Anchor, Kept, PlantOptions, plant_feet};
-use sinmdm::motion::{LocalMotion, decode, encode_for_model};
+use sinmdm::motion::{FeatureLayout, LocalMotion, decode, encode_for_model};
 use sinmdm::{Model, ModelOptions};
-use sinmdm_eval::{FeetReference, evaluate, mean_scores, metric_features, motion_metric_features};
+use sinmdm_eval::{
+    FeetReference, FeetScores, evaluate, mean_scores, metric_features, motion_metric_features,
+};
+
+/// The table's coverage / global diversity column of planted (or raw) samples' motions.
+type Benchmark<'a> = dyn Fn(&[&LocalMotion]) -> Result<String, Box<dyn std::error::Error>> + 'a;
 
 /// Mean over frames of the per-frame distance between two metric feature tables.
 fn mean_frame_distance(a: &Array2<f64>, b: &Array2<f64>) -> f64 {
@@ -65,8 +70,114 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ))
     };
 
+    let settings = settings();
+    let clip_labels = labels_of(clip.features.view());
+    println!(
+        "the clip planted with its own labels (how much a setting changes motion that is right):"
+    );
+    for (name, options) in &settings[..5] {
+        let (planted, _) = plant_feet(
+            layout,
+            &clip_motion,
+            &clip_labels,
+            &Kept::default(),
+            options,
+        )?;
+        let moved = mean_frame_distance(
+            &motion_metric_features(layout, &planted, clip.features.view()),
+            &clip_metric,
+        );
+        println!(
+            "  {name}: mean per-frame distance to the clip {moved:.3}, skating {:.1} %",
+            100.0 * reference.scores(&planted).skating_ratio
+        );
+    }
+
+    let raw = print_reference_rows(layout, &reference, &clip_motion, &samples, &benchmark)?;
+    for (name, options) in settings {
+        let started = std::time::Instant::now();
+        let planted = samples
+            .iter()
+            .map(|(m, l)| plant_feet(layout, m, l, &Kept::default(), &options))
+            .collect::<Result<Vec<_>, _>>()?;
+        let ms = started.elapsed().as_secs_f64() * 1000.0 / samples.len() as f64;
+        let s = mean_scores(
+            &planted
+                .iter()
+                .map(|(m, _)| reference.scores(m))
+                .collect::<Vec<_>>(),
+        );
+        let lifted: usize = planted.iter().map(|(_, s)| s.lifted_frames).sum();
+        let miss = format!(
+            "{:.4}/{:.4}",
+            planted.iter().map(|(_, s)| s.mean_miss).sum::<f64>() / planted.len() as f64,
+            planted.iter().map(|(_, s)| s.max_miss).fold(0.0, f64::max)
+        );
+        let scores = benchmark(&planted.iter().map(|(m, _)| m).collect::<Vec<_>>())?;
+        println!(
+            "{name} | {:.1} | {:.4} | {:.1} | {:.3} | {scores} | {lifted} | {miss} | {ms:.1}",
+            100.0 * s.skating_ratio,
+            s.max_penetration,
+            100.0 * s.penetrating_frames,
+            s.jitter / raw.jitter
+        );
+    }
+    Ok(())
+}
+
+/// Prints the ground and the table's header, clip and raw rows; returns the raw samples' mean
+/// scores, against which the settings' jitter is given.
+fn print_reference_rows(
+    layout: &FeatureLayout,
+    reference: &FeetReference,
+    clip_motion: &LocalMotion,
+    samples: &[(LocalMotion, Vec<Vec<f32>>)],
+    benchmark: &Benchmark<'_>,
+) -> Result<FeetScores, Box<dyn std::error::Error>> {
+    let clip_scores = reference.scores(clip_motion);
+    let raw = mean_scores(
+        &samples
+            .iter()
+            .map(|(m, _)| reference.scores(m))
+            .collect::<Vec<_>>(),
+    );
+    println!(
+        "ground {:.4} (layout {:?})",
+        reference.ground(),
+        layout.ground
+    );
+    println!(
+        "setting | skating % | deepest H | floor frames % | jitter ratio to raw | coverage / global diversity | lifted | miss mean/max H | ms/sample"
+    );
+    println!(
+        "clip | {:.1} | {:.4} | {:.1} | {:.3} | | | |",
+        100.0 * clip_scores.skating_ratio,
+        clip_scores.max_penetration,
+        100.0 * clip_scores.penetrating_frames,
+        clip_scores.jitter / raw.jitter
+    );
+    println!(
+        "raw | {:.1} | {:.4} | {:.1} | 1.000 | {} | | |",
+        100.0 * raw.skating_ratio,
+        raw.max_penetration,
+        100.0 * raw.penetrating_frames,
+        benchmark(&samples.iter().map(|(m, _)| m).collect::<Vec<_>>())?
+    );
+    Ok(raw)
+}
+
+/// The settings the sweep compares: the default, then one change each.
+fn settings() -> Vec<(&'static str, PlantOptions)> {
+    let mut settings = span_settings();
+    settings.extend(hold_settings());
+    settings
+}
+
+/// The default and the settings that change which frames are planted (the first five also plant
+/// the clip).
+fn span_settings() -> Vec<(&'static str, PlantOptions)> {
     let base = PlantOptions::default();
-    let settings = [
+    vec![
         ("default", base),
         (
             "labelled spans only",
@@ -118,6 +229,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ..base
             },
         ),
+    ]
+}
+
+/// The settings that change how a planted foot is held: root travel, hold, anchor, blend,
+/// stance smoothing and reach.
+fn hold_settings() -> Vec<(&'static str, PlantOptions)> {
+    let base = PlantOptions::default();
+    vec![
         (
             "legs only (no root travel)",
             PlantOptions {
@@ -174,86 +293,5 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ..base
             },
         ),
-    ];
-
-    let clip_labels = labels_of(clip.features.view());
-    println!(
-        "the clip planted with its own labels (how much a setting changes motion that is right):"
-    );
-    for (name, options) in &settings[..5] {
-        let (planted, _) = plant_feet(
-            layout,
-            &clip_motion,
-            &clip_labels,
-            &Kept::default(),
-            options,
-        )?;
-        let moved = mean_frame_distance(
-            &motion_metric_features(layout, &planted, clip.features.view()),
-            &clip_metric,
-        );
-        println!(
-            "  {name}: mean per-frame distance to the clip {moved:.3}, skating {:.1} %",
-            100.0 * reference.scores(&planted).skating_ratio
-        );
-    }
-
-    let clip_scores = reference.scores(&clip_motion);
-    let raw = mean_scores(
-        &samples
-            .iter()
-            .map(|(m, _)| reference.scores(m))
-            .collect::<Vec<_>>(),
-    );
-    println!(
-        "ground {:.4} (layout {:?})",
-        reference.ground(),
-        layout.ground
-    );
-    println!(
-        "setting | skating % | deepest H | floor frames % | jitter ratio to raw | coverage / global diversity | lifted | miss mean/max H | ms/sample"
-    );
-    println!(
-        "clip | {:.1} | {:.4} | {:.1} | {:.3} | | | |",
-        100.0 * clip_scores.skating_ratio,
-        clip_scores.max_penetration,
-        100.0 * clip_scores.penetrating_frames,
-        clip_scores.jitter / raw.jitter
-    );
-    println!(
-        "raw | {:.1} | {:.4} | {:.1} | 1.000 | {} | | |",
-        100.0 * raw.skating_ratio,
-        raw.max_penetration,
-        100.0 * raw.penetrating_frames,
-        benchmark(&samples.iter().map(|(m, _)| m).collect::<Vec<_>>())?
-    );
-    for (name, options) in settings {
-        let started = std::time::Instant::now();
-        let planted = samples
-            .iter()
-            .map(|(m, l)| plant_feet(layout, m, l, &Kept::default(), &options))
-            .collect::<Result<Vec<_>, _>>()?;
-        let ms = started.elapsed().as_secs_f64() * 1000.0 / samples.len() as f64;
-        let s = mean_scores(
-            &planted
-                .iter()
-                .map(|(m, _)| reference.scores(m))
-                .collect::<Vec<_>>(),
-        );
-        let lifted: usize = planted.iter().map(|(_, s)| s.lifted_frames).sum();
-        let miss = format!(
-            "{:.4}/{:.4}",
-            planted.iter().map(|(_, s)| s.mean_miss).sum::<f64>() / planted.len() as f64,
-            planted.iter().map(|(_, s)| s.max_miss).fold(0.0, f64::max)
-        );
-        let scores = benchmark(&planted.iter().map(|(m, _)| m).collect::<Vec<_>>())?;
-        println!(
-            "{name} | {:.1} | {:.4} | {:.1} | {:.3} | {scores} | {lifted} | {miss} | {ms:.1}",
-            100.0 * s.skating_ratio,
-            s.max_penetration,
-            100.0 * s.penetrating_frames,
-            s.jitter / raw.jitter
-        );
-    }
-    Ok(())
+    ]
 }

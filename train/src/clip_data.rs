@@ -7,7 +7,9 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use sinmdm::model_file::ClipSourceFacts;
-use sinmdm::motion::{ContactConfig, EncodeOptions, FeatureLayout, Normalizer, RootLayout, encode};
+use sinmdm::motion::{
+    ChannelClip, ContactConfig, EncodeOptions, FeatureLayout, Normalizer, RootLayout, encode,
+};
 use sinmdm_formats::{
     AnimationChoice, ClipFormat, FileAccess, ReadOptions, STILL_TOLERANCE, clip_moves,
     read_clip_with_access,
@@ -87,48 +89,7 @@ impl ClipData {
                 reason: source,
             },
         )?;
-        let read_options = ReadOptions {
-            animation: data.animation.as_deref().map(AnimationChoice::parse),
-            fps: None,
-        };
-        let (clip, source) = match format {
-            ClipFormat::Bvh => {
-                if data.animation.is_some() {
-                    return Err(TrainError::Config {
-                        path: path.to_path_buf(),
-                        message: "data.animation (--clip-anim) picks an animation of a glTF or FBX clip; a BVH file holds one".into(),
-                    });
-                }
-                let text = String::from_utf8_lossy(&bytes);
-                (
-                    sinmdm::bvh::parse_bvh(&text, &path.display().to_string())?,
-                    None,
-                )
-            }
-            format @ (ClipFormat::Gltf | ClipFormat::Fbx) => {
-                let access = FileAccess {
-                    allow_outside_folder: data.allow_outside_folder,
-                };
-                let (clip, source) = read_clip_with_access(path, &read_options, access)?;
-                let read = source
-                    .animation
-                    .expect("a glTF or FBX clip names its animation");
-                if read.still == Some(true) {
-                    return Err(TrainError::StillClip {
-                        path: path.to_path_buf(),
-                        what: format!("animation {}", read.describe()),
-                        tolerance: STILL_TOLERANCE,
-                    });
-                }
-                let facts = ClipSourceFacts {
-                    format: format.name().into(),
-                    animation: Some(read.name.unwrap_or_else(|| format!("#{}", read.index))),
-                    animations: source.animations.len(),
-                    file_unit_meters: source.file_unit_meters,
-                };
-                (clip, Some(facts))
-            }
-        };
+        let (clip, source) = read_clip(path, format, &bytes, data)?;
         if !clip_moves(&clip) {
             return Err(TrainError::StillClip {
                 path: path.to_path_buf(),
@@ -186,6 +147,59 @@ impl ClipData {
             features,
         })
     }
+}
+
+/// Reads `path` (its `bytes` already read) as `format`: the clip, and what the file was when not
+/// BVH; rejects `data.animation` for a BVH file and a still glTF or FBX animation.
+fn read_clip(
+    path: &Path,
+    format: ClipFormat,
+    bytes: &[u8],
+    data: &DataConfig,
+) -> Result<(ChannelClip, Option<ClipSourceFacts>), TrainError> {
+    let read_options = ReadOptions {
+        animation: data.animation.as_deref().map(AnimationChoice::parse),
+        fps: None,
+    };
+    let clip_and_source = match format {
+        ClipFormat::Bvh => {
+            if data.animation.is_some() {
+                return Err(TrainError::Config {
+                    path: path.to_path_buf(),
+                    message: "data.animation (--clip-anim) picks an animation of a glTF or FBX clip; a BVH file holds one".into(),
+                });
+            }
+            let text = String::from_utf8_lossy(bytes);
+            (
+                sinmdm::bvh::parse_bvh(&text, &path.display().to_string())?,
+                None,
+            )
+        }
+        format @ (ClipFormat::Gltf | ClipFormat::Fbx) => {
+            let access = FileAccess {
+                allow_outside_folder: data.allow_outside_folder,
+            };
+            let (clip, source) = read_clip_with_access(path, &read_options, access)?;
+            let read = source
+                .animation
+                .expect("a glTF or FBX clip names its animation");
+            if read.still == Some(true) {
+                return Err(TrainError::StillClip {
+                    path: path.to_path_buf(),
+                    what: format!("animation {}", read.describe()),
+                    tolerance: STILL_TOLERANCE,
+                });
+            }
+            let facts = ClipSourceFacts {
+                format: format.name().into(),
+                animation: Some(read.name.unwrap_or_else(|| format!("#{}", read.index))),
+                animations: source.animations.len(),
+                file_unit_meters: source.file_unit_meters,
+            };
+            (clip, Some(facts))
+        }
+    };
+    Ok(clip_and_source)
 }
 
 /// The root layout of `encoded` in words, with why it was chosen when `asked` was

@@ -398,7 +398,7 @@ fn a_time_budget_sets_the_steps_and_records_them() {
 }
 
 #[test]
-fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
+fn dry_run_prints_the_sizes_of_a_configuration() {
     let bin = env!("CARGO_BIN_EXE_sinmdm-train");
     let out = Command::new(bin)
         .arg(walk())
@@ -417,7 +417,11 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
         text.contains("from_clip       off: the configuration's numbers train as written"),
         "{text}"
     );
+}
 
+#[test]
+fn dry_run_of_the_default_reads_the_clip() {
+    let bin = env!("CARGO_BIN_EXE_sinmdm-train");
     // Without --config, the built-in default; --fps replaces its frame rate.
     let default = TrainConfig::load(&root().join("configs/default.yaml")).unwrap();
     let out = Command::new(bin)
@@ -444,6 +448,11 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
             && text.contains("chosen from the clip (data.root_layout auto)"),
         "{text}"
     );
+}
+
+#[test]
+fn dry_run_at_the_clips_frame_rate_widens_the_window_and_names_a_bad_fps() {
+    let bin = env!("CARGO_BIN_EXE_sinmdm-train");
     let out = Command::new(bin)
         .arg(walk())
         .args(["--fps", "clip", "--dry-run"])
@@ -463,7 +472,11 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
         .output()
         .unwrap();
     assert!(String::from_utf8_lossy(&out.stderr).contains("--fps must be"));
+}
 
+#[test]
+fn the_window_flag_replaces_the_window_and_names_what_it_refuses() {
+    let bin = env!("CARGO_BIN_EXE_sinmdm-train");
     // --window replaces the window at any frame rate: 5 at 120 fps stays 5 (14 + 3 * 5 frames).
     let out = Command::new(bin)
         .arg(walk())
@@ -497,7 +510,11 @@ fn dry_run_prints_sizes_and_the_cli_names_bad_configs() {
         !out.status.success() && err.contains("--window sets the QnA window of a new run"),
         "{err}"
     );
+}
 
+#[test]
+fn the_cli_names_an_unknown_field_of_a_config_and_writes_nothing() {
+    let bin = env!("CARGO_BIN_EXE_sinmdm-train");
     let bad = scratch("bad.yaml");
     let text = std::fs::read_to_string(root().join("configs/tiny.yaml"))
         .unwrap()

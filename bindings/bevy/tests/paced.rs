@@ -8,9 +8,11 @@ mod common;
 
 use std::time::{Duration, Instant};
 
+use bevy_app::App;
+use bevy_ecs::entity::Entity;
 use bevy_math::{Quat, Vec3};
 use bevy_transform::components::{GlobalTransform, Transform};
-use sinmdm::{Stream, StreamOptions};
+use sinmdm::{Pose, Stream, StreamOptions};
 use sinmdm_bevy::{CharacterOptions, MotionCharacter, MotionModel};
 
 use common::{BEVY_FPS, app_with, matrix, model_path, world_positions};
@@ -41,24 +43,7 @@ fn follows_forward_kinematics(name: &str) {
 
     // Paced as a game's frames are: each update at its time on the wall clock.
     let frames = 240;
-    let start = Instant::now();
-    let mut seen = Vec::new();
-    for k in 0..frames {
-        let due = start + Duration::from_secs_f64(k as f64 / BEVY_FPS);
-        if let Some(wait) = due.checked_duration_since(Instant::now()) {
-            std::thread::sleep(wait);
-        }
-        app.update();
-        let world = app.world();
-        let c = world.get::<MotionCharacter>(character).unwrap();
-        assert!(c.error().is_none(), "{:?}", c.error());
-        let joints: Vec<Vec3> = c
-            .joints()
-            .iter()
-            .map(|&e| world.get::<GlobalTransform>(e).unwrap().translation())
-            .collect();
-        seen.push((c.clock().unwrap(), joints));
-    }
+    let seen = paced_frames(&mut app, character, frames);
     let c = app.world().get::<MotionCharacter>(character).unwrap();
     assert_eq!(
         c.waits(),
@@ -91,6 +76,53 @@ fn follows_forward_kinematics(name: &str) {
     let turn = metadata.layout.up.canonical_from_file().0;
     let scale = f64::from(c.frame().metres_per_unit);
     let height = metadata.layout.skeleton_height * scale;
+    let worst = worst_joint_distance(&seen, &poses, &parents, &turn, scale, &place);
+    eprintln!(
+        "{name}: worst joint distance {:.3e} m ({:.3e} x height), ahead {} frames",
+        worst,
+        worst / height,
+        c.ahead_frames()
+    );
+    assert!(
+        worst <= 1e-5 * height,
+        "joints {worst} m from forward kinematics (height {height} m)"
+    );
+}
+
+/// Updates `app` `frames` times, each at its time on the wall clock, checking that the character
+/// has no error: the character's clock and joint positions after each update.
+fn paced_frames(app: &mut App, character: Entity, frames: usize) -> Vec<(f64, Vec<Vec3>)> {
+    let start = Instant::now();
+    let mut seen = Vec::new();
+    for k in 0..frames {
+        let due = start + Duration::from_secs_f64(k as f64 / BEVY_FPS);
+        if let Some(wait) = due.checked_duration_since(Instant::now()) {
+            std::thread::sleep(wait);
+        }
+        app.update();
+        let world = app.world();
+        let c = world.get::<MotionCharacter>(character).unwrap();
+        assert!(c.error().is_none(), "{:?}", c.error());
+        let joints: Vec<Vec3> = c
+            .joints()
+            .iter()
+            .map(|&e| world.get::<GlobalTransform>(e).unwrap().translation())
+            .collect();
+        seen.push((c.clock().unwrap(), joints));
+    }
+    seen
+}
+
+/// The largest distance of any joint in `seen` from its position by forward kinematics of the
+/// stream's `poses`, interpolated at the clock it was seen at, with the character at `place`.
+fn worst_joint_distance(
+    seen: &[(f64, Vec<Vec3>)],
+    poses: &[Pose],
+    parents: &[Option<usize>],
+    turn: &[[f64; 3]; 3],
+    scale: f64,
+    place: &Transform,
+) -> f64 {
     let place_rot = matrix(
         [
             place.rotation.x,
@@ -102,16 +134,16 @@ fn follows_forward_kinematics(name: &str) {
     );
     let place_pos = place.translation.to_array().map(f64::from);
     let mut worst = 0.0f64;
-    for (clock, joints) in &seen {
+    for (clock, joints) in seen {
         let base = clock.floor() as usize;
         let t = clock - base as f64;
         let expected = world_positions(
-            &parents,
+            parents,
             &poses[base],
             &poses[base + 1],
             t,
             (&place_rot, place_pos),
-            &turn,
+            turn,
             scale,
         );
         for (got, want) in joints.iter().zip(&expected) {
@@ -122,14 +154,5 @@ fn follows_forward_kinematics(name: &str) {
             worst = worst.max(d);
         }
     }
-    eprintln!(
-        "{name}: worst joint distance {:.3e} m ({:.3e} x height), ahead {} frames",
-        worst,
-        worst / height,
-        c.ahead_frames()
-    );
-    assert!(
-        worst <= 1e-5 * height,
-        "joints {worst} m from forward kinematics (height {height} m)"
-    );
+    worst
 }

@@ -44,6 +44,49 @@ fn steer_now(
     reach
 }
 
+/// Runs `frames` Bevy frames of a character of `model` walking straight at the clip's speed, told
+/// at frame `turn_at` to turn at `turn` rad/s if given: its directions of travel, and its steering
+/// reach when told (0 when never told).
+fn run_told_to_turn(
+    model: &MotionModel,
+    options: &CharacterOptions,
+    limits: &SteerLimits,
+    turn_at: usize,
+    frames: usize,
+    turn: Option<f32>,
+) -> (Vec<Option<f64>>, usize) {
+    let (mut app, character) = app_with(model, options.clone(), Transform::IDENTITY);
+    let frame = app
+        .world()
+        .get::<MotionCharacter>(character)
+        .unwrap()
+        .frame();
+    let speed = Steering::clip_speed(&frame, limits);
+    let straight = Steering::Velocity {
+        forward: speed,
+        turn: 0.0,
+    };
+    app.world_mut().entity_mut(character).insert(straight);
+    let mut roots = Vec::new();
+    let mut reach = 0;
+    for k in 0..frames {
+        if k == turn_at
+            && let Some(turn) = turn
+        {
+            reach = steer_now(
+                &mut app,
+                character,
+                Steering::Velocity {
+                    forward: speed,
+                    turn,
+                },
+            );
+        }
+        roots.push(frame_root(&mut app, character));
+    }
+    (travel_headings(&roots), reach)
+}
+
 #[test]
 fn a_steering_command_turns_the_character_left_within_its_reach() {
     let model = MotionModel::open(model_path("human_zombie_walk_fair.onnx"), Some(1)).unwrap();
@@ -63,40 +106,8 @@ fn a_steering_command_turns_the_character_left_within_its_reach() {
     };
     let turn_at = (4.0 * BEVY_FPS) as usize;
     let frames = turn_at + (8.0 * BEVY_FPS) as usize;
-    let run = |turn: Option<f32>| {
-        let (mut app, character) = app_with(&model, options.clone(), Transform::IDENTITY);
-        let frame = app
-            .world()
-            .get::<MotionCharacter>(character)
-            .unwrap()
-            .frame();
-        let speed = Steering::clip_speed(&frame, &limits);
-        let straight = Steering::Velocity {
-            forward: speed,
-            turn: 0.0,
-        };
-        app.world_mut().entity_mut(character).insert(straight);
-        let mut roots = Vec::new();
-        let mut reach = 0;
-        for k in 0..frames {
-            if k == turn_at
-                && let Some(turn) = turn
-            {
-                reach = steer_now(
-                    &mut app,
-                    character,
-                    Steering::Velocity {
-                        forward: speed,
-                        turn,
-                    },
-                );
-            }
-            roots.push(frame_root(&mut app, character));
-        }
-        (travel_headings(&roots), reach)
-    };
-    let (straight, _) = run(None);
-    let (turned, reach) = run(Some(0.8));
+    let (straight, _) = run_told_to_turn(&model, &options, &limits, turn_at, frames, None);
+    let (turned, reach) = run_told_to_turn(&model, &options, &limits, turn_at, frames, Some(0.8));
     let (straight, turned) = (unwrapped(&straight), unwrapped(&turned));
     // The model frames a change can take to show, in Bevy frames.
     let reach_bevy = (reach as f64 / fps * BEVY_FPS).ceil() as usize;

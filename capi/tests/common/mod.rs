@@ -6,9 +6,10 @@ use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
+use sinmdm::motion::FeatureMatrix;
 use sinmdm::{
-    Feet, Model, ModelOptions, Pose, Request, Span, Stream, StreamOptions, Task,
-    features_from_poses,
+    FeatureLayout, Feet, Generated, Model, ModelOptions, Pose, Request, Span, Stream,
+    StreamOptions, Task, features_from_poses,
 };
 
 pub fn repo() -> PathBuf {
@@ -155,8 +156,26 @@ pub fn expected() -> BTreeMap<String, String> {
     let mut model = Model::open(model_path(), &ModelOptions { threads: Some(1) }).unwrap();
     let mut out = BTreeMap::new();
     let go = &mut |_: usize, _: usize| ControlFlow::Continue(());
+    let crowd = generate_lines(&mut model, go, &mut out);
+    let layout = model.metadata().layout.clone();
+    let reference = features_from_poses(&layout, &crowd.poses(0).unwrap()).unwrap();
+    let between_reference = reference.clone();
+    inbetween_lines(&mut model, reference, go, &mut out);
+    dance_lines(&mut model, &layout, between_reference, go, &mut out);
+    stream_lines(&mut model, "stream", &[], &mut out);
+    steer_lines(go, &mut out);
+    out
+}
+
+/// The generated samples' lines (`generate1`, `dpm2m`, `default_steps`); returns the crowd of
+/// two whose first sample the in-between and the dance start from.
+fn generate_lines(
+    model: &mut Model,
+    go: &mut dyn FnMut(usize, usize) -> ControlFlow<()>,
+    out: &mut BTreeMap<String, String>,
+) -> Generated {
     let crowd = sinmdm::run(
-        &mut model,
+        model,
         &Request {
             task: Task::Generate { frames: 40 },
             count: 2,
@@ -168,9 +187,9 @@ pub fn expected() -> BTreeMap<String, String> {
         go,
     )
     .unwrap();
-    pose_lines("generate1", &crowd.poses(1).unwrap(), &mut out);
+    pose_lines("generate1", &crowd.poses(1).unwrap(), out);
     let quick = sinmdm::run(
-        &mut model,
+        model,
         &Request {
             task: Task::Generate { frames: 40 },
             count: 1,
@@ -182,10 +201,10 @@ pub fn expected() -> BTreeMap<String, String> {
         go,
     )
     .unwrap();
-    pose_lines("dpm2m", &quick.poses(0).unwrap(), &mut out);
+    pose_lines("dpm2m", &quick.poses(0).unwrap(), out);
     // A zeroed `steps` in C is the library's default step count.
     let default_steps = sinmdm::run(
-        &mut model,
+        model,
         &Request {
             task: Task::Generate { frames: 30 },
             count: 1,
@@ -197,12 +216,19 @@ pub fn expected() -> BTreeMap<String, String> {
         go,
     )
     .unwrap();
-    pose_lines("default_steps", &default_steps.poses(0).unwrap(), &mut out);
-    let layout = model.metadata().layout.clone();
-    let reference = features_from_poses(&layout, &crowd.poses(0).unwrap()).unwrap();
-    let between_reference = reference.clone();
+    pose_lines("default_steps", &default_steps.poses(0).unwrap(), out);
+    crowd
+}
+
+/// The in-between of `reference`, kept at frames 0-10 and 30-40: `inbetween`.
+fn inbetween_lines(
+    model: &mut Model,
+    reference: FeatureMatrix,
+    go: &mut dyn FnMut(usize, usize) -> ControlFlow<()>,
+    out: &mut BTreeMap<String, String>,
+) {
     let between = sinmdm::run(
-        &mut model,
+        model,
         &Request {
             task: Task::Inbetween {
                 reference,
@@ -218,17 +244,27 @@ pub fn expected() -> BTreeMap<String, String> {
         go,
     )
     .unwrap();
-    pose_lines("inbetween", &between.poses(0).unwrap(), &mut out);
+    pose_lines("inbetween", &between.poses(0).unwrap(), out);
+}
+
+/// The dance beats of `between_reference` (`dancebeats.status`) and its dance (`dance`).
+fn dance_lines(
+    model: &mut Model,
+    layout: &FeatureLayout,
+    between_reference: FeatureMatrix,
+    go: &mut dyn FnMut(usize, usize) -> ControlFlow<()>,
+    out: &mut BTreeMap<String, String>,
+) {
     // The reference's dance beats: the status and count the C ABI gives (0 and the count, or
     // SINMDM_INVALID_ARGUMENT, 2, and 0 when the motion has no regular beat).
-    let motion = sinmdm::motion::decode(&layout, between_reference.view()).unwrap();
+    let motion = sinmdm::motion::decode(layout, between_reference.view()).unwrap();
     let summary = match sinmdm_beats::pulses::motion_beats(&motion) {
         Ok((_, regular)) => [0.0, regular.frames.len() as f32],
         Err(_) => [2.0, 0.0],
     };
     out.insert("dancebeats.status".into(), hex(summary));
     let dance = sinmdm::run(
-        &mut model,
+        model,
         &Request {
             task: Task::Dance {
                 reference: between_reference,
@@ -252,8 +288,14 @@ pub fn expected() -> BTreeMap<String, String> {
         go,
     )
     .unwrap();
-    pose_lines("dance", &dance.poses(0).unwrap(), &mut out);
-    stream_lines(&mut model, "stream", &[], &mut out);
+    pose_lines("dance", &dance.poses(0).unwrap(), out);
+}
+
+/// The steered zombie walk's lines: `steer`, `steerfacing` and `steerstream`.
+fn steer_lines(
+    go: &mut dyn FnMut(usize, usize) -> ControlFlow<()>,
+    out: &mut BTreeMap<String, String>,
+) {
     // Steering the zombie walk: 40 frames at 12 units/s turning 0.3 rad/s, one-shot; and a
     // stream told 10 units/s turning -0.2 rad/s for 60 frames, read in chunks of 20 and 25.
     let mut zombie = Model::open(steer_model_path(), &ModelOptions { threads: Some(1) }).unwrap();
@@ -275,16 +317,15 @@ pub fn expected() -> BTreeMap<String, String> {
             .poses(0)
             .unwrap()
     };
-    pose_lines("steer", &steered(steer_commands(40, 12.0, 0.3)), &mut out);
+    pose_lines("steer", &steered(steer_commands(40, 12.0, 0.3)), out);
     // The same with facing commands.
-    pose_lines("steerfacing", &steered(facing_commands()), &mut out);
+    pose_lines("steerfacing", &steered(facing_commands()), out);
     stream_lines(
         &mut zombie,
         "steerstream",
         &steer_commands(60, 10.0, -0.2),
-        &mut out,
+        out,
     );
-    out
 }
 
 /// `label hex hex ...` lines of a program's output, by label.

@@ -43,13 +43,14 @@ use crate::config::{FromClip, TrainConfig};
 mod batch_pairing;
 mod calm;
 mod reading;
+mod setting_lines;
 mod window_cost;
 
 use batch_pairing::batch_line;
 pub use batch_pairing::{BATCH_ITEMS_MULTIPLE, paired_items};
-use calm::ladder_list;
 pub use calm::{calm_most_steps, calm_warmup_steps, not_calm_after_all};
 pub use reading::ClipReading;
+use setting_lines::{Choosing, steps_at_fps_line};
 pub use window_cost::{
     FITTED_STEPS_ROUNDING, WINDOW_STEP_COST_OFFSET, steps_at_window, window_step_cost,
 };
@@ -137,135 +138,20 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
         && asked.channels
         && config.model.channels < MANY_FEET_CHANNELS
         && MANY_FEET_CHANNELS.is_multiple_of(config.model.heads);
-    // What the steps line says after its label (the steps meant at 30 fps, and why).
-    let steps_said = match (asked.steps, calm) {
-        (false, _) => format!("{} ({kept})", config.training.steps),
-        (true, true) => {
-            let steps = calm_most_steps();
-            out.training.steps = steps;
-            out.training.warmup_steps = calm_warmup_steps(steps);
-            format!(
-                "chosen by the step ladder when training starts: short runs of {} steps (warm-up a third), each sampled {} times and scored, and the one that meets coverage >= {}, replay <= {} s (or the clip's own backwards score), jitter within {}x of the clip's either way and moves like the clip (still frames, speeds) with the widest margin (where none meets them all, the one that moves most like the clip, then misses the rest by least in all) trains the model (a calm clip is covered within a few hundred steps, and replays the longer it trains)",
-                ladder_list(),
-                crate::ladder_settings::CHECK_SAMPLES,
-                crate::ladder_settings::goals::COVERAGE,
-                crate::ladder_settings::goals::REPLAY_SECONDS,
-                crate::ladder_settings::goals::JITTER_RATIO,
-            )
-        }
-        (true, false) if widen && config.training.steps > MANY_FEET_STEPS => {
-            out.training.steps = MANY_FEET_STEPS;
-            format!(
-                "{MANY_FEET_STEPS}: the {MANY_FEET_CHANNELS} channels below cost more a step, and this many fit the time {} steps of {} channels take",
-                config.training.steps, config.model.channels
-            )
-        }
-        (true, false) => format!(
-            "{} (the configuration's): a varied clip covers more the longer it trains",
-            config.training.steps
-        ),
+    let choosing = Choosing {
+        config,
+        reading,
+        calm,
+        widen,
+        kept,
     };
+    // What the steps line says after its label (the steps meant at 30 fps, and why).
+    let steps_said = choosing.steps_said(&mut out, asked.steps);
     let steps_line = lines.len();
     lines.push(format!("steps           {steps_said}"));
-    lines.push(match (asked.window, calm) {
-        (false, _) => format!("window          {} ({kept})", config.model.window),
-        (true, true) => format!(
-            "window          {} (the configuration's): the rule widens only a varied clip's",
-            config.model.window
-        ),
-        (true, false) => {
-            let (wanted, why) = if reading.has_many_feet() {
-                (
-                    MANY_FEET_WINDOW,
-                    format!(
-                        "on {} feet, a varied clip needs a wider field to keep its legs in step",
-                        reading.feet
-                    ),
-                )
-            } else {
-                (
-                    VARIED_WINDOW,
-                    "a wider field smooths a varied clip's samples".to_string(),
-                )
-            };
-            let at_30 = if config.model.window_follows_fps {
-                " at 30 fps"
-            } else {
-                ""
-            };
-            // The widest of the wanted windows that the clip is long enough for; never narrower
-            // than the configuration's.
-            let field = |window: usize| {
-                let mut model = config.model.clone();
-                model.window = window;
-                model.at_fps(reading.fps).receptive_field()
-            };
-            let wanted = wanted.max(config.model.window);
-            let fallback = VARIED_WINDOW.max(config.model.window);
-            match [wanted, fallback]
-                .into_iter()
-                .find(|&w| field(w) <= reading.frames)
-            {
-                Some(window) if window == wanted => {
-                    out.model.window = window;
-                    format!("window          {window}{at_30}: {why}")
-                }
-                Some(window) => {
-                    out.model.window = window;
-                    format!(
-                        "window          {window}{at_30}: the clip's {} frames are too few for window {wanted} ({why})",
-                        reading.frames
-                    )
-                }
-                None => format!(
-                    "window          {} (the configuration's): the clip's {} frames are fewer than the {} a wider window sees",
-                    config.model.window,
-                    reading.frames,
-                    field(fallback)
-                ),
-            }
-        }
-    });
-    lines.push(match (asked.dropout, calm) {
-        (false, _) => format!("dropout         {} ({kept})", config.model.dropout),
-        (true, true) => format!(
-            "dropout         {} (the configuration's): the rule raises only a varied clip's on three feet or more",
-            config.model.dropout
-        ),
-        (true, false) if reading.has_many_feet() => {
-            out.model.dropout = MANY_FEET_DROPOUT;
-            format!(
-                "dropout         {MANY_FEET_DROPOUT}: on {} feet, keeps a varied clip's samples varied (more costs it coverage)",
-                reading.feet
-            )
-        }
-        (true, false) => format!(
-            "dropout         {} (the configuration's): more damps a varied clip's samples on two feet (their median speed falls below the clip's)",
-            config.model.dropout
-        ),
-    });
-    lines.push(match (asked.channels, calm) {
-        (false, _) => format!("channels        {} ({kept})", config.model.channels),
-        (true, true) => format!(
-            "channels        {} (the configuration's): the rule widens only a varied clip's network",
-            config.model.channels
-        ),
-        (true, false) if widen => {
-            out.model.channels = MANY_FEET_CHANNELS;
-            format!(
-                "channels        {MANY_FEET_CHANNELS}: on {} feet, the network needs the width to hold every leg's phase at once",
-                reading.feet
-            )
-        }
-        (true, false) if reading.has_many_feet() => format!(
-            "channels        {} (the configuration's): at least {MANY_FEET_CHANNELS}, or {} heads do not divide {MANY_FEET_CHANNELS}",
-            config.model.channels, config.model.heads
-        ),
-        (true, false) => format!(
-            "channels        {} (the configuration's): on {} feet, the configuration's width serves",
-            config.model.channels, reading.feet
-        ),
-    });
+    lines.push(choosing.window_line(&mut out, asked.window));
+    lines.push(choosing.dropout_line(&mut out, asked.dropout));
+    lines.push(choosing.channels_line(&mut out, asked.channels));
     lines.push(batch_line(
         config,
         &mut out,
@@ -276,19 +162,11 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
     ));
     // The steps above are meant at 30 fps. At a higher rate the window follows the frame rate,
     // a step costs more, and a varied clip's steps fall to fit the same time.
-    if asked.steps && !calm {
-        let at_30 = out.model.window;
-        let trained = out.model.at_fps(reading.fps).window;
-        let steps = steps_at_window(out.training.steps, at_30, trained);
-        if steps < out.training.steps {
-            lines[steps_line] = format!(
-                "steps           {steps}: at {} fps the window is {trained}, whose steps cost {:.2}x those of window {at_30}, so this many fit the time of the steps meant at 30 fps, {steps_said}",
-                reading.fps,
-                window_step_cost(trained) / window_step_cost(at_30),
-            );
-            out.training.steps = steps;
-            out.training.warmup_steps = out.training.warmup_steps.min(steps / 10);
-        }
+    if asked.steps
+        && !calm
+        && let Some(line) = steps_at_fps_line(&mut out, reading, &steps_said)
+    {
+        lines[steps_line] = line;
     }
     RuleChoice {
         reading,
