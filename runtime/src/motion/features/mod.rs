@@ -24,6 +24,7 @@ pub type FeatureMatrix = ndarray::Array2<f32>;
 mod decode;
 mod encode;
 mod error;
+mod fill;
 pub mod heading;
 mod layout;
 mod reference;
