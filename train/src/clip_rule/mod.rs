@@ -69,15 +69,14 @@ pub const MANY_FEET_WINDOW: usize = 7;
 /// Channels of a varied clip on [`MANY_FEET`] feet or more (never fewer than the
 /// configuration's).
 pub const MANY_FEET_CHANNELS: usize = 96;
-/// Dropout of a varied clip on [`MANY_FEET`] feet or more (chosen on clips at the default's
-/// 30 fps, and trained at any rate): at the configuration's 0.2 a dog that walks, stands and runs
-/// keeps too little global diversity (1.185), and more costs a dog's walk coverage (95.7 at 0.3,
-/// 94.4 at its own 60 fps with 0.25, 92.5 with 0.3; docs/TRAINING_EXPERIMENTS.md, "The default's
-/// frame rate, and a dog's dropout").
+/// Dropout of a varied clip on [`MANY_FEET`] feet or more, at any frame rate: the
+/// configuration's 0.2 leaves a dog that walks, stands and runs too little diversity, and more
+/// than 0.3 costs a walking dog coverage (docs/TRAINING_EXPERIMENTS.md, "The default's frame
+/// rate, and a dog's dropout").
 pub const MANY_FEET_DROPOUT: f64 = 0.3;
 /// Steps of a varied clip on [`MANY_FEET`] feet or more whose channels the rule widened (at most
-/// the configuration's): a step of 96 channels at window 7 costs about 0.04 s on 2 cores, so the
-/// run takes what 17 000 steps of 64 channels at window 11 took (8.5-9 minutes).
+/// the configuration's): the wider network's run takes the time the default's takes
+/// (docs/TRAINING_EXPERIMENTS.md, "A wider network for four feet").
 pub const MANY_FEET_STEPS: u64 = 13_000;
 
 /// What the rule chose for one clip, and why.
