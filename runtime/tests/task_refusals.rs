@@ -1,34 +1,14 @@
 //! Requests, clips and model files the tasks refuse, through real onnxruntime on the small
 //! trained model (tests/data/models/walk_tiny.onnx): each error names what is wrong.
 
-use std::path::PathBuf;
-
-use ndarray::{Array2, s};
 use sinmdm::bvh::read_bvh;
 use sinmdm::motion::encode_for;
 use sinmdm::tasks::{self, Request, Span, Task, TaskError};
 use sinmdm::{Method, Model, ModelError, ModelOptions};
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+mod common;
 
-fn model() -> Model {
-    Model::open(
-        std::env::var("SINMDM_TEST_MODEL")
-            .map(PathBuf::from)
-            .unwrap_or(root().join("tests/data/models/walk_tiny.onnx")),
-        &ModelOptions { threads: Some(1) },
-    )
-    .expect("the test model opens (run scripts/setup.sh first)")
-}
-
-/// The walk in the model's layout, raw, cut to `frames`.
-fn walk(model: &Model, frames: usize) -> Array2<f32> {
-    let clip = read_bvh(root().join("tests/data/bvh/human_walk_cmu_131_01.bvh")).unwrap();
-    let all = encode_for(&clip, &model.metadata().layout).unwrap();
-    all.slice(s![.., ..frames]).to_owned()
-}
+use common::{tiny_model as model, walk_features as walk, workspace as root};
 
 fn plan_error(task: Task, count: usize, steps: Option<usize>) -> TaskError {
     let m = model();

@@ -2,35 +2,16 @@
 //! configs/tiny.yaml on the CMU walk): what the mask keeps, crowds, harmonization, dance. The
 //! requests they refuse are in task_refusals.rs.
 
-use std::path::PathBuf;
-
-use ndarray::{Array2, Array3, Axis, s};
+use ndarray::{Array2, Array3, Axis};
 use sinmdm::bvh::read_bvh;
 use sinmdm::diffusion::sampler::low_pass;
 use sinmdm::motion::encode_for;
 use sinmdm::tasks::{self, Generated, Request, Span, Task};
-use sinmdm::{Method, Model, ModelOptions};
+use sinmdm::{Method, Model};
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+mod common;
 
-fn model() -> Model {
-    Model::open(
-        std::env::var("SINMDM_TEST_MODEL")
-            .map(PathBuf::from)
-            .unwrap_or(root().join("tests/data/models/walk_tiny.onnx")),
-        &ModelOptions { threads: Some(1) },
-    )
-    .expect("the test model opens (run scripts/setup.sh first)")
-}
-
-/// The walk in the model's layout, raw, cut to `frames`.
-fn walk(model: &Model, frames: usize) -> Array2<f32> {
-    let clip = read_bvh(root().join("tests/data/bvh/human_walk_cmu_131_01.bvh")).unwrap();
-    let all = encode_for(&clip, &model.metadata().layout).unwrap();
-    all.slice(s![.., ..frames]).to_owned()
-}
+use common::{tiny_model as model, walk_features as walk, workspace as root};
 
 fn run(model: &mut Model, task: Task, count: usize, steps: usize) -> Generated {
     run_with(model, task, count, steps, Method::Ancestral)

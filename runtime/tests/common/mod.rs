@@ -1,4 +1,4 @@
-//! Shared helpers for the integration tests: where the clips are.
+//! Shared helpers for the integration tests: where the clips are, and the small trained model.
 
 #![allow(dead_code)]
 
@@ -72,4 +72,24 @@ pub fn max_position_error(a: &[GlobalPose], b: &[GlobalPose]) -> f64 {
         })
         .map(|(p, q)| (p - q).norm())
         .fold(0.0, f64::max)
+}
+
+/// The small trained model (tests/data/models/walk_tiny.onnx, or `SINMDM_TEST_MODEL`) on one
+/// thread.
+pub fn tiny_model() -> sinmdm::Model {
+    sinmdm::Model::open(
+        std::env::var("SINMDM_TEST_MODEL")
+            .map(PathBuf::from)
+            .unwrap_or(workspace().join("tests/data/models/walk_tiny.onnx")),
+        &sinmdm::ModelOptions { threads: Some(1) },
+    )
+    .expect("the test model opens (run scripts/setup.sh first)")
+}
+
+/// The CMU walk in `model`'s layout, raw, cut to `frames`.
+pub fn walk_features(model: &sinmdm::Model, frames: usize) -> ndarray::Array2<f32> {
+    let clip = sinmdm::bvh::read_bvh(workspace().join("tests/data/bvh/human_walk_cmu_131_01.bvh"))
+        .unwrap();
+    let all = sinmdm::motion::encode_for(&clip, &model.metadata().layout).unwrap();
+    all.slice(ndarray::s![.., ..frames]).to_owned()
 }

@@ -138,7 +138,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
     let local = to_canonical(&resample(&file_local, fps), up);
     let joints = skeleton.len();
 
-    let rest_translations = rest_translations(clip, canonical_from_file);
+    let rest_translations = rest_translations(clip, &starts, canonical_from_file);
     let frame = container_frame(skeleton, root_joint, &local);
     let root = root_features(skeleton, root_joint, canonical_from_file, frame, &local);
     let rotation_joints: Vec<usize> = (0..joints)
@@ -217,9 +217,8 @@ fn checked_fps(clip: &ChannelClip, options: &EncodeOptions) -> Result<f64, Motio
 
 /// Each joint's translation in the clip's first frame: its offset, with the position channels
 /// it has; a top joint's turned to the canonical frame.
-fn rest_translations(clip: &ChannelClip, canonical_from_file: Mat3) -> Vec<Vec3> {
+fn rest_translations(clip: &ChannelClip, starts: &[usize], canonical_from_file: Mat3) -> Vec<Vec3> {
     let skeleton = &clip.skeleton;
-    let starts = skeleton.channel_starts();
     let first = clip.frame(0);
     skeleton
         .joints
