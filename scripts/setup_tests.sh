@@ -6,6 +6,8 @@
 #  - a project-local .venv with the pinned onnxruntime the tests compare bits with, the Python
 #    reference (python/, editable) and the independent readers (scripts/requirements.txt);
 #  - the node packages of tests/node (the Khronos glTF validator, three.js);
+#  - PyPI's bpy (Blender 4.5 as a Python module) in its own .venv-blender, as Blender's own
+#    Python: the add-on's test (blender/) runs it headless, with nothing else installed there;
 #  - a release build of the whole workspace, the trainer included.
 # Safe to run again: it installs only what is missing or changed.
 set -euo pipefail
@@ -61,6 +63,27 @@ echo "setup: the tests' onnxruntime library at $lib"
 if ! .venv/bin/python -c "import sinmdm_reference" 2>/dev/null; then
   echo "setup: installing the Python reference (python/) in editable mode"
   .venv/bin/python -m pip install --quiet --disable-pip-version-check --no-deps -e python
+fi
+
+# bpy 4.5 is built for CPython 3.11 only; the add-on's test runs in this venv, apart from .venv
+# (whose numpy and onnxruntime pins are the runtime's, not Blender's).
+bpy_pin="bpy==4.5.15"
+if [ "$(.venv-blender/bin/python -c 'import importlib.metadata as m; print(m.version("bpy"))' 2>/dev/null)" != "${bpy_pin#bpy==}" ]; then
+  blender_python=""
+  for candidate in "$python" python3.11; do
+    if command -v "$candidate" >/dev/null && [ "$("$candidate" -c 'import sys; print(sys.version_info[:2] == (3, 11))')" = True ]; then
+      blender_python=$candidate
+      break
+    fi
+  done
+  if [ -z "$blender_python" ]; then
+    echo "setup: the Blender add-on's test needs Python 3.11 (PyPI's bpy 4.5 is built for it); set PYTHON to one" >&2
+    exit 1
+  fi
+  echo "setup: installing $bpy_pin into .venv-blender (the Blender add-on's test runs Blender headless)"
+  rm -rf .venv-blender
+  "$blender_python" -m venv .venv-blender
+  .venv-blender/bin/python -m pip install --quiet --disable-pip-version-check "$bpy_pin"
 fi
 
 if command -v npm >/dev/null; then
