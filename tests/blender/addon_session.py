@@ -6,7 +6,7 @@ buttons through their operators (Learn, Generate, In-between, Start Learn + Canc
 and writes what it saw to OUT/report.json and OUT/heads.npz (every generated key's bone heads in
 world space), for the test to compare with `sinmdm generate` read by an independent BVH reader.
 
-Run: python addon_session.py ROOT ADDON.zip RIG(glb|fbx) OUT
+Run: python addon_session.py ROOT ADDON.zip RIG(glb|fbx|bvh) OUT
 """
 
 import json
@@ -49,6 +49,8 @@ def import_rig():
     """The rig, on an Empty parent that scales and turns it (world space is not the armature's)."""
     if RIG == "glb":
         bpy.ops.import_scene.gltf(filepath=str(ROOT / "tests/data/gltf/human_walk_cmu_131_01_skinned.glb"))
+    elif RIG == "bvh":  # Blender's BVH importer: Euler bones in the file's channel order
+        bpy.ops.import_anim.bvh(filepath=str(ROOT / "tests/data/gltf/human_walk_cmu_131_01_2s.bvh"), rotate_mode="NATIVE")
     else:
         import gzip
 
@@ -178,7 +180,7 @@ def main():
     report["model"] = bpy.path.abspath(arm["sinmdm_model"])
 
     # Rotation modes the user chose are kept: a few bones in Euler and axis-angle.
-    modes = ["XYZ", "ZXY", "AXIS_ANGLE", "YZX"]
+    modes = ["XYZ", "QUATERNION", "AXIS_ANGLE", "YZX"]
     for i, pb in enumerate(list(arm.pose.bones)[1:9]):
         pb.rotation_mode = modes[i % len(modes)]
     report["modes"] = {pb.name: pb.rotation_mode for pb in arm.pose.bones}
