@@ -164,6 +164,24 @@ def other_tasks(arm, source, settings, names):
     return out
 
 
+def inbetween_keeps(source, after, before):
+    """Presses In-between and compares the new action's keys outside (after, before) with the
+    source's: counts, and whether every one (frame, value, handles) is the same."""
+    made = made_by(bpy.ops.sinmdm.inbetween)
+    a, b = after + 0.5, before - 0.5  # the add-on's GAP_MARGIN
+    src_keys, new_keys = keys_of(source), keys_of(made)
+    kept_equal, kept_count, inside_changed = True, 0, 0
+    for key, points in src_keys.items():
+        outside = [p for p in points if not a < p[0] < b]
+        got = [p for p in new_keys.get(key, []) if not a < p[0] < b]
+        kept_count += len(outside)
+        if outside != got and "first_difference" not in report:
+            report["first_difference"] = [key, [p[:2] for p in outside[:3]], [p[:2] for p in got[:3]]]
+        kept_equal &= outside == got
+        inside_changed += sum(1 for p in new_keys.get(key, []) if a < p[0] < b and p not in points)
+    return {"kept_keys": kept_count, "kept_equal": kept_equal, "new_inside": inside_changed}
+
+
 def main():
     enable()
     arm = import_rig()
@@ -204,28 +222,18 @@ def main():
         report[f"curves_{i}"] = sorted({fc.data_path.split(".")[-1] for fc in action.fcurves})
     np.savez(OUT / "heads.npz", **heads)
 
-    # In-between: the keys outside the preview range stay exactly as they were.
+    # In-between: the keys outside the gap stay exactly as they were; the gap is the preview
+    # range, then two markers.
     scene = bpy.context.scene
     first, last = (int(round(f)) for f in source.frame_range)
+    settings.count = 1
     scene.use_preview_range = True
     scene.frame_preview_start, scene.frame_preview_end = first + 8, last - 8
-    settings.count = 1
-    before = set(bpy.data.actions)
-    assert bpy.ops.sinmdm.inbetween() == {"FINISHED"}
-    (between,) = [a for a in bpy.data.actions if a not in before]
-    a, b = scene.frame_preview_start + 0.5, scene.frame_preview_end - 0.5  # the add-on's GAP_MARGIN
-    src_keys, new_keys = keys_of(source), keys_of(between)
-    kept_equal, kept_count, inside_changed = True, 0, 0
-    for key, points in src_keys.items():
-        outside = [p for p in points if not a < p[0] < b]
-        got = [p for p in new_keys.get(key, []) if not a < p[0] < b]
-        kept_count += len(outside)
-        if outside != got and "first_difference" not in report:
-            report["first_difference"] = [key, [p[:2] for p in outside[:3]], [p[:2] for p in got[:3]]]
-        kept_equal &= outside == got
-        inside_changed += sum(1 for p in new_keys.get(key, []) if a < p[0] < b and p not in points)
-    report["inbetween"] = {"kept_keys": kept_count, "kept_equal": kept_equal, "new_inside": inside_changed}
+    report["inbetween"] = inbetween_keeps(source, first + 8, last - 8)
     scene.use_preview_range = False
+    scene.timeline_markers.new("from", frame=first + 5)
+    scene.timeline_markers.new("to", frame=last - 12)
+    report["inbetween_markers"] = inbetween_keeps(source, first + 5, last - 12)
 
     report["more"] = other_tasks(arm, source, settings, names)
 
@@ -249,8 +257,16 @@ def main():
         "model_after_cancel": (run.parent / "model.onnx").exists(),
         "message": scene.sinmdm.message,
     }
-    assert bpy.ops.sinmdm.learn() == {"FINISHED"}
+    # Learn again the way the panel runs it: started, then the timer until the job is applied.
+    from sinmdm_blender import operators
+
+    assert bpy.ops.sinmdm.start_learn() == {"FINISHED"}
+    seen = []
+    while operators._tick() is not None:
+        seen.append(scene.sinmdm.progress)
+        time.sleep(0.25)
     report["resume"] = {
+        "progress_seen": sorted(set(round(p, 3) for p in seen)),
         "lines": [line for line in jobs.last().lines if "from step" in line],
         "model": (run.parent / "model.onnx").exists(),
         "message": scene.sinmdm.message,

@@ -84,9 +84,11 @@ def test_every_generated_bone_head_is_where_sinmdm_generate_puts_it(session, tmp
         assert np.allclose(steps, steps[0], atol=1e-3)
 
 
-def test_inbetween_keeps_the_kept_keys_exactly(session):
+@pytest.mark.parametrize("gap", ["inbetween", "inbetween_markers"])
+def test_inbetween_keeps_the_kept_keys_exactly(session, gap):
+    """The gap from the preview range, then from two markers."""
     _, report = session
-    between = report["inbetween"]
+    between = report[gap]
     assert between["kept_keys"] > 100 and between["new_inside"] > 100
     assert between["kept_equal"], f"a kept key changed: {report.get('first_difference')}"
 
@@ -99,6 +101,9 @@ def test_cancel_during_learn_leaves_a_run_that_learn_resumes(session):
     last = int(cancel["checkpoints"][-1].split("-")[1])
     assert any(f"from step {last} of 400" in line for line in resume["lines"]), resume["lines"]
     assert resume["model"] and "resumed" in resume["message"]
+    # The panel's progress bar moved with the trainer's step lines while the job ran.
+    moving = [p for p in resume["progress_seen"] if 0.0 < p < 1.0]
+    assert len(moving) >= 3 and moving == sorted(moving), resume["progress_seen"]
 
 
 def test_the_picture_shows_three_poses(session):
