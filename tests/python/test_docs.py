@@ -8,7 +8,7 @@ import re
 
 from conftest import ROOT
 
-SKIP_DIRS = {".git", "target", ".venv", "node_modules", "out", "__pycache__"}
+SKIP_DIRS = {".git", "target", ".venv", ".venv-blender", "node_modules", "out", "__pycache__"}
 SOURCE_SUFFIXES = {".rs", ".py", ".sh", ".md", ".yaml", ".toml", ".cs", ".c", ".h", ".mjs"}
 CITATION = re.compile(r"SPEC\s*(?:§|section\s+)(\d+)")
 
