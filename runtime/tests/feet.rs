@@ -3,10 +3,12 @@
 //! its exact length; frames a task kept are bit for bit the input's; and on a real model, the
 //! frames an in-between keeps are the network's raw motion after planting.
 
+mod common;
+
 use std::ops::ControlFlow;
-use std::path::PathBuf;
 
 use ndarray::s;
+use sinmdm::Feet;
 use sinmdm::bvh::read_bvh;
 use sinmdm::motion::feet::{Kept, PlantOptions, plant_feet};
 use sinmdm::motion::math::{self, Mat3, Vec3, axis_rotation};
@@ -15,7 +17,6 @@ use sinmdm::motion::{
     global_poses,
 };
 use sinmdm::tasks::{Request, Span, Task};
-use sinmdm::{Feet, Model, ModelOptions};
 
 const FRAMES: usize = 40;
 /// The labelled contact span.
@@ -304,12 +305,8 @@ fn labels_of_the_wrong_shape_are_refused() {
 
 #[test]
 fn an_inbetween_keeps_its_frames_after_planting() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let mut model = Model::open(
-        root.join("tests/data/models/walk_tiny.onnx"),
-        &ModelOptions { threads: Some(1) },
-    )
-    .unwrap();
+    let root = common::workspace();
+    let mut model = common::tiny_model();
     let clip = read_bvh(root.join("tests/data/bvh/human_walk_cmu_131_01.bvh")).unwrap();
     let reference = encode_for(&clip, &model.metadata().layout)
         .unwrap()

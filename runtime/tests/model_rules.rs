@@ -2,6 +2,8 @@
 //! model's metadata per rule: each is refused with a message that names the field and value.
 //! And every shipped model follows them all.
 
+mod common;
+
 use std::path::PathBuf;
 
 use sinmdm::model_file::{ModelMetadata, problems};
@@ -13,13 +15,7 @@ fn root() -> PathBuf {
 }
 
 fn walk() -> ModelMetadata {
-    Model::open(
-        root().join("tests/data/models/walk_tiny.onnx"),
-        &ModelOptions { threads: Some(1) },
-    )
-    .expect("run scripts/setup.sh first")
-    .metadata()
-    .clone()
+    common::tiny_model().metadata().clone()
 }
 
 /// The problems of the walk's metadata after `breaking` it; asserts one of them contains every

@@ -1,18 +1,17 @@
 //! The sampler as a stepper, tasks over any denoiser, and cancelling a run: through the real
 //! model where a network is needed, through small denoisers with known answers otherwise.
 
+mod common;
+
 use std::convert::Infallible;
 use std::ops::ControlFlow;
-use std::path::PathBuf;
 
 use ndarray::{Array2, Array3, ArrayView3};
 use sinmdm::diffusion::{Guidance, Inpainting, Sampler, Schedule};
-use sinmdm::{Denoiser, Model, ModelOptions, Request, Task, TaskError};
+use sinmdm::{Denoiser, Model, Request, Task, TaskError};
 
 fn model() -> Model {
-    let path =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/data/models/walk_tiny.onnx");
-    Model::open(path, &ModelOptions { threads: Some(1) }).expect("run scripts/setup.sh first")
+    common::tiny_model()
 }
 
 fn request(task: Task, count: usize) -> Request {

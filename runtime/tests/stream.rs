@@ -2,15 +2,13 @@
 //! for, the root's travel carries on across seams, planted and raw streams share their
 //! features, and poses supplied for composition are followed.
 
+mod common;
+
 use sinmdm::motion::fk::global_poses;
-use sinmdm::{Feet, Model, ModelOptions, Stream, StreamCompose, StreamOptions};
+use sinmdm::{Feet, Model, Stream, StreamCompose, StreamOptions};
 
 fn model() -> Model {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../tests/data/models/walk_tiny.onnx"
-    );
-    Model::open(path, &ModelOptions { threads: Some(1) }).unwrap()
+    common::tiny_model()
 }
 
 fn options(feet: Feet) -> StreamOptions {
