@@ -74,7 +74,8 @@ def _has_checkpoint(run):
 
 
 def write_clip(context, obj, action, path):
-    """Samples the action into a world-space BVH at `path`; returns (rig, first frame, text)."""
+    """Samples the action into a world-space BVH for `path` (its folder is made; the caller
+    writes the text); returns (rig, first frame, text)."""
     scene = context.scene
     settings = scene.sinmdm
     rig = Rig(obj)
@@ -167,7 +168,7 @@ def sampling_job(context, task):
     scene = context.scene
     settings = scene.sinmdm
     obj, action = source(context)
-    rig = Rig(obj)
+    Rig(obj)  # a rig the add-on cannot use is refused before anything runs
     model = model_of(obj)
     sinmdm = preferences.find_binary("sinmdm")
     if sinmdm is None:
@@ -223,7 +224,6 @@ def sampling_job(context, task):
         made = apply_outputs(Rig(target), _outputs(output, count), source_name, task, seed, place, fps)
         return "INFO", f"{task}: {len(made)} new action(s) on '{obj_name}': {', '.join(a.name for a in made)}"
 
-    del rig
     return jobs.Job(task.capitalize(), argv, finish)
 
 
