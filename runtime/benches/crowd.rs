@@ -1,0 +1,158 @@
+//! Characters per core with today's streams: N steered walks, each its own [`Stream`] on one
+//! shared model run on one thread, advanced as a game advances them, one model frame at a time:
+//! each frame every character prepares ahead within a step budget, then takes its frame.
+//! Characters join at staggered block phases (their first frames are pulled before the clock
+//! starts), as characters of a game do, so their blocks do not all start on one frame.
+//!
+//! Prints, for each crowd size: CPU time of this thread per character-second of motion (and the
+//! characters one core animates in real time at the model's frame rate), the worst frame's wait
+//! for the whole crowd and per character, and the memory the crowd's streams hold per
+//! character. Linux: CPU time from /proc/thread-self/schedstat, memory from /proc/self/status.
+//!
+//! `cargo bench -p sinmdm --bench crowd [-- MODEL.onnx]` (default: the shipped walk).
+//! `SINMDM_CROWD_SIZES=1,8,64,512` and `SINMDM_CROWD_SECONDS=20` (motion per character) change
+//! the run; `SINMDM_CROWD_BUDGET=4` is the steps a character may spend preparing per frame.
+
+use std::time::Instant;
+
+use sinmdm::steer::SteerFrame;
+use sinmdm::{Feet, Model, ModelOptions, Stream, StreamOptions};
+
+fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// Nanoseconds this thread has run on a CPU (wall time where /proc says nothing).
+fn thread_cpu_ns(start: Instant) -> u128 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse().ok())
+        .unwrap_or_else(|| start.elapsed().as_nanos())
+}
+
+/// The resident memory of the process in bytes (0 where /proc says nothing).
+fn resident_bytes() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmRSS:"))?
+                .split_whitespace()
+                .nth(1)?
+                .parse::<u64>()
+                .ok()
+        })
+        .map_or(0, |kb| kb * 1024)
+}
+
+/// Character `i`'s commands: walk at the clip's pace, turning left or right by its index.
+fn commands(i: usize, frames: usize, fps: f64) -> Vec<SteerFrame> {
+    let turn = (i as f64 % 7.0 - 3.0) * 0.1;
+    (0..frames)
+        .map(|f| SteerFrame::Velocity {
+            forward: 12.0,
+            turn: turn * (f as f64 / fps).sin().signum(),
+        })
+        .collect()
+}
+
+struct Figures {
+    cpu_ms_per_character_second: f64,
+    worst_frame_ms: f64,
+    worst_character_ms: f64,
+    bytes_per_character: f64,
+}
+
+fn crowd(model: &mut Model, size: usize, seconds: f64, budget: usize) -> Figures {
+    let fps = model.metadata().layout.fps;
+    let frames = (seconds * fps).round() as usize;
+    let before = resident_bytes();
+    let mut streams: Vec<Stream> = (0..size)
+        .map(|i| {
+            let options = StreamOptions {
+                seed: i as u64,
+                feet: Feet::Planted,
+                ..StreamOptions::default()
+            };
+            let mut stream = Stream::new(model.metadata(), options).expect("stream");
+            let block = stream.sizes().block;
+            let join = i * block / size.max(1);
+            stream
+                .steer(&commands(
+                    i,
+                    join + frames + stream.lookahead() + block,
+                    fps,
+                ))
+                .expect("steer");
+            stream.next(model, join + 1).expect("join");
+            stream
+        })
+        .collect();
+    let held = resident_bytes().saturating_sub(before) as f64 / size as f64;
+    let ahead = streams[0].sizes().block / 4;
+    let clock = Instant::now();
+    let cpu = thread_cpu_ns(clock);
+    let (mut worst_frame, mut worst_character) = (0f64, 0f64);
+    for _ in 0..frames {
+        let frame = Instant::now();
+        for stream in &mut streams {
+            let one = Instant::now();
+            stream.prepare(model, budget, ahead).expect("prepare");
+            stream.next(model, 1).expect("next");
+            worst_character = worst_character.max(one.elapsed().as_secs_f64());
+        }
+        worst_frame = worst_frame.max(frame.elapsed().as_secs_f64());
+    }
+    let cpu_s = (thread_cpu_ns(clock) - cpu) as f64 / 1e9;
+    Figures {
+        cpu_ms_per_character_second: 1e3 * cpu_s / (size as f64 * seconds),
+        worst_frame_ms: 1e3 * worst_frame,
+        worst_character_ms: 1e3 * worst_character,
+        bytes_per_character: held,
+    }
+}
+
+fn main() {
+    let path = std::env::args()
+        .skip(1)
+        .find(|a| a.ends_with(".onnx"))
+        .unwrap_or_else(|| {
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../onnx-models/human_walk_cmu.onnx"
+            )
+            .into()
+        });
+    let sizes: Vec<usize> = std::env::var("SINMDM_CROWD_SIZES")
+        .unwrap_or_else(|_| "1,8,64,512".into())
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect();
+    let seconds: f64 = env_or("SINMDM_CROWD_SECONDS", 20.0);
+    let budget: usize = env_or("SINMDM_CROWD_BUDGET", 4);
+    let mut model = Model::open(&path, &ModelOptions { threads: Some(1) }).expect("model");
+    let fps = model.metadata().layout.fps;
+    println!(
+        "{path}: {seconds} s of steered walk per character at {fps} fps, one thread, \
+         prepare budget {budget} steps per character per frame"
+    );
+    println!(
+        "| characters | CPU ms per character-second | characters per core at {fps} fps | \
+         worst frame, whole crowd (ms) | worst frame, one character (ms) | memory per character (KiB) |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for size in sizes {
+        let f = crowd(&mut model, size, seconds, budget);
+        println!(
+            "| {size} | {:.2} | {:.0} | {:.1} | {:.1} | {:.0} |",
+            f.cpu_ms_per_character_second,
+            1e3 / f.cpu_ms_per_character_second,
+            f.worst_frame_ms,
+            f.worst_character_ms,
+            f.bytes_per_character / 1024.0
+        );
+    }
+}
