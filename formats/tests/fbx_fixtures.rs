@@ -29,7 +29,7 @@ fn blender_fbx_files_put_every_joint_where_the_bvh_does() {
 
 #[test]
 fn a_mixamo_style_file_reads_as_its_bvh_in_metres() {
-    // Written by scripts/lab/make_mixamo_style_fbx.py from the cut walk: ASCII, a 'mixamorig:'
+    // Written by lab/scripts/make_mixamo_style_fbx.py from the cut walk: ASCII, a 'mixamorig:'
     // namespace, centimetres (5.64 cm to the BVH unit), rest orientations in PreRotation, some
     // PostRotations, '_End' leaf bones.
     let file = root().join("tests/data/fbx/human_walk_cmu_131_01_mixamo_style.fbx");

@@ -1,5 +1,5 @@
 //! The walk retargeted onto characters Blender made from the walk's own rig (see
-//! `scripts/lab/make_retarget_fixtures.py`): one with other proportions, an A pose and rolled
+//! `lab/scripts/make_retarget_fixtures.py`): one with other proportions, an A pose and rolled
 //! bones under the same names, one with Unreal mannequin names as well. Played back, every
 //! paired bone points where its joint points, the hips keep the hip-height ratio above the
 //! ground, and the feet skate no more than the clip's.

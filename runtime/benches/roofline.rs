@@ -14,7 +14,7 @@
 //!
 //! `cargo bench -p sinmdm --bench roofline -- [MODEL.onnx] [FRAMES] [ROUNDS] [loop|stream|crowd]`
 //! (default: the shipped walk, 498 frames, 5 rounds, all three parts). `scripts/bench_roofline.sh` runs it with the GEMM
-//! roofline and the whole-process crowd of `scripts/lab/profile_network.py`.
+//! roofline and the whole-process crowd of `lab/scripts/profile_network.py`.
 
 use std::ops::ControlFlow;
 use std::time::Instant;

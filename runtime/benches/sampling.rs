@@ -2,7 +2,8 @@
 //! loop's overhead over bare onnxruntime calls, and peak memory.
 //!
 //! `cargo bench -p sinmdm --bench sampling -- MODEL.onnx [FRAMES] [THREADS]`; without a model it
-//! uses `SINMDM_BENCH_MODEL`. `scripts/lab/bench_runtime.sh` makes a paper-size (C 256) model first.
+//! uses `SINMDM_BENCH_MODEL`. `lab/scripts/bench_runtime.sh` makes a paper-size (C 256) model
+//! first.
 
 mod common;
 

@@ -1,7 +1,7 @@
 //! The training loss: the mean squared error of the predicted clean motion x0 (SPEC §4).
 //!
 //! Two further terms were tried and lost (an acceleration term on the prediction's error, and a
-//! foot-contact term holding predicted contact points still); docs/TRAINING_EXPERIMENTS.md has
+//! foot-contact term holding predicted contact points still); lab/EXPERIMENTS.md has
 //! their figures and names the commit that removed them.
 
 use burn::nn::loss::{MseLoss, Reduction};

@@ -1,6 +1,6 @@
 //! An exponential moving average of the weights, kept beside the trained ones and exported
 //! instead of them: the average of the last few thousand steps denoises more smoothly than any
-//! single step's weights (see `docs/TRAINING_EXPERIMENTS.md`).
+//! single step's weights (see `lab/EXPERIMENTS.md`).
 
 use burn::module::{Module, ModuleMapper, ModuleVisitor, Param};
 use burn::tensor::{Tensor, TensorData};

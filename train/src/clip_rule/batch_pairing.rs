@@ -8,7 +8,7 @@ use crate::config::TrainConfig;
 /// an even one: a multiple of this. The trainer shares a step's items among the cores, item by
 /// item, so an odd count leaves one of the two cores of the 10-minute goal's machine idle for
 /// part of every step: 3 items take as long as 4 (the rule's setting trained 13 000 steps of a
-/// dog of 409 frames in 13.2 minutes in 3 items, 7.2 in 2; docs/TRAINING_EXPERIMENTS.md, "Items
+/// dog of 409 frames in 13.2 minutes in 3 items, 7.2 in 2; lab/EXPERIMENTS.md, "Items
 /// in pairs"). A single copy is left alone: pairing it would double a step's frames, unmeasured.
 pub const BATCH_ITEMS_MULTIPLE: usize = 2;
 

@@ -2,7 +2,7 @@
 //! settings that no single value serves on every clip.
 //!
 //! One measure, taken before the first step, splits clips into two kinds that want opposite
-//! things (docs/TRAINING_EXPERIMENTS.md, "A default that reads the clip"):
+//! things (lab/EXPERIMENTS.md, "A default that reads the clip"):
 //! - a **calm** clip (its own intra diversity under [`CALM_INTRA_BELOW`]: a walk in one mood, a
 //!   kick, a dance phrase, an idle) is covered within a few hundred steps, and the longer it
 //!   trains the longer its samples replay it verbatim; how soon differs from clip to clip. Its
@@ -15,7 +15,7 @@
 //!   - on two feet or fewer, its samples shake more than the clip at the configuration's window:
 //!     it trains a wider window ([`VARIED_WINDOW`]) that smooths them, and keeps the
 //!     configuration's dropout: more damps its samples below the clip's speed
-//!     (docs/TRAINING_EXPERIMENTS.md, "The candidates one at a time");
+//!     (lab/EXPERIMENTS.md, "The candidates one at a time");
 //!   - on [`MANY_FEET`] feet or more (a dog, a horse, a fox), its samples at a window that serves
 //!     a biped keep too little of the clip (a fifth of a dog's one-second windows are never
 //!     made): the legs' phases must hold over a longer span, and the network needs the width to
@@ -32,7 +32,7 @@
 //! The measure is the benchmark's intra diversity ([`sinmdm_eval::intra_diversity`]): the mean
 //! distance, per frame, between two 15-frame windows of the clip's joint rotations and contact
 //! labels. The rule names no clip; its threshold and the varied clip's setting were chosen on the
-//! project's clips and judged on the ones each was not chosen on (`scripts/lab/leave_one_out.py`).
+//! project's clips and judged on the ones each was not chosen on (`lab/scripts/leave_one_out.py`).
 //!
 //! A configuration asks for the rule with its `from_clip` section; each part it names may be
 //! replaced by the rule, and a run saves the numbers it trained with, the section off.
@@ -71,12 +71,12 @@ pub const MANY_FEET_WINDOW: usize = 7;
 pub const MANY_FEET_CHANNELS: usize = 96;
 /// Dropout of a varied clip on [`MANY_FEET`] feet or more, at any frame rate: the
 /// configuration's 0.2 leaves a dog that walks, stands and runs too little diversity, and more
-/// than 0.3 costs a walking dog coverage (docs/TRAINING_EXPERIMENTS.md, "The default's frame
+/// than 0.3 costs a walking dog coverage (lab/EXPERIMENTS.md, "The default's frame
 /// rate, and a dog's dropout").
 pub const MANY_FEET_DROPOUT: f64 = 0.3;
 /// Steps of a varied clip on [`MANY_FEET`] feet or more whose channels the rule widened (at most
 /// the configuration's): the wider network's run takes the time the default's takes
-/// (docs/TRAINING_EXPERIMENTS.md, "A wider network for four feet").
+/// (lab/EXPERIMENTS.md, "A wider network for four feet").
 pub const MANY_FEET_STEPS: u64 = 13_000;
 
 /// What the rule chose for one clip, and why.

@@ -4,7 +4,7 @@
 //! it trains the longer its samples replay it verbatim. How few steps a calm clip can train and
 //! still be covered, and how many it can train before it replays, differ from clip to clip in
 //! ways one number read before training did not predict on clips it was not chosen on
-//! (docs/TRAINING_EXPERIMENTS.md, "The step ladder"). So the trainer measures instead: it trains
+//! (lab/EXPERIMENTS.md, "The step ladder"). So the trainer measures instead: it trains
 //! short runs of [`LADDER_STEPS`] steps (each its own run, warm-up a third; the most-trained
 //! first, and the rest only when it covers the clip), samples each as the benchmark does
 //! ([`CHECK_SAMPLES`] samples of twice the clip, seed [`CHECK_SEED`], through onnxruntime as a
