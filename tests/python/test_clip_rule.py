@@ -8,32 +8,50 @@ import subprocess
 
 import numpy as np
 import pytest
+import yaml
 
-from conftest import TRAIN, clips, encoded_clip
+from conftest import ROOT, TRAIN, clips, encoded_clip
 
-# The benchmark's window for the intra diversity, and the rule's numbers (clip_rule/,
-# step_ladder/).
+# The benchmark's window for the intra diversity; the rule's ladder of steps (step_ladder/).
 LOCAL_WINDOW = 15
-CALM_INTRA_BELOW = 0.7
 LADDER_STEPS = [50, 75, 100, 150, 200, 250, 300, 400, 600, 1000]
-VARIED_WINDOW = 5
-DEFAULT_DROPOUT = 0.2  # a varied clip on two feet keeps the configuration's
-MANY_FEET = 3
-MANY_FEET_WINDOW = 7
-MANY_FEET_CHANNELS = 96
-MANY_FEET_STEPS = 13000
-MANY_FEET_DROPOUT = 0.3
-DEFAULT_CHANNELS = 64
-DEFAULT_STEPS = 17000
-# A step's cost grows with the QnA window k as 10 + k; steps fitted to a wider window are rounded
-# down to 500 (WINDOW_STEP_COST_OFFSET, FITTED_STEPS_ROUNDING).
-WINDOW_STEP_COST_OFFSET = 10
-FITTED_STEPS_ROUNDING = 500
-# The default's frames a step and most items (configs/default.yaml); a varied clip's items come
-# in multiples of 2 (BATCH_ITEMS_MULTIPLE).
-FRAMES_PER_STEP = 1024
-BATCH_SIZE = 8
 
+
+def rust_constant(name):
+    """A number of the rule as train/src/clip_rule/ defines it (`pub const NAME: T = V;`), read
+    from the source so that it lives in one place."""
+    for path in sorted((ROOT / "train" / "src" / "clip_rule").glob("*.rs")):
+        found = re.search(rf"pub const {name}: \w+ = ([0-9_.]+);", path.read_text())
+        if found:
+            value = found.group(1).replace("_", "")
+            return float(value) if "." in value else int(value)
+    raise AssertionError(f"train/src/clip_rule/ defines no {name}")
+
+
+def default_config(section, key):
+    """A value of configs/default.yaml (read, not restated)."""
+    return yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())[section][key]
+
+
+CALM_INTRA_BELOW = rust_constant("CALM_INTRA_BELOW")
+VARIED_WINDOW = rust_constant("VARIED_WINDOW")
+MANY_FEET = rust_constant("MANY_FEET")
+MANY_FEET_WINDOW = rust_constant("MANY_FEET_WINDOW")
+MANY_FEET_CHANNELS = rust_constant("MANY_FEET_CHANNELS")
+MANY_FEET_STEPS = rust_constant("MANY_FEET_STEPS")
+MANY_FEET_DROPOUT = rust_constant("MANY_FEET_DROPOUT")
+# A step's cost grows with the QnA window k as OFFSET + k; steps fitted to a wider window are
+# rounded down to whole units.
+WINDOW_STEP_COST_OFFSET = rust_constant("WINDOW_STEP_COST_OFFSET")
+FITTED_STEPS_ROUNDING = rust_constant("FITTED_STEPS_ROUNDING")
+# The default's settings a varied clip on two feet keeps; its frames a step and most items; a
+# varied clip's items come in multiples of BATCH_ITEMS_MULTIPLE.
+DEFAULT_DROPOUT = default_config("model", "dropout")
+DEFAULT_CHANNELS = default_config("model", "channels")
+DEFAULT_STEPS = default_config("training", "steps")
+FRAMES_PER_STEP = default_config("training", "frames_per_step")
+BATCH_SIZE = default_config("training", "batch_size")
+assert rust_constant("BATCH_ITEMS_MULTIPLE") == 2, "items_of below pairs a varied clip's items in twos"
 
 def items_of(frames, paired):
     """The copies of a clip of `frames` frames in a step: round(1024 / frames) within 1..8, half

@@ -68,3 +68,20 @@ def test_every_relative_markdown_link_points_at_something_that_exists():
                 broken.append(f"{path.relative_to(ROOT)}: {target} (no such heading)")
     assert checked >= 30, checked
     assert not broken, "broken links:\n" + "\n".join(broken)
+
+
+def test_the_documents_state_the_rule_s_step_counts_as_the_code_has_them():
+    """The step counts the rule chooses live in the code (clip_rule's MANY_FEET_STEPS) and the
+    default configuration; the documents that explain the rule restate them for readers, so a
+    change there fails here until they say the new number."""
+    import yaml
+
+    source = "\n".join(p.read_text() for p in (ROOT / "train" / "src" / "clip_rule").glob("*.rs"))
+    many_feet = int(re.search(r"pub const MANY_FEET_STEPS: u64 = ([0-9_]+);", source).group(1).replace("_", ""))
+    default = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())["training"]["steps"]
+    spaced = lambda n: f"{n:,}".replace(",", " ")  # noqa: E731 (the documents' thousands)
+    for name in ("docs/GUIDE.md", "docs/SPEC.md", "configs/default.yaml"):
+        text = (ROOT / name).read_text()
+        for steps in (many_feet, default):
+            assert f"{spaced(steps)} steps" in text, f"{name} does not state {spaced(steps)} steps"
+    assert f"{spaced(many_feet)} steps" in (ROOT / "docs" / "ARCHITECTURE.md").read_text()

@@ -253,8 +253,9 @@ mod tests {
         assert!(MANY_FEET_STEPS < config.training.steps);
         assert_eq!(out.training.warmup_steps, config.training.warmup_steps);
         assert!(
-            choice.lines[1].contains("13000: the 96 channels below cost more a step")
-                && choice.lines[2].contains("on 4 feet")
+            choice.lines[1].contains(&format!(
+                "{MANY_FEET_STEPS}: the {MANY_FEET_CHANNELS} channels below cost more a step"
+            )) && choice.lines[2].contains("on 4 feet")
                 && choice.lines[3].starts_with("dropout         0.3: on 4 feet")
                 && choice.lines[4].starts_with("channels        96: on 4 feet"),
             "{:?}",

@@ -32,7 +32,9 @@ pub fn steps_at_window(steps: u64, at_30: usize, trained: usize) -> u64 {
 mod tests {
     use super::*;
     use crate::clip_rule::tests::{DEFAULT, reading};
-    use crate::clip_rule::{ClipReading, MANY_FEET_WINDOW, VARIED_WINDOW, calm_most_steps, choose};
+    use crate::clip_rule::{
+        ClipReading, MANY_FEET_STEPS, MANY_FEET_WINDOW, VARIED_WINDOW, calm_most_steps, choose,
+    };
     use crate::config::TrainConfig;
 
     #[test]
@@ -47,7 +49,11 @@ mod tests {
                 && chosen as f64 * window_step_cost(trained) <= budget
                 && (chosen + unit) as f64 * window_step_cost(trained) > budget
         };
-        for (feet, at_30, steps) in [(2, VARIED_WINDOW, 17_000), (4, MANY_FEET_WINDOW, 13_000)] {
+        let default_steps = config.training.steps;
+        for (feet, at_30, steps) in [
+            (2, VARIED_WINDOW, default_steps),
+            (4, MANY_FEET_WINDOW, MANY_FEET_STEPS),
+        ] {
             let at_60 = ClipReading {
                 frames: 1054,
                 fps: 60.0,

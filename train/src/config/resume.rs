@@ -83,6 +83,7 @@ fn first_difference(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::clip_rule::{MANY_FEET_CHANNELS, MANY_FEET_STEPS, MANY_FEET_WINDOW};
 
     /// The default, and what a new run with it on a varied clip of `frames` frames on four feet
     /// at 30 fps saved: the rule's choices, and the root layout auto chose.
@@ -112,7 +113,7 @@ mod tests {
                 saved.model.window,
                 saved.training.steps
             ),
-            (96, 7, 13_000)
+            (MANY_FEET_CHANNELS, MANY_FEET_WINDOW, MANY_FEET_STEPS)
         );
         let asked = default.for_resume(&saved, 30.0);
         assert_eq!(saved.resume_difference(&asked), None);
