@@ -22,5 +22,5 @@ part burn-import env CARGO_TARGET_DIR=target/burn-import-check \
 part compressed env CARGO_TARGET_DIR=target/compressed cargo test --release -p sinmdm-beats --features compressed
 # The Bevy plugin: its own workspace and lockfile (Bevy's crates stay out of the main build),
 # tested with its AnimationClip feature in its own target folder.
-part bevy env CARGO_TARGET_DIR=target/bevy cargo test --locked --manifest-path bindings/bevy/Cargo.toml --features animation-clip
+part bevy env CARGO_TARGET_DIR=target/bevy CARGO_INCREMENTAL=0 cargo test --locked --manifest-path bindings/bevy/Cargo.toml --features animation-clip
 part python .venv/bin/python -m pytest -q --durations=15 tests/python
