@@ -1,8 +1,9 @@
 //! Characters per core with today's streams: N steered walks, each its own [`Stream`] on one
 //! shared model run on one thread, advanced as a game advances them, one model frame at a time:
 //! each frame every character prepares ahead within a step budget, then takes its frame.
-//! Characters join at staggered block phases (their first frames are pulled before the clock
-//! starts), as characters of a game do, so their blocks do not all start on one frame.
+//! Characters join at staggered block phases (their first frames are pulled, and the next
+//! prepared, before the clock starts), as characters of a game do, so their blocks do not all
+//! start on one frame.
 //!
 //! Prints, for each crowd size: CPU time of this thread per character-second of motion (and the
 //! characters one core animates in real time at the model's frame rate), the worst frame's wait
@@ -11,7 +12,8 @@
 //!
 //! `cargo bench -p sinmdm --bench crowd [-- MODEL.onnx]` (default: the shipped walk).
 //! `SINMDM_CROWD_SIZES=1,8,64,512` and `SINMDM_CROWD_SECONDS=20` (motion per character) change
-//! the run; `SINMDM_CROWD_BUDGET=4` is the steps a character may spend preparing per frame.
+//! the run; `SINMDM_CROWD_BUDGET=4` is the steps a character may spend preparing per frame;
+//! `SINMDM_CROWD_FREE=1` leaves the characters unsteered.
 
 use std::time::Instant;
 
@@ -66,7 +68,7 @@ struct Figures {
     bytes_per_character: f64,
 }
 
-fn crowd(model: &mut Model, size: usize, seconds: f64, budget: usize) -> Figures {
+fn crowd(model: &mut Model, size: usize, seconds: f64, budget: usize, free: bool) -> Figures {
     let fps = model.metadata().layout.fps;
     let frames = (seconds * fps).round() as usize;
     let before = resident_bytes();
@@ -80,19 +82,26 @@ fn crowd(model: &mut Model, size: usize, seconds: f64, budget: usize) -> Figures
             let mut stream = Stream::new(model.metadata(), options).expect("stream");
             let block = stream.sizes().block;
             let join = i * block / size.max(1);
-            stream
-                .steer(&commands(
-                    i,
-                    join + frames + stream.lookahead() + block,
-                    fps,
-                ))
-                .expect("steer");
+            if !free {
+                stream
+                    .steer(&commands(
+                        i,
+                        join + frames + stream.lookahead() + block,
+                        fps,
+                    ))
+                    .expect("steer");
+            }
             stream.next(model, join + 1).expect("join");
             stream
         })
         .collect();
     let held = resident_bytes().saturating_sub(before) as f64 / size as f64;
+    // Every character starts the clock prepared as far ahead as the loop keeps it, so the
+    // worst frame is the loop's own, not the crowd's first frame.
     let ahead = streams[0].sizes().block / 4;
+    for stream in &mut streams {
+        stream.prepare(model, usize::MAX, ahead).expect("prepare");
+    }
     let clock = Instant::now();
     let cpu = thread_cpu_ns(clock);
     let (mut worst_frame, mut worst_character) = (0f64, 0f64);
@@ -133,11 +142,13 @@ fn main() {
         .collect();
     let seconds: f64 = env_or("SINMDM_CROWD_SECONDS", 20.0);
     let budget: usize = env_or("SINMDM_CROWD_BUDGET", 4);
+    let free = std::env::var("SINMDM_CROWD_FREE").is_ok_and(|v| v == "1");
     let mut model = Model::open(&path, &ModelOptions { threads: Some(1) }).expect("model");
     let fps = model.metadata().layout.fps;
     println!(
-        "{path}: {seconds} s of steered walk per character at {fps} fps, one thread, \
-         prepare budget {budget} steps per character per frame"
+        "{path}: {seconds} s of {} walk per character at {fps} fps, one thread, \
+         prepare budget {budget} steps per character per frame",
+        if free { "unsteered" } else { "steered" }
     );
     println!(
         "| characters | CPU ms per character-second | characters per core at {fps} fps | \
@@ -145,7 +156,7 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|");
     for size in sizes {
-        let f = crowd(&mut model, size, seconds, budget);
+        let f = crowd(&mut model, size, seconds, budget, free);
         println!(
             "| {size} | {:.2} | {:.0} | {:.1} | {:.1} | {:.0} |",
             f.cpu_ms_per_character_second,
