@@ -14,6 +14,7 @@ from .rig import Rig, RigError
 
 MODEL_KEY = "sinmdm_model"
 RUN_KEY = "sinmdm_run"
+ACTION_KEY = "sinmdm_action"
 
 
 def scene_fps(scene):
@@ -43,8 +44,9 @@ def _safe(name):
 
 
 def run_folder(obj, action):
-    """The folder of this armature's runs: beside a saved .blend, else in the preferences' folder."""
-    if RUN_KEY in obj and os.path.isdir(bpy.path.abspath(obj[RUN_KEY])):
+    """The folder of this armature's run on `action`: the one Learn last used for it, else a new
+    one beside a saved .blend, else in the preferences' folder."""
+    if obj.get(ACTION_KEY) == action.name and RUN_KEY in obj and os.path.isdir(bpy.path.abspath(obj[RUN_KEY])):
         return bpy.path.abspath(obj[RUN_KEY])
     if bpy.data.filepath:
         base = os.path.join(os.path.dirname(bpy.data.filepath), "sinmdm")
@@ -120,6 +122,7 @@ def learn_job(context):
         argv += ["--root-layout", settings.root_layout]
         resumed = False
     obj[RUN_KEY] = _stored_path(folder)
+    obj[ACTION_KEY] = action.name
     obj_name = obj.name
 
     def finish(job):
