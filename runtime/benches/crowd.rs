@@ -13,7 +13,8 @@
 //! `cargo bench -p sinmdm --bench crowd [-- MODEL.onnx]` (default: the shipped walk).
 //! `SINMDM_CROWD_SIZES=1,8,64,512` and `SINMDM_CROWD_SECONDS=20` (motion per character) change
 //! the run; `SINMDM_CROWD_BUDGET=4` is the steps a character may spend preparing per frame;
-//! `SINMDM_CROWD_FREE=1` leaves the characters unsteered.
+//! `SINMDM_CROWD_FREE=1` leaves the characters unsteered; `SINMDM_CROWD_CHUNK=30` reads 30
+//! frames a call (then a "frame" below is one such read).
 
 use std::time::Instant;
 
@@ -68,7 +69,14 @@ struct Figures {
     bytes_per_character: f64,
 }
 
-fn crowd(model: &mut Model, size: usize, seconds: f64, budget: usize, free: bool) -> Figures {
+fn crowd(
+    model: &mut Model,
+    size: usize,
+    seconds: f64,
+    budget: usize,
+    free: bool,
+    chunk: usize,
+) -> Figures {
     let fps = model.metadata().layout.fps;
     let frames = (seconds * fps).round() as usize;
     let before = resident_bytes();
@@ -105,12 +113,12 @@ fn crowd(model: &mut Model, size: usize, seconds: f64, budget: usize, free: bool
     let clock = Instant::now();
     let cpu = thread_cpu_ns(clock);
     let (mut worst_frame, mut worst_character) = (0f64, 0f64);
-    for _ in 0..frames {
+    for _ in 0..frames / chunk {
         let frame = Instant::now();
         for stream in &mut streams {
             let one = Instant::now();
             stream.prepare(model, budget, ahead).expect("prepare");
-            stream.next(model, 1).expect("next");
+            stream.next(model, chunk).expect("next");
             worst_character = worst_character.max(one.elapsed().as_secs_f64());
         }
         worst_frame = worst_frame.max(frame.elapsed().as_secs_f64());
@@ -143,6 +151,7 @@ fn main() {
     let seconds: f64 = env_or("SINMDM_CROWD_SECONDS", 20.0);
     let budget: usize = env_or("SINMDM_CROWD_BUDGET", 4);
     let free = std::env::var("SINMDM_CROWD_FREE").is_ok_and(|v| v == "1");
+    let chunk: usize = env_or("SINMDM_CROWD_CHUNK", 1usize).max(1);
     let mut model = Model::open(&path, &ModelOptions { threads: Some(1) }).expect("model");
     let fps = model.metadata().layout.fps;
     println!(
@@ -156,7 +165,7 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|");
     for size in sizes {
-        let f = crowd(&mut model, size, seconds, budget, free);
+        let f = crowd(&mut model, size, seconds, budget, free, chunk);
         println!(
             "| {size} | {:.2} | {:.0} | {:.1} | {:.1} | {:.0} |",
             f.cpu_ms_per_character_second,
