@@ -34,9 +34,9 @@ def _channels(rig, bone_index, basis):
     else:
         eulers, previous = [], None
         for m in basis:
-            e = Matrix(m[:3, :3].tolist()).to_euler(mode, previous) if previous else Matrix(m[:3, :3].tolist()).to_euler(mode)
-            previous = e
-            eulers.append(tuple(e))
+            # Each angle nearest the previous frame's, so keys do not jump by whole turns.
+            previous = Matrix(m[:3, :3].tolist()).to_euler(mode, *([previous] if previous else []))
+            eulers.append(tuple(previous))
         eulers = np.array(eulers)
         for i in range(3):
             out[(path + ".rotation_euler", i)] = eulers[:, i]

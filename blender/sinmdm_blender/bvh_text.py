@@ -54,8 +54,10 @@ def write(skeleton, root_positions, local_rotations, fps):
     names, parents = skeleton.names, skeleton.parents
     children = {j: [c for c, p in enumerate(parents) if p == j] for j in range(len(names))}
     lines = ["HIERARCHY"]
+    order = []  # the joints as the hierarchy lists them, which is the motion's channel order
 
     def joint(j, depth):
+        order.append(j)
         pad = "\t" * depth
         lines.append(f"{pad}{'ROOT' if parents[j] < 0 else 'JOINT'} {names[j]}")
         lines.append(pad + "{")
@@ -75,16 +77,7 @@ def write(skeleton, root_positions, local_rotations, fps):
             lines.append(pad + "\t}")
         lines.append(pad + "}")
 
-    order = []
-
-    def visit(j):
-        order.append(j)
-        for c in children[j]:
-            visit(c)
-
-    root = parents.index(-1)
-    joint(root, 0)
-    visit(root)
+    joint(parents.index(-1), 0)
     frames = np.asarray(root_positions).shape[0]
     angles = matrices_to_zyx_degrees(np.asarray(local_rotations))
     lines += ["MOTION", f"Frames: {frames}", f"Frame Time: {1.0 / fps:.8f}"]
@@ -93,7 +86,7 @@ def write(skeleton, root_positions, local_rotations, fps):
         for j in order:
             values += list(angles[f, j])
         lines.append(" ".join(f"{v:.6f}" for v in values))
-    return "\n".join(lines) + "\n", order
+    return "\n".join(lines) + "\n"
 
 
 def read(text):

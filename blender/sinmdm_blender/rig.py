@@ -60,11 +60,6 @@ class Rig:
         self.scale = float(scales.mean())
         self.world_rotation = world[:3, :3] / self.scale
 
-    def height(self):
-        """The rest skeleton's extent along the world's Z, for tolerances and messages."""
-        heads = self._world_points(self.rest[:, :3, 3])
-        return float(np.ptp(heads[:, 2])) or 1.0
-
     def _world_points(self, points):
         return points @ self.world[:3, :3].T + self.world[:3, 3]
 
@@ -108,8 +103,7 @@ class Rig:
             if p >= 0:
                 local[:, j] = np.swapaxes(delta[:, p], -1, -2) @ delta[:, j]
         root = self._world_points(pose[:, 0, :3, 3])
-        text, _ = bvh_text.write(self.skeleton(), root, local, fps)
-        return text
+        return bvh_text.write(self.skeleton(), root, local, fps)
 
     def bases_from_bvh(self, text):
         """(bone indices the clip drives, basis matrices F x K x 4 x 4, frame time) of a BVH text

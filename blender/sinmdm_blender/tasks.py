@@ -66,27 +66,21 @@ def _stored_path(path):
 
 
 def _has_checkpoint(run):
-    for _, _, files in os.walk(run):
-        if any(f.startswith("step-") for f in files):
-            return True
-    for _, dirs, _ in os.walk(run):
-        if any(d.startswith("step-") for d in dirs):
-            return True
-    return False
+    """Whether the trainer saved a checkpoint (a `step-*` file or folder) under `run`."""
+    return any(
+        name.startswith("step-") for _, dirs, files in os.walk(run) for name in dirs + files
+    )
 
 
-def write_clip(context, obj, action, path):
-    """Samples the action into a world-space BVH for `path` (its folder is made; the caller
-    writes the text); returns (rig, first frame, text)."""
+def clip_text(context, obj, action):
+    """The action sampled over its frame range (or the scene's) as world-space BVH text."""
     scene = context.scene
     settings = scene.sinmdm
     rig = Rig(obj)
     first, last = frame_range(scene, action, settings.use_scene_range)
     if last - first < 2:
         raise RigError(f"the frame range {first}..{last} is too short to learn from")
-    text = rig.to_bvh(rig.sample(scene, action, first, last), scene_fps(scene))
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    return rig, first, text
+    return rig.to_bvh(rig.sample(scene, action, first, last), scene_fps(scene))
 
 
 def learn_job(context):
@@ -98,7 +92,7 @@ def learn_job(context):
     clip = os.path.join(folder, "clip.bvh")
     run = os.path.join(folder, "run")
     model = os.path.join(folder, "model.onnx")
-    _, _, text = write_clip(context, obj, action, clip)
+    text = clip_text(context, obj, action)
     same_clip = os.path.isfile(clip) and open(clip, encoding="utf-8").read() == text
     train = preferences.find_binary("sinmdm-train")
     if train is None:
@@ -193,7 +187,7 @@ def sampling_job(context, task):
 
     def reference():
         ref = os.path.join(out_dir, "reference.bvh")
-        _, _, text = write_clip(context, obj, action, ref)
+        text = clip_text(context, obj, action)
         with open(ref, "w", encoding="utf-8") as f:
             f.write(text)
         return ["--reference", ref]
