@@ -18,6 +18,8 @@
 
 use std::time::Instant;
 
+mod common;
+
 use sinmdm::steer::SteerFrame;
 use sinmdm::{Feet, Model, ModelOptions, Stream, StreamOptions};
 
@@ -133,16 +135,7 @@ fn crowd(
 }
 
 fn main() {
-    let path = std::env::args()
-        .skip(1)
-        .find(|a| a.ends_with(".onnx"))
-        .unwrap_or_else(|| {
-            concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../onnx-models/human_walk_cmu.onnx"
-            )
-            .into()
-        });
+    let path = common::model_argument();
     let sizes: Vec<usize> = std::env::var("SINMDM_CROWD_SIZES")
         .unwrap_or_else(|_| "1,8,64,512".into())
         .split(',')

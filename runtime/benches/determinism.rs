@@ -93,14 +93,10 @@ fn main() {
         .skip(1)
         .filter(|a| !a.starts_with("--"))
         .collect();
-    let default_model = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../onnx-models/human_walk_cmu.onnx"
-    );
     let path = args
         .first()
         .cloned()
-        .unwrap_or_else(|| default_model.into());
+        .unwrap_or_else(|| common::SHIPPED_WALK.into());
     let frames: usize = args.get(1).map_or(498, |s| s.parse().expect("FRAMES"));
     let threads: usize = args.get(2).map_or(2, |s| s.parse().expect("THREADS"));
     let rounds: usize = std::env::var("SINMDM_BENCH_ROUNDS")

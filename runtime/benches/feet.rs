@@ -13,16 +13,7 @@ use common::median;
 use sinmdm::{Feet, Model, ModelOptions, Request, Task};
 
 fn main() {
-    let path = std::env::args()
-        .skip(1)
-        .find(|a| a.ends_with(".onnx"))
-        .unwrap_or_else(|| {
-            concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../onnx-models/human_walk_cmu.onnx"
-            )
-            .into()
-        });
+    let path = common::model_argument();
     let mut model = Model::open(&path, &ModelOptions::default()).expect("model");
     let frames = 2 * model.clip_frames();
     let request = Request {

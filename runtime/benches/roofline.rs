@@ -311,13 +311,7 @@ fn main() {
         .first()
         .filter(|p| !p.is_empty())
         .cloned()
-        .unwrap_or_else(|| {
-            concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../onnx-models/human_walk_cmu.onnx"
-            )
-            .to_string()
-        });
+        .unwrap_or_else(|| common::SHIPPED_WALK.to_string());
     let frames: usize = args.get(1).map_or(498, |s| s.parse().expect("FRAMES"));
     let rounds: usize = args.get(2).map_or(5, |s| s.parse().expect("ROUNDS"));
     let only = args.get(3).map(String::as_str);

@@ -1,6 +1,22 @@
-//! What the runtime's benchmarks share: a session opened as the runtime opens its own, the
-//! model with its time inside onnxruntime counted, and the median. Each bench uses some of it.
+//! What the runtime's benchmarks share: the model they run by default, a session opened as the
+//! runtime opens its own, the model with its time inside onnxruntime counted, and the median.
+//! Each bench uses some of it.
 #![allow(dead_code)]
+
+/// The shipped walk model, every bench's default.
+pub const SHIPPED_WALK: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../onnx-models/human_walk_cmu.onnx"
+);
+
+/// The first command-line argument that names an `.onnx` file (cargo bench passes flags of its
+/// own beside it), else [`SHIPPED_WALK`].
+pub fn model_argument() -> String {
+    std::env::args()
+        .skip(1)
+        .find(|a| a.ends_with(".onnx"))
+        .unwrap_or_else(|| SHIPPED_WALK.into())
+}
 
 use std::time::Instant;
 
