@@ -2,11 +2,13 @@
 
 import json
 import pathlib
+import re
 import subprocess
 
 import bvhio
 import numpy as np
 import pytest
+import yaml
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SINMDM = ROOT / "target" / "release" / "sinmdm"
@@ -36,6 +38,22 @@ def encoded_clip(clip, tmp_path, run_sinmdm, data_extra=""):
     features = tmp_path / "features.json"
     run_sinmdm("encode", clip, "-m", model, "-o", features)
     return json.loads(features.read_text())
+
+
+def rust_constant(name):
+    """A number of the clip rule as train/src/clip_rule/ defines it (`pub const NAME: T = V;`),
+    read from the source so that it lives in one place."""
+    for path in sorted((ROOT / "train" / "src" / "clip_rule").glob("*.rs")):
+        found = re.search(rf"pub const {name}: \w+ = ([0-9_.]+);", path.read_text())
+        if found:
+            value = found.group(1).replace("_", "")
+            return float(value) if "." in value else int(value)
+    raise AssertionError(f"train/src/clip_rule/ defines no {name}")
+
+
+def default_config(section, key):
+    """A value of configs/default.yaml (read, not restated)."""
+    return yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())[section][key]
 
 
 def clips():

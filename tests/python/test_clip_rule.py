@@ -8,29 +8,12 @@ import subprocess
 
 import numpy as np
 import pytest
-import yaml
 
-from conftest import ROOT, TRAIN, clips, encoded_clip
+from conftest import TRAIN, clips, default_config, encoded_clip, rust_constant
 
 # The benchmark's window for the intra diversity; the rule's ladder of steps (step_ladder/).
 LOCAL_WINDOW = 15
 LADDER_STEPS = [50, 75, 100, 150, 200, 250, 300, 400, 600, 1000]
-
-
-def rust_constant(name):
-    """A number of the rule as train/src/clip_rule/ defines it (`pub const NAME: T = V;`), read
-    from the source so that it lives in one place."""
-    for path in sorted((ROOT / "train" / "src" / "clip_rule").glob("*.rs")):
-        found = re.search(rf"pub const {name}: \w+ = ([0-9_.]+);", path.read_text())
-        if found:
-            value = found.group(1).replace("_", "")
-            return float(value) if "." in value else int(value)
-    raise AssertionError(f"train/src/clip_rule/ defines no {name}")
-
-
-def default_config(section, key):
-    """A value of configs/default.yaml (read, not restated)."""
-    return yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())[section][key]
 
 
 CALM_INTRA_BELOW = rust_constant("CALM_INTRA_BELOW")

@@ -6,7 +6,7 @@ has)."""
 import pathlib
 import re
 
-from conftest import ROOT
+from conftest import ROOT, default_config, rust_constant
 
 SKIP_DIRS = {".git", "target", ".venv", ".venv-blender", "node_modules", "out", "__pycache__"}
 SOURCE_SUFFIXES = {".rs", ".py", ".sh", ".md", ".yaml", ".toml", ".cs", ".c", ".h", ".mjs"}
@@ -74,11 +74,8 @@ def test_the_documents_state_the_rule_s_step_counts_as_the_code_has_them():
     """The step counts the rule chooses live in the code (clip_rule's MANY_FEET_STEPS) and the
     default configuration; the documents that explain the rule restate them for readers, so a
     change there fails here until they say the new number."""
-    import yaml
-
-    source = "\n".join(p.read_text() for p in (ROOT / "train" / "src" / "clip_rule").glob("*.rs"))
-    many_feet = int(re.search(r"pub const MANY_FEET_STEPS: u64 = ([0-9_]+);", source).group(1).replace("_", ""))
-    default = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())["training"]["steps"]
+    many_feet = rust_constant("MANY_FEET_STEPS")
+    default = default_config("training", "steps")
     spaced = lambda n: f"{n:,}".replace(",", " ")  # noqa: E731 (the documents' thousands)
     for name in ("docs/GUIDE.md", "docs/SPEC.md", "configs/default.yaml"):
         text = (ROOT / name).read_text()
