@@ -11,7 +11,7 @@ import json
 import pathlib
 import sys
 
-# The goals (SPEC section 9; eval/src/kinematics.rs and train/src/step_ladder/ hold them).
+# The goals (SPEC section 9; eval/src/kinematics.rs and train/src/choose/step_ladder/ hold them).
 STILL_MARGIN, LOW, HIGH, SPEED_DISTANCE, ACCELERATION_DISTANCE = 0.05, 0.8, 1.25, 0.2, 0.5
 COVERAGE, JITTER = 95.0, 1.5
 

@@ -1,4 +1,4 @@
-"""Leave-one-out judgement of the rule that reads the clip (train/src/clip_rule/).
+"""Leave-one-out judgement of the rule that reads the clip (train/src/choose/clip_rule/).
 
 The rule's family, as the trainer ships it: a clip whose own intra diversity is under a threshold
 T is calm and its steps are chosen by its own step ladder (nothing chosen on other clips); any

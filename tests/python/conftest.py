@@ -41,14 +41,14 @@ def encoded_clip(clip, tmp_path, run_sinmdm, data_extra=""):
 
 
 def rust_constant(name):
-    """A number of the clip rule as train/src/clip_rule/ defines it (`pub const NAME: T = V;`),
+    """A number of the clip rule as train/src/choose/clip_rule/ defines it (`pub const NAME: T = V;`),
     read from the source so that it lives in one place."""
-    for path in sorted((ROOT / "train" / "src" / "clip_rule").glob("*.rs")):
+    for path in sorted((ROOT / "train" / "src" / "choose" / "clip_rule").glob("*.rs")):
         found = re.search(rf"pub const {name}: \w+ = ([0-9_.]+);", path.read_text())
         if found:
             value = found.group(1).replace("_", "")
             return float(value) if "." in value else int(value)
-    raise AssertionError(f"train/src/clip_rule/ defines no {name}")
+    raise AssertionError(f"train/src/choose/clip_rule/ defines no {name}")
 
 
 def default_config(section, key):

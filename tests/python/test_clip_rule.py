@@ -1,4 +1,4 @@
-"""The rule that reads the clip (train/src/clip_rule/): the clip's own intra diversity the
+"""The rule that reads the clip (train/src/choose/clip_rule/): the clip's own intra diversity the
 trainer reads before training, against the benchmark's measure computed with numpy from the
 features `sinmdm encode` writes, and the choice the default makes from it."""
 

@@ -84,6 +84,49 @@ def test_sibling_modules_import_one_way(crate):
     assert not cycles, f"{crate} has module cycles:\n" + "\n".join(cycles)
 
 
+# The training crate's wings, highest first: a module imports only wings ranked below its own
+# (those ranked 0 may import each other; the sibling check above keeps them free of cycles).
+TRAIN_WINGS = {"library_task": 5, "choose": 4, "export": 3, "run": 2, "clip": 1,
+               "chosen": 0, "config": 0, "model": 0}
+
+
+def wing_climbs(crate, wings):
+    """Every import that climbs: (file, the wing it sits in, the wing it imports)."""
+    src = ROOT / crate / "src"
+    climbs = []
+    for path in sorted(src.rglob("*.rs")):
+        module = module_of(src, path)
+        if not module or module[0] not in wings or "bin" in path.relative_to(src).parts:
+            continue
+        here = wings[module[0]]
+        for target in imports(module, path.read_text()):
+            there = wings.get(target[0]) if target else None
+            if there is None or target[0] == module[0]:
+                continue
+            if there > here or (there == here and here > 0):
+                climbs.append((str(path.relative_to(ROOT)), module[0], target[0]))
+    return climbs
+
+
+def test_the_training_wings_import_downward_only():
+    """The policy (`choose`) sits above the run, the run above the clip: the trainer imports
+    nothing from the rule that reads the clip."""
+    src = ROOT / "train" / "src"
+    assert all((src / wing).exists() or (src / f"{wing}.rs").exists() for wing in TRAIN_WINGS)
+    climbs = wing_climbs("train", TRAIN_WINGS)
+    assert not climbs, "imports that climb:\n" + "\n".join(f"  {f}: {a} -> {b}" for f, a, b in climbs)
+
+
+def test_the_wing_check_sees_a_climb(tmp_path, monkeypatch):
+    src = tmp_path / "demo" / "src"
+    (src / "run").mkdir(parents=True)
+    (src / "lib.rs").write_text("pub mod choose;\npub mod run;\n")
+    (src / "choose.rs").write_text("use crate::run::Trainer;\n")
+    (src / "run" / "mod.rs").write_text("use crate::choose::clip_rule::RuleChoice;\n")
+    monkeypatch.setattr("test_module_graph.ROOT", tmp_path)
+    assert wing_climbs("demo", {"choose": 2, "run": 1}) == [("demo/src/run/mod.rs", "run", "choose")]
+
+
 def test_the_check_finds_a_cycle_when_there_is_one(tmp_path, monkeypatch):
     src = tmp_path / "demo" / "src"
     src.mkdir(parents=True)

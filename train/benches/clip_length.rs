@@ -11,10 +11,10 @@ use std::time::Instant;
 use burn::tensor::{Device, Tensor, TensorData};
 use ndarray::Array2;
 use sinmdm::diffusion::Schedule;
+use sinmdm_train::clip::batch::make_batch;
 use sinmdm_train::config::TrainConfig;
-use sinmdm_train::data::make_batch;
 use sinmdm_train::model::QnaUnet;
-use sinmdm_train::trainer::{StepOutcome, new_optimizer, optimisation_step};
+use sinmdm_train::run::trainer::{StepOutcome, new_optimizer, optimisation_step};
 
 fn main() {
     sinmdm_train::memory::keep_freed_memory();

@@ -7,7 +7,7 @@ use std::time::Instant;
 use burn::tensor::{Device, Distribution, Tensor, TensorData};
 use sinmdm_train::config::{ModelConfig, TrainConfig};
 use sinmdm_train::model::QnaUnet;
-use sinmdm_train::trainer::{StepOutcome, new_optimizer, optimisation_step};
+use sinmdm_train::run::trainer::{StepOutcome, new_optimizer, optimisation_step};
 
 /// Multiply-adds per frame of one forward pass (convolutions, 1x1 projections and the QnA score
 /// projection; normalisation and element-wise work left out).

@@ -24,6 +24,12 @@ pub enum TrainError {
         /// What is wrong (names the key).
         message: String,
     },
+    /// A run was started with a configuration that leaves settings to the rule that reads the
+    /// clip: the policy applies that rule before a run starts, and the run trains final numbers.
+    #[error(
+        "the configuration's from_clip section leaves settings to the rule that reads the clip; start the run through choose::start_run (as sinmdm-train does), or turn from_clip off"
+    )]
+    RuleNotApplied,
     /// The clip could not be read.
     #[error(transparent)]
     Bvh(#[from] sinmdm::bvh::BvhError),
@@ -74,7 +80,7 @@ pub enum TrainError {
         /// What does not fit.
         message: String,
     },
-    /// A rung of the step ladder could not be sampled or scored ([`crate::step_ladder`]).
+    /// A rung of the step ladder could not be sampled or scored ([`crate::choose::step_ladder`]).
     #[error("could not check the samples of '{}' (a rung of the step ladder that chooses a calm clip's steps): {message}", model.display())]
     Check {
         /// The rung's model file.
@@ -87,15 +93,16 @@ pub enum TrainError {
     Export(String),
     /// Steps kept going non-finite after every recovery the trainer tries.
     #[error(
-        "the loss or its gradients kept going non-finite: at step {step}, after {tried}, the run had already gone back to step {to} {max} times; stopped. The last good checkpoint is {}; a smaller training.learning_rate or another training.seed may get past it",
-        last_checkpoint.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "none (no checkpoint was written yet)".into()),
-        max = crate::recovery::MAX_ROLLBACKS
+        "the loss or its gradients kept going non-finite: at step {step}, after {tried}, the run had already gone back to step {to} {rollbacks} times; stopped. The last good checkpoint is {}; a smaller training.learning_rate or another training.seed may get past it",
+        last_checkpoint.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "none (no checkpoint was written yet)".into())
     )]
     Unrecoverable {
         /// The step that failed last.
         step: u64,
         /// The step the run kept going back to.
         to: u64,
+        /// How many times it went back there (the most the trainer allows).
+        rollbacks: u32,
         /// What was tried (skipped steps, roll-backs, the learning rate's factor).
         tried: String,
         /// The newest checkpoint on disk.

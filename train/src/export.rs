@@ -9,10 +9,10 @@ use sinmdm::model_file::{
 };
 use sinmdm_export::{NetworkShape, Weights};
 
-use crate::checkpoint::{self, CheckpointState};
 use crate::error::TrainError;
 use crate::model::QnaUnet;
 use crate::model::weights::named_tensors;
+use crate::run::checkpoint::{self, CheckpointState};
 
 /// The network's weights by name, as the exporter reads them.
 pub fn weights_of(model: &QnaUnet) -> Weights {

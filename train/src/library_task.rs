@@ -14,7 +14,8 @@ use sinmdm_library::status::{host, now};
 use sinmdm_library::task::Plan;
 use sinmdm_library::{ClipEntry, LibraryError, Manifest, State, TaskFolder, TaskStatus};
 
-use crate::{RunEnd, StepReport, TrainConfig, TrainError, Trainer, checkpoint, export};
+use crate::run::checkpoint;
+use crate::{RunEnd, StepReport, TrainConfig, TrainError, Trainer, export};
 
 /// Why a library task stopped.
 #[derive(Debug, thiserror::Error)]
@@ -128,7 +129,7 @@ fn evaluate(
     manifest: &Manifest,
     entry: &ClipEntry,
     folder: &TaskFolder,
-    state: &crate::checkpoint::CheckpointState,
+    state: &crate::run::checkpoint::CheckpointState,
 ) -> Result<(), LibraryTaskError> {
     let name = Manifest::name(entry);
     let partial = folder.dir.join("eval.json.partial");
@@ -240,7 +241,7 @@ pub fn run_task(
     let plan = folder.prepare(
         &fingerprint,
         |run| checkpoint::latest(run).ok().flatten().is_some(),
-        &[crate::step_ladder::LADDER_FOLDER],
+        &[crate::choose::step_ladder::LADDER_FOLDER],
     )?;
     if plan == Plan::UpToDate {
         return Ok(TaskEnd::UpToDate(folder.model()));
@@ -267,13 +268,12 @@ pub fn run_task(
             return outcome;
         }
     }
-    let state =
-        crate::checkpoint::load_state(&checkpoint::latest(&folder.run())?.ok_or_else(|| {
-            TrainError::Checkpoint {
-                path: folder.run(),
-                message: "holds no checkpoint after training".into(),
-            }
-        })?)?;
+    let state = crate::run::checkpoint::load_state(
+        &checkpoint::latest(&folder.run())?.ok_or_else(|| TrainError::Checkpoint {
+            path: folder.run(),
+            message: "holds no checkpoint after training".into(),
+        })?,
+    )?;
     status.state = State::Done;
     status.finished = Some(now());
     status.training_seconds = Some(state.elapsed_seconds);
@@ -297,12 +297,12 @@ fn train_export_evaluate(
     let mut trainer = if resumed {
         Trainer::resume(&run, Some(&entry.clip), None, device)?
     } else {
-        let started = crate::step_ladder::start_run(
+        let started = crate::choose::start_run(
             &entry.clip,
             config,
             &run,
             device,
-            &crate::step_ladder::Ladder::default(),
+            &crate::choose::step_ladder::Ladder::default(),
             stop,
             &mut |_| {},
         )?;
@@ -315,7 +315,7 @@ fn train_export_evaluate(
         RunEnd::Finished(dir) => dir,
         RunEnd::Interrupted(_) => return Ok(TaskEnd::Interrupted),
     };
-    crate::loss_plot::write(trainer.loss_log(), &run.join("loss.png"))?;
+    crate::run::loss_plot::write(trainer.loss_log(), &run.join("loss.png"))?;
     let partial = folder.dir.join("model.onnx.partial");
     export::export_checkpoint(&dir, &partial)?;
     put_in_place(&partial, &folder.model())?;

@@ -8,7 +8,7 @@ use burn::tensor::Device;
 use sinmdm::bvh::read_bvh;
 use sinmdm::motion::{ColumnKind, UpAxis};
 use sinmdm_formats::gltf::{GltfWriteOptions, write_gltf};
-use sinmdm_train::clip_data::ClipData;
+use sinmdm_train::clip::ClipData;
 use sinmdm_train::{TrainConfig, Trainer};
 
 mod common;

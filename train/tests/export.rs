@@ -60,7 +60,11 @@ fn ort_forward(
 
 /// A tiny trained run whose weights (zero-initialised ones too) are then perturbed, so every
 /// path of the graph carries signal.
-fn perturbed_run() -> (QnaUnet, sinmdm_train::checkpoint::CheckpointState, PathBuf) {
+fn perturbed_run() -> (
+    QnaUnet,
+    sinmdm_train::run::checkpoint::CheckpointState,
+    PathBuf,
+) {
     let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
     let mut config: TrainConfig = TrainConfig::load(&root().join("configs/tiny.yaml")).unwrap();
     config.training.steps = 3;
@@ -133,7 +137,7 @@ fn one_step_run(name: &str, channels: usize) -> PathBuf {
     let clip = root().join("tests/data/bvh/fox_survey_khronos.bvh");
     let mut trainer = Trainer::start(&clip, config, &run, Device::flex().autodiff()).unwrap();
     trainer.run(&AtomicBool::new(false), |_| {}).unwrap();
-    sinmdm_train::checkpoint::resolve(&run).unwrap()
+    sinmdm_train::run::checkpoint::resolve(&run).unwrap()
 }
 
 #[test]

@@ -7,9 +7,9 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use burn::tensor::Device;
-use sinmdm_train::checkpoint::{self, CheckpointState};
 use sinmdm_train::model::weights::named_tensors;
-use sinmdm_train::recovery::{NonFinite, RecoveryEvent};
+use sinmdm_train::run::checkpoint::{self, CheckpointState};
+use sinmdm_train::run::recovery::{NonFinite, RecoveryEvent};
 use sinmdm_train::{RunEnd, TrainConfig, TrainError, Trainer};
 
 mod common;

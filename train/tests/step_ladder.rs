@@ -10,7 +10,8 @@ use std::sync::atomic::AtomicBool;
 
 use burn::tensor::Device;
 use sinmdm_train::TrainConfig;
-use sinmdm_train::step_ladder::{Ladder, RungCheck, choose, folder, start_run};
+use sinmdm_train::choose::start_run;
+use sinmdm_train::choose::step_ladder::{Ladder, RungCheck, choose, folder};
 
 mod common;
 use common::root;
@@ -162,7 +163,7 @@ fn each_rung_is_scored_as_sinmdm_eval_scores_it_and_the_chosen_one_trains() {
             "the configuration's, as a varied clip"
         ),
     }
-    let lines = trainer.rule_lines().unwrap().join("\n");
+    let lines = trainer.chosen().unwrap().lines().join("\n");
     assert!(lines.contains("   6 steps: coverage"), "{lines}");
     let _ = std::fs::remove_dir_all(&run);
 }
@@ -189,7 +190,7 @@ fn scored(steps: u64, coverage: f64, replay_seconds: f64, jitter_ratio: f64) -> 
 
 /// What a rung of `steps` on the fox is made from, when `ladder` climbs it for `config`.
 fn fox_rung_fingerprint(ladder: &Ladder, config: &TrainConfig, steps: u64) -> String {
-    let clip = sinmdm_train::clip_data::sha256_hex(&std::fs::read(fox()).unwrap());
+    let clip = sinmdm_train::clip::sha256_hex(&std::fs::read(fox()).unwrap());
     ladder.rung_fingerprint(&clip, config, steps)
 }
 
@@ -262,7 +263,7 @@ fn scored_rungs_are_kept_and_the_widest_margin_trains() {
     let config = &trainer.state().config;
     assert_eq!(config.training.steps, 4);
     assert_eq!(config.training.warmup_steps, 1);
-    let lines = trainer.rule_lines().unwrap().join("\n");
+    let lines = trainer.chosen().unwrap().lines().join("\n");
     assert!(
         lines.contains(
             "steps           4 (warm-up 1): the rung of the step ladder that meets every goal"
@@ -287,9 +288,9 @@ fn a_clip_the_most_steps_do_not_cover_trains_as_a_varied_one() {
     // The fox stands on four feet: a varied clip on as many trains the wide window.
     assert_eq!(
         trained.model.window,
-        sinmdm_train::clip_rule::MANY_FEET_WINDOW
+        sinmdm_train::choose::clip_rule::MANY_FEET_WINDOW
     );
-    let lines = trainer.rule_lines().unwrap().join("\n");
+    let lines = trainer.chosen().unwrap().lines().join("\n");
     assert!(
         lines.contains("varied: its own intra diversity")
             && lines
@@ -312,5 +313,30 @@ fn a_climb_stopped_before_its_first_rung_starts_no_run() {
     );
     assert!(stopped.is_none());
     assert!(!run.join("config.yaml").exists());
+    let _ = std::fs::remove_dir_all(&run);
+}
+
+#[test]
+fn a_run_started_without_the_policy_refuses_a_configuration_that_asks_for_the_rule() {
+    // The trainer trains final numbers; the rule that reads the clip is the policy's to apply
+    // (`choose::start_run`), so a configuration that still asks for it is refused, before any
+    // folder is made.
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let run = common::scratch("ladder", "refused");
+    let err = sinmdm_train::Trainer::start(&fox(), tiny_asking_for_steps(), &run, device())
+        .err()
+        .expect("refused");
+    assert!(
+        matches!(err, sinmdm_train::TrainError::RuleNotApplied),
+        "{err}"
+    );
+    assert!(err.to_string().contains("from_clip"), "{err}");
+    assert!(!run.exists());
+    // Without the section the same configuration trains as written, and keeps no record of a
+    // choice.
+    let mut written = tiny_asking_for_steps();
+    written.from_clip.steps = false;
+    let trainer = sinmdm_train::Trainer::start(&fox(), written, &run, device()).unwrap();
+    assert!(trainer.chosen().is_none());
     let _ = std::fs::remove_dir_all(&run);
 }

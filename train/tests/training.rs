@@ -104,13 +104,15 @@ fn stopped_and_resumed_run_reproduces_the_uninterrupted_one() {
         named_tensors(&second.averaged_model().unwrap())
     );
     // The export writes the average.
-    let checkpoint = sinmdm_train::checkpoint::latest(&parts).unwrap().unwrap();
+    let checkpoint = sinmdm_train::run::checkpoint::latest(&parts)
+        .unwrap()
+        .unwrap();
     let shape = sinmdm_train::QnaUnet::new(
         second.state().features,
         &second.state().config.model,
         &Device::flex(),
     );
-    let exported = sinmdm_train::checkpoint::load_exported(&checkpoint, shape).unwrap();
+    let exported = sinmdm_train::run::checkpoint::load_exported(&checkpoint, shape).unwrap();
     assert_eq!(whole_average, named_tensors(&exported));
     std::fs::remove_dir_all(&whole).unwrap();
     std::fs::remove_dir_all(&parts).unwrap();

@@ -25,7 +25,7 @@ pub struct TrainConfig {
     pub training: TrainingConfig,
     /// How the clip becomes features.
     pub data: DataConfig,
-    /// Which settings the rule that reads the clip chooses ([`crate::clip_rule`]); absent:
+    /// Which settings the rule that reads the clip chooses (`choose::clip_rule`); absent:
     /// none, every number trains as written. A run saves the numbers chosen, with this off.
     #[serde(default, skip_serializing_if = "FromClip::is_off")]
     pub from_clip: FromClip,
@@ -174,7 +174,7 @@ fn is_world(layout: &sinmdm::motion::RootLayout) -> bool {
     *layout == sinmdm::motion::RootLayout::World
 }
 
-/// Which settings the rule that reads the clip ([`crate::clip_rule`]) may choose: the
+/// Which settings the rule that reads the clip (`choose::clip_rule`) may choose: the
 /// configuration's `from_clip` section. A part left false trains the configuration's own number.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -83,7 +83,7 @@ fn first_difference(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::clip_rule::{MANY_FEET_CHANNELS, MANY_FEET_STEPS, MANY_FEET_WINDOW};
+    use crate::choose::clip_rule::{MANY_FEET_CHANNELS, MANY_FEET_STEPS, MANY_FEET_WINDOW};
 
     /// The default, and what a new run with it on a varied clip of `frames` frames on four feet
     /// at 30 fps saved: the rule's choices, and the root layout auto chose.
@@ -92,13 +92,15 @@ mod tests {
         intra_diversity: f64,
     ) -> (TrainConfig, TrainConfig) {
         let default = TrainConfig::parse(include_str!("../../../configs/default.yaml")).unwrap();
-        let dog = crate::clip_rule::ClipReading {
+        let dog = crate::choose::clip_rule::ClipReading {
             frames,
             fps: 30.0,
             intra_diversity,
             feet: 4,
         };
-        let mut saved = crate::clip_rule::choose(&default, dog).config.at_fps(30.0);
+        let mut saved = crate::choose::clip_rule::choose(&default, dog)
+            .config
+            .at_fps(30.0);
         saved.data.root_layout = sinmdm::motion::RootLayout::Heading;
         (default, saved)
     }

@@ -4,9 +4,9 @@ use anyhow::{Result, bail};
 use burn::module::Module;
 use burn::tensor::Device;
 
-use sinmdm_train::clip_data::ClipData;
-use sinmdm_train::clip_rule;
-use sinmdm_train::motion_span;
+use sinmdm_train::choose::clip_rule;
+use sinmdm_train::clip::ClipData;
+use sinmdm_train::clip::motion_span;
 use sinmdm_train::{QnaUnet, TrainConfig};
 
 use super::{Args, new_run_config};
@@ -21,9 +21,9 @@ pub(super) fn dry_run(args: &Args) -> Result<()> {
     let (config, rule, ladder, window_from_clip) = match clip_rule::apply(&config, &data) {
         Some(choice) => (
             choice.config,
-            Some(choice.lines),
+            Some(choice.choices.lines()),
             choice.climb_ladder,
-            choice.window_from_clip,
+            choice.choices.window_from_clip(),
         ),
         None => (config, None, false, false),
     };

@@ -216,7 +216,7 @@ fn fit_to_budget(
     }
     let begun = std::time::Instant::now();
     let per_step =
-        sinmdm_train::trainer::seconds_per_step(clip, config, device.clone(), PROBE_STEPS)?;
+        sinmdm_train::choose::budget::seconds_per_step(clip, config, device.clone(), PROBE_STEPS)?;
     let left = minutes * 60.0 - begun.elapsed().as_secs_f64() - BUDGET_RESERVE_SECONDS;
     let steps = (left * (1.0 - BUDGET_MARGIN) / per_step).floor();
     if steps < 1.0 {
@@ -329,15 +329,15 @@ fn started(args: &Args, out: &Path, device: Device, stop: &Arc<AtomicBool>) -> R
     if let Some(minutes) = args.minutes {
         fit_to_budget(clip, &mut config, &device, minutes)?;
     }
-    let mut on_rung = |rung: &sinmdm_train::step_ladder::RungCheck| {
+    let mut on_rung = |rung: &sinmdm_train::choose::step_ladder::RungCheck| {
         eprintln!("step ladder: {}", rung.line());
     };
-    match sinmdm_train::step_ladder::start_run(
+    match sinmdm_train::choose::start_run(
         clip,
         config,
         out,
         device,
-        &sinmdm_train::step_ladder::Ladder::default(),
+        &sinmdm_train::choose::step_ladder::Ladder::default(),
         stop,
         &mut on_rung,
     )? {
@@ -345,7 +345,7 @@ fn started(args: &Args, out: &Path, device: Device, stop: &Arc<AtomicBool>) -> R
         None => {
             eprintln!(
                 "interrupted while the step ladder chose the steps; the same command starts again and keeps the rungs finished (in {})",
-                sinmdm_train::step_ladder::folder(out).display()
+                sinmdm_train::choose::step_ladder::folder(out).display()
             );
             std::process::exit(130);
         }
@@ -372,9 +372,9 @@ fn print_start(trainer: &Trainer, out: &Path) {
     if state.clip.in_place {
         eprintln!("in-place cycle: contacts measured against the treadmill");
     }
-    if let Some(lines) = trainer.rule_lines() {
+    if let Some(chosen) = trainer.chosen() {
         eprintln!("the rule that reads the clip chose (--dry-run says more):");
-        for line in lines {
+        for line in chosen.lines() {
             eprintln!("  {line}");
         }
     }
@@ -434,7 +434,7 @@ fn finish(args: &Args, trainer: &Trainer, end: RunEnd, out: &Path) -> Result<()>
     match end {
         RunEnd::Finished(dir) => {
             let png = trainer.run_dir().join("loss.png");
-            sinmdm_train::loss_plot::write(trainer.loss_log(), &png)?;
+            sinmdm_train::run::loss_plot::write(trainer.loss_log(), &png)?;
             eprintln!(
                 "done: {} steps in {:.0} s, final loss {:.4} (mean of the last 100: {:.4})\ncheckpoint {}\nloss curve {}",
                 state.step,
@@ -448,7 +448,8 @@ fn finish(args: &Args, trainer: &Trainer, end: RunEnd, out: &Path) -> Result<()>
                 eprintln!(
                     "non-finite steps recovered from: {} (listed under 'recovery' in {})",
                     state.recovery.summary(),
-                    dir.join(sinmdm_train::checkpoint::STATE_FILE).display()
+                    dir.join(sinmdm_train::run::checkpoint::STATE_FILE)
+                        .display()
                 );
             }
             if let Some(file) = &args.export {

@@ -5,9 +5,9 @@ use burn::module::{Module, ModuleMapper, ModuleVisitor, Param};
 use burn::optim::GradientsParams;
 use burn::tensor::{Device, Distribution, Tensor};
 
-use crate::loss::x0_loss;
 use crate::model::QnaUnet;
 use crate::model::dropout::DropoutKey;
+use crate::run::loss::x0_loss;
 
 /// The batch's mean loss and its gradients (none when the loss is not finite), computed in
 /// `shards` shards on as many threads. The loss is the x0 MSE.
@@ -194,7 +194,7 @@ mod tests {
         // The tiny network with dropout on and perturbed weights (so no gradient is trivially
         // zero), the whole batch against uneven shards: the same loss and gradients.
         let mut config: TrainConfig =
-            TrainConfig::parse(include_str!("../../configs/tiny.yaml")).unwrap();
+            TrainConfig::parse(include_str!("../../../configs/tiny.yaml")).unwrap();
         config.model.dropout = 0.5;
         let _random = crate::device_random_lock();
         let device = Device::flex().autodiff();

@@ -6,7 +6,7 @@
 //! - a **calm** clip (its own intra diversity under [`CALM_INTRA_BELOW`]: a walk in one mood, a
 //!   kick, a dance phrase, an idle) is covered within a few hundred steps, and the longer it
 //!   trains the longer its samples replay it verbatim; how soon differs from clip to clip. Its
-//!   steps are left to the step ladder ([`crate::step_ladder`]), which trains short runs and
+//!   steps are left to the step ladder ([`crate::choose::step_ladder`]), which trains short runs and
 //!   keeps the one whose own samples meet the goals best; a calm clip that no short run covers
 //!   trains as a varied one ([`not_calm_after_all`]).
 //! - a **varied** clip (at or over it: a walk that turns and stops, a hop, a dog's run) covers
@@ -37,20 +37,20 @@
 //! A configuration asks for the rule with its `from_clip` section; each part it names may be
 //! replaced by the rule, and a run saves the numbers it trained with, the section off.
 
-use crate::clip_data::ClipData;
+use crate::chosen::{Choices, Chosen, ClipKind, Reason};
+use crate::clip::ClipData;
 use crate::config::{FromClip, TrainConfig};
 
 mod batch_pairing;
 mod calm;
 mod reading;
-mod setting_lines;
+mod settings;
 mod window_cost;
 
-use batch_pairing::batch_line;
 pub use batch_pairing::{BATCH_ITEMS_MULTIPLE, paired_items};
 pub use calm::{calm_most_steps, calm_warmup_steps, not_calm_after_all};
 pub use reading::ClipReading;
-use setting_lines::{Choosing, steps_at_fps_line};
+use settings::{Choosing, steps_at_fps};
 pub use window_cost::{
     FITTED_STEPS_ROUNDING, WINDOW_STEP_COST_OFFSET, steps_at_window, window_step_cost,
 };
@@ -86,15 +86,19 @@ pub struct RuleChoice {
     pub reading: ClipReading,
     /// The configuration as the rule leaves it (`from_clip` off).
     pub config: TrainConfig,
-    /// One line per setting, saying what it is and why (also for a setting the configuration
-    /// kept because the rule was not asked to choose it).
-    pub lines: Vec<String>,
-    /// Whether the steps are left to the step ladder ([`crate::step_ladder`]): a calm clip whose
-    /// steps the rule was asked for. `config` then holds the ladder's most steps.
+    /// Each setting's value and why (also for a setting the configuration kept because the rule
+    /// was not asked to choose it).
+    pub choices: Choices,
+    /// Whether the steps are left to the step ladder ([`crate::choose::step_ladder`]): a calm
+    /// clip whose steps the rule was asked for. `config` then holds the ladder's most steps.
     pub climb_ladder: bool,
-    /// Whether the configuration left the QnA window to the rule (so the window `config` holds
-    /// is the rule's choice for this clip).
-    pub window_from_clip: bool,
+}
+
+impl RuleChoice {
+    /// The choices in words, a line per setting ([`Choices::lines`]).
+    pub fn lines(&self) -> Vec<String> {
+        self.choices.lines()
+    }
 }
 
 /// What the rule chooses for a new run on `data` with `config`; `None` when its `from_clip`
@@ -109,28 +113,30 @@ pub fn apply(config: &TrainConfig, data: &ClipData) -> Option<RuleChoice> {
 /// Applies the rule of `config.from_clip` to `config` for the clip `reading` describes. The
 /// settings the rule is not asked for are kept; the result has `from_clip` off.
 pub fn choose(config: &TrainConfig, reading: ClipReading) -> RuleChoice {
-    let calm = reading.is_calm();
-    let kind = if calm {
-        format!(
-            "calm: its own intra diversity {:.3} is under {CALM_INTRA_BELOW}",
-            reading.intra_diversity
-        )
+    let intra_diversity = reading.intra_diversity;
+    let below = CALM_INTRA_BELOW;
+    let kind = if reading.is_calm() {
+        let reason = Reason::CalmClip {
+            intra_diversity,
+            below,
+        };
+        Chosen::new(ClipKind::Calm, reason)
     } else {
-        format!(
-            "varied: its own intra diversity {:.3} is at least {CALM_INTRA_BELOW}",
-            reading.intra_diversity
-        )
+        let reason = Reason::VariedClip {
+            intra_diversity,
+            below,
+        };
+        Chosen::new(ClipKind::Varied, reason)
     };
-    choose_kind(config, reading, calm, kind)
+    choose_kind(config, reading, kind)
 }
 
-fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: String) -> RuleChoice {
+/// The rule's choice for a clip of the kind `kind` says.
+fn choose_kind(config: &TrainConfig, reading: ClipReading, kind: Chosen<ClipKind>) -> RuleChoice {
+    let calm = kind.value == ClipKind::Calm;
     let asked = config.from_clip;
     let mut out = config.clone();
     out.from_clip = FromClip::default();
-    let mut lines = Vec::new();
-    lines.push(format!("clip            {kind}"));
-    let kept = "the configuration's; from_clip does not ask for it";
     // A varied clip on many feet trains a wider network, if asked and if the heads divide it.
     let widen = !calm
         && reading.has_many_feet()
@@ -142,37 +148,32 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
         reading,
         calm,
         widen,
-        kept,
     };
-    // What the steps line says after its label (the steps meant at 30 fps, and why).
-    let steps_said = choosing.steps_said(&mut out, asked.steps);
-    let steps_line = lines.len();
-    lines.push(format!("steps           {steps_said}"));
-    lines.push(choosing.window_line(&mut out, asked.window));
-    lines.push(choosing.dropout_line(&mut out, asked.dropout));
-    lines.push(choosing.channels_line(&mut out, asked.channels));
-    lines.push(batch_line(
-        config,
-        &mut out,
-        reading,
-        asked.batch,
-        calm,
-        kept,
-    ));
+    let meant = choosing.steps(&mut out, asked.steps);
+    let window = choosing.window(&mut out, asked.window);
+    let dropout = choosing.dropout(&mut out, asked.dropout);
+    let channels = choosing.channels(&mut out, asked.channels);
+    let batch = batch_pairing::batch(config, &mut out, reading, asked.batch, calm);
     // The steps above are meant at 30 fps. At a higher rate the window follows the frame rate,
     // a step costs more, and a varied clip's steps fall to fit the same time.
-    if asked.steps
-        && !calm
-        && let Some(line) = steps_at_fps_line(&mut out, reading, &steps_said)
-    {
-        lines[steps_line] = line;
-    }
+    let steps = if asked.steps && !calm {
+        steps_at_fps(&mut out, reading, &meant).unwrap_or(meant)
+    } else {
+        meant
+    };
     RuleChoice {
         reading,
         config: out,
-        lines,
+        choices: Choices {
+            kind,
+            steps,
+            window,
+            dropout,
+            channels,
+            batch,
+            rungs: Vec::new(),
+        },
         climb_ladder: calm && asked.steps,
-        window_from_clip: asked.window,
     }
 }
 
@@ -180,8 +181,8 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, calm: bool, kind: Str
 mod tests {
     use super::*;
 
-    pub(super) const DEFAULT: &str = include_str!("../../../configs/default.yaml");
-    const TINY: &str = include_str!("../../../configs/tiny.yaml");
+    pub(super) const DEFAULT: &str = include_str!("../../../../configs/default.yaml");
+    const TINY: &str = include_str!("../../../../configs/tiny.yaml");
 
     pub(super) fn reading(intra_diversity: f64) -> ClipReading {
         ClipReading {
@@ -223,7 +224,7 @@ mod tests {
                 out.model.window_follows_fps,
                 "the window still follows the frame rate"
             );
-            assert!(choice.lines[0].contains("varied"), "{:?}", choice.lines);
+            assert!(choice.lines()[0].contains("varied"), "{:?}", choice.lines());
             assert!(!choice.climb_ladder);
             out.validate().unwrap();
         }
@@ -253,13 +254,13 @@ mod tests {
         assert!(MANY_FEET_STEPS < config.training.steps);
         assert_eq!(out.training.warmup_steps, config.training.warmup_steps);
         assert!(
-            choice.lines[1].contains(&format!(
+            choice.lines()[1].contains(&format!(
                 "{MANY_FEET_STEPS}: the {MANY_FEET_CHANNELS} channels below cost more a step"
-            )) && choice.lines[2].contains("on 4 feet")
-                && choice.lines[3].starts_with("dropout         0.3: on 4 feet")
-                && choice.lines[4].starts_with("channels        96: on 4 feet"),
+            )) && choice.lines()[2].contains("on 4 feet")
+                && choice.lines()[3].starts_with("dropout         0.3: on 4 feet")
+                && choice.lines()[4].starts_with("channels        96: on 4 feet"),
             "{:?}",
-            choice.lines
+            choice.lines()
         );
         out.validate().unwrap();
         // A configuration already as wide, or with fewer steps, keeps its numbers; heads that do
@@ -280,9 +281,9 @@ mod tests {
             (64, 17_000)
         );
         assert!(
-            kept.lines[4].contains("64 heads do not divide 96"),
+            kept.lines()[4].contains("64 heads do not divide 96"),
             "{:?}",
-            kept.lines
+            kept.lines()
         );
         // Two feet, or three: the boundary.
         let biped = ClipReading { feet: 2, ..dog };
@@ -304,9 +305,9 @@ mod tests {
         let choice = choose(&config, short);
         assert_eq!(choice.config.model.window, VARIED_WINDOW);
         assert!(
-            choice.lines[2].contains("too few for window 7"),
+            choice.lines()[2].contains("too few for window 7"),
             "{:?}",
-            choice.lines
+            choice.lines()
         );
         let shorter = ClipReading { frames: 28, ..dog };
         assert_eq!(
@@ -338,11 +339,11 @@ mod tests {
         assert_eq!(dog.config.model.dropout, config.model.dropout);
         assert!(
             varied
-                .lines
+                .lines()
                 .iter()
                 .any(|l| l.starts_with("window") && l.contains("from_clip does not ask for it")),
             "{:?}",
-            varied.lines
+            varied.lines()
         );
         config.from_clip.steps = false;
         let calm = choose(&config, reading(0.2));
@@ -360,9 +361,12 @@ mod tests {
         let choice = choose(&config, short);
         assert_eq!(choice.config.model.window, config.model.window);
         assert!(
-            choice.lines.iter().any(|l| l.contains("fewer than the 29")),
+            choice
+                .lines()
+                .iter()
+                .any(|l| l.contains("fewer than the 29")),
             "{:?}",
-            choice.lines
+            choice.lines()
         );
         let just = ClipReading {
             frames: 29,

@@ -1,7 +1,7 @@
 //! How fast a run goes: what the loop reports after each step, with the time the rest should
 //! take.
 
-use crate::recovery::RecoveryEvent;
+use crate::run::recovery::RecoveryEvent;
 
 /// What the loop reports after each step.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,7 +1,8 @@
 //! A varied clip's batch items in pairs: the even count of copies of the clip a step that
-//! keeps both cores busy, and the rule's line that says so.
+//! keeps both cores busy.
 
 use super::ClipReading;
+use crate::chosen::{Batch, Chosen, Reason};
 use crate::config::TrainConfig;
 
 /// A varied clip that would train an odd count of copies of the clip a step, 3 or more, trains
@@ -12,49 +13,50 @@ use crate::config::TrainConfig;
 /// in pairs"). A single copy is left alone: pairing it would double a step's frames, unmeasured.
 pub const BATCH_ITEMS_MULTIPLE: usize = 2;
 
-/// The rule's batch line; it sets `out.training.frames_per_step` where it pairs the items.
-pub(super) fn batch_line(
+/// The rule's batch; it sets `out.training.frames_per_step` where it pairs the items.
+pub(super) fn batch(
     config: &TrainConfig,
     out: &mut TrainConfig,
     reading: ClipReading,
     asked: bool,
     calm: bool,
-    kept: &str,
-) -> String {
+) -> Chosen<Batch> {
     let frames = reading.frames;
     let items = config.training.batch_shape(frames).items;
-    let Some(budget) = config.training.frames_per_step else {
-        return format!(
-            "batch           {items} copies of the whole clip (the configuration's batch_size; it sets no frames_per_step)"
-        );
+    let budget = config.training.frames_per_step;
+    let theirs = Batch {
+        items,
+        frames,
+        budget,
     };
-    let noun = if items == 1 { "item" } else { "items" };
-    let theirs =
-        format!("{items} {noun} of the clip's {frames} frames from {budget} frames a step");
+    let Some(budget) = budget else {
+        return Chosen::new(theirs, Reason::NoFrameBudget);
+    };
     if !asked {
-        return format!("batch           {theirs} ({kept})");
+        return Chosen::new(theirs, Reason::NotAsked);
     }
     if calm {
-        return format!(
-            "batch           {theirs} (the configuration's): the rule pairs only a varied clip's items"
-        );
+        return Chosen::new(theirs, Reason::CalmKeepsBatch);
     }
     match paired_items(items, frames, budget, config.training.batch_size) {
         Some(paired) => {
             out.training.frames_per_step = Some(paired * frames);
-            format!(
-                "batch           {paired} items of the clip's {frames} frames, {} frames a step: the configuration's {budget} would make {items}, and a step's items are shared among the cores, so an odd count leaves one of two cores idle for part of every step",
-                paired * frames
-            )
+            let batch = Batch {
+                items: paired,
+                ..theirs
+            };
+            let reason = Reason::PairedItems {
+                configured_items: items,
+            };
+            Chosen::new(batch, reason)
         }
-        None if frames > budget => format!(
-            "batch           {theirs} (the configuration's): each item a random window of the longer clip"
-        ),
-        None if items == 1 => format!(
-            "batch           {theirs} (the configuration's): a single copy is left alone, as a second would double a step's frames"
-        ),
-        None => format!(
-            "batch           {theirs} (the configuration's): a multiple of {BATCH_ITEMS_MULTIPLE}, which the cores share evenly"
+        None if frames > budget => Chosen::new(theirs, Reason::WindowsOfLongerClip),
+        None if items == 1 => Chosen::new(theirs, Reason::SingleCopy),
+        None => Chosen::new(
+            theirs,
+            Reason::EvenItems {
+                multiple: BATCH_ITEMS_MULTIPLE,
+            },
         ),
     }
 }
@@ -86,8 +88,8 @@ pub fn paired_items(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::clip_rule::tests::{DEFAULT, reading};
-    use crate::clip_rule::{choose, not_calm_after_all};
+    use crate::choose::clip_rule::tests::{DEFAULT, reading};
+    use crate::choose::clip_rule::{choose, not_calm_after_all};
 
     #[test]
     fn paired_items_take_the_even_count_whose_frames_come_nearest_the_budget() {
@@ -137,8 +139,8 @@ mod tests {
             "what it replaces"
         );
         let line = choice
-            .lines
-            .iter()
+            .lines()
+            .into_iter()
             .find(|l| l.starts_with("batch"))
             .unwrap();
         assert!(
@@ -153,7 +155,7 @@ mod tests {
             Some(budget)
         );
         // A calm clip that no rung covered trains as a varied one, in pairs.
-        let after_all = not_calm_after_all(&config, calm, "no rung covered it");
+        let after_all = not_calm_after_all(&config, calm, 80.0, 1000);
         assert_eq!(after_all.config.training.frames_per_step, Some(818));
         let mut fixed = config.clone();
         fixed.from_clip.batch = false;
@@ -174,7 +176,7 @@ mod tests {
             let choice = choose(&config, clip);
             assert_eq!(choice.config.training.frames_per_step, Some(budget));
             choice
-                .lines
+                .lines()
                 .into_iter()
                 .find(|l| l.starts_with("batch"))
                 .unwrap()

@@ -1,5 +1,5 @@
-//! How a trainer comes to be: a new run in a folder that holds none (the rule that reads the
-//! clip applied), or a run resumed from its newest checkpoint.
+//! How a trainer comes to be: a new run of a final configuration in a folder that holds none,
+//! or a run resumed from its newest checkpoint.
 
 use std::collections::{BTreeSet, VecDeque};
 use std::path::{Path, PathBuf};
@@ -12,16 +12,16 @@ use burn::tensor::Device;
 use sinmdm::diffusion::Schedule;
 
 use super::{CLIP_COPY, CONFIG_COPY, LOSS_LOG, Trainer, fresh_parts, load_parts, saved_clip};
-use crate::checkpoint::{self, CheckpointState};
-use crate::clip_data::ClipData;
-use crate::clip_rule::RuleChoice;
+use crate::chosen::Choices;
+use crate::clip::ClipData;
 use crate::config::TrainConfig;
 use crate::error::{TrainError, io};
-use crate::loss_log::LossLog;
 use crate::model::QnaUnet;
-use crate::recovery::RecoveryRecord;
-use crate::run_folder::clip_copy;
-use crate::weight_average::WeightAverage;
+use crate::run::checkpoint::{self, CheckpointState};
+use crate::run::folder::clip_copy;
+use crate::run::loss_log::LossLog;
+use crate::run::recovery::RecoveryRecord;
+use crate::run::weight_average::WeightAverage;
 
 /// The schedule of a configuration.
 fn schedule(config: &TrainConfig) -> Schedule {
@@ -55,7 +55,7 @@ impl Trainer {
             session_start: Instant::now(),
             last_checkpoint,
             injected_faults: BTreeSet::new(),
-            rule: None,
+            chosen: None,
         }
     }
 
@@ -71,7 +71,8 @@ impl Trainer {
     }
 
     /// Starts a new run of `config` on `clip` in the folder `run` (created if needed; it must
-    /// not already hold a run).
+    /// not already hold a run). `config` trains as written: one whose `from_clip` section leaves
+    /// settings to the rule that reads the clip is refused ([`TrainError::RuleNotApplied`]).
     pub fn start(
         clip: &Path,
         config: TrainConfig,
@@ -79,52 +80,35 @@ impl Trainer {
         device: Device,
     ) -> Result<Trainer, TrainError> {
         Trainer::check_new_run(run)?;
+        Trainer::check_final(&config)?;
         let data = ClipData::load(clip, &config.data, &config.model)?;
-        Trainer::start_loaded(clip, data, config, run, device)
+        Trainer::start_chosen(clip, data, config, None, run, device)
     }
 
-    /// [`Trainer::start`] for a clip already read: `data` is `clip` as [`ClipData::load`] read
-    /// it with `config`'s data section.
-    pub fn start_loaded(
-        clip: &Path,
-        data: ClipData,
-        config: TrainConfig,
-        run: &Path,
-        device: Device,
-    ) -> Result<Trainer, TrainError> {
-        // (The steps of a calm clip are left to the step ladder, which `step_ladder::start_run`
-        // climbs before it starts the run; called directly, a calm clip trains the ladder's most.)
-        match crate::clip_rule::apply(&config, &data) {
-            Some(choice) => Trainer::start_chosen(clip, data, choice, run, device),
-            None => Trainer::begin(clip, data, config, None, run, device),
+    /// An error when `config` still leaves settings to the rule that reads the clip.
+    fn check_final(config: &TrainConfig) -> Result<(), TrainError> {
+        if config.from_clip.is_off() {
+            Ok(())
+        } else {
+            Err(TrainError::RuleNotApplied)
         }
     }
 
-    /// [`Trainer::start_loaded`] once the rule that reads the clip has chosen: `choice.config`
-    /// trains, and `choice` is what the run says the rule chose.
+    /// Starts a new run of the final configuration `config` (the rule that reads the clip, if
+    /// any, applied) on the clip `data` was read from (`clip`, read with `config`'s data
+    /// section); `chosen` is what the rule chose and why, which the run keeps and prints.
     pub fn start_chosen(
         clip: &Path,
         data: ClipData,
-        choice: RuleChoice,
-        run: &Path,
-        device: Device,
-    ) -> Result<Trainer, TrainError> {
-        let config = choice.config.clone();
-        Trainer::begin(clip, data, config, Some(choice), run, device)
-    }
-
-    /// Starts a new run of `config` (the rule, if any, applied) on the clip `data` was read from.
-    fn begin(
-        clip: &Path,
-        data: ClipData,
         config: TrainConfig,
-        rule: Option<RuleChoice>,
+        chosen: Option<Choices>,
         run: &Path,
         device: Device,
     ) -> Result<Trainer, TrainError> {
         Trainer::check_new_run(run)?;
-        // The run saves the numbers it trains: what the rule that reads the clip chose, a
-        // window that follows the frame rate and a root layout chosen from the clip, resolved.
+        Trainer::check_final(&config)?;
+        // The run saves the numbers it trains: a window that follows the frame rate and a root
+        // layout chosen from the clip, resolved.
         let mut config = config.at_fps(data.facts.layout.fps);
         config.data.root_layout = data.facts.root_layout();
         std::fs::create_dir_all(run).map_err(io("create the output folder", run))?;
@@ -153,7 +137,7 @@ impl Trainer {
         };
         let parts = (model, average, optimizer);
         let mut trainer = Trainer::assemble(run, device, parts, data, state, log, None);
-        trainer.rule = rule;
+        trainer.chosen = chosen;
         Ok(trainer)
     }
 

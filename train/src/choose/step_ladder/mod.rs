@@ -1,6 +1,6 @@
 //! A calm clip's steps, chosen by its own samples: the step ladder.
 //!
-//! A calm clip (see [`crate::clip_rule`]) is covered within a few hundred steps, and the longer
+//! A calm clip (see [`crate::choose::clip_rule`]) is covered within a few hundred steps, and the longer
 //! it trains the longer its samples replay it verbatim. How few steps a calm clip can train and
 //! still be covered, and how many it can train before it replays, differ from clip to clip in
 //! ways one number read before training did not predict on clips it was not chosen on
@@ -28,13 +28,14 @@ use burn::tensor::Device;
 use sinmdm::motion::encode_for_model;
 use sinmdm_formats::{AnimationChoice, FileAccess, ReadOptions, read_clip_with_access};
 
-pub use crate::ladder_settings::{CHECK_SAMPLES, CHECK_SEED, LADDER_STEPS, goals};
+pub use crate::choose::ladder_settings::{CHECK_SAMPLES, CHECK_SEED, LADDER_STEPS, goals};
 
-use crate::clip_data::ClipData;
-use crate::clip_rule::RuleChoice;
+use crate::choose::clip_rule::{self, RuleChoice};
+use crate::chosen::{Chosen, Reason};
+use crate::clip::ClipData;
 use crate::config::TrainConfig;
 use crate::error::TrainError;
-use crate::trainer::{RunEnd, Trainer};
+use crate::run::{RunEnd, Trainer};
 
 mod rung_check;
 
@@ -137,7 +138,7 @@ impl Ladder {
         let mut rung = config.clone();
         rung.from_clip = Default::default();
         rung.training.steps = steps;
-        rung.training.warmup_steps = crate::clip_rule::calm_warmup_steps(steps);
+        rung.training.warmup_steps = clip_rule::calm_warmup_steps(steps);
         rung.training.checkpoint_every = steps;
         rung
     }
@@ -260,12 +261,12 @@ impl Ladder {
     }
 }
 
-/// Starts a new run of `config` on `clip` in the folder `run`, as [`Trainer::start`] does, but
-/// for a calm clip whose steps the rule that reads the clip was asked for, climbs `ladder`
-/// ([`Ladder::default`] for the trainer) first (in [`folder`]`(run)`) and trains the rung it chooses, or trains the clip as a
-/// varied one when no rung covers it. `on_rung` hears each rung's scores; `None` when the stop
-/// flag was raised during the climb (the same command starts again and keeps the finished
-/// rungs).
+/// Starts a new run of `config` on `clip` in the folder `run`: reads the clip, applies the rule
+/// that reads it where the configuration asks for it ([`clip_rule::apply`]), and for a calm clip
+/// whose steps the rule was asked for, climbs `ladder` ([`Ladder::default`] for the trainer)
+/// first (in [`folder`]`(run)`) and trains the rung it chooses, or trains the clip as a varied
+/// one when no rung covers it. `on_rung` hears each rung's scores; `None` when the stop flag was
+/// raised during the climb (the same command starts again and keeps the finished rungs).
 pub fn start_run(
     clip: &Path,
     config: TrainConfig,
@@ -277,10 +278,15 @@ pub fn start_run(
 ) -> Result<Option<Trainer>, TrainError> {
     Trainer::check_new_run(run)?;
     let data = ClipData::load(clip, &config.data, &config.model)?;
-    let choice = match crate::clip_rule::apply(&config, &data) {
+    let choice = match clip_rule::apply(&config, &data) {
         Some(choice) if choice.climb_ladder => choice,
-        Some(choice) => return Trainer::start_chosen(clip, data, choice, run, device).map(Some),
-        None => return Trainer::start_loaded(clip, data, config, run, device).map(Some),
+        Some(choice) => {
+            let RuleChoice {
+                config, choices, ..
+            } = choice;
+            return Trainer::start_chosen(clip, data, config, Some(choices), run, device).map(Some);
+        }
+        None => return Trainer::start_chosen(clip, data, config, None, run, device).map(Some),
     };
     let on_clip = LadderClip {
         path: clip,
@@ -297,48 +303,39 @@ pub fn start_run(
         Climb::Done(rungs) => rungs,
         Climb::Interrupted => return Ok(None),
     };
-    let mut chosen = match choose(&rungs) {
+    let mut chosen = climbed(&config, choice, &rungs);
+    chosen.choices.rungs = rungs.iter().map(RungCheck::line).collect();
+    let RuleChoice {
+        config, choices, ..
+    } = chosen;
+    Trainer::start_chosen(clip, data, config, Some(choices), run, device).map(Some)
+}
+
+/// The rule's choice once the ladder has climbed: `choice` with the steps of the rung it
+/// chooses, or, where no rung covers the clip, the clip trained as a varied one (`config` is the
+/// configuration the rule was applied to).
+fn climbed(config: &TrainConfig, choice: RuleChoice, rungs: &[RungCheck]) -> RuleChoice {
+    match choose(rungs) {
         Some(best) => {
-            let mut chosen = choice.config;
-            chosen.training.steps = best.steps;
-            chosen.training.warmup_steps = crate::clip_rule::calm_warmup_steps(best.steps);
-            let why = if best.meets_goals() {
-                "the rung of the step ladder that meets every goal with the widest margin"
-            } else {
-                "no rung of the step ladder meets every goal; this one moves most like the clip, then misses the rest by least in all"
+            let mut chosen = choice;
+            let warmup = clip_rule::calm_warmup_steps(best.steps);
+            chosen.config.training.steps = best.steps;
+            chosen.config.training.warmup_steps = warmup;
+            let reason = Reason::LadderRung {
+                warmup,
+                meets_goals: best.meets_goals(),
             };
-            let mut lines = choice.lines;
-            for line in lines.iter_mut().filter(|l| l.starts_with("steps ")) {
-                *line = format!(
-                    "steps           {} (warm-up {}): {why}",
-                    chosen.training.steps, chosen.training.warmup_steps
-                );
-            }
-            RuleChoice {
-                config: chosen,
-                lines,
-                ..choice
-            }
+            chosen.choices.steps = Chosen::new(best.steps, reason);
+            chosen
         }
         None => {
             let most = rungs
                 .iter()
                 .max_by(|a, b| a.coverage.total_cmp(&b.coverage))
                 .expect("the ladder has rungs");
-            let why = format!(
-                "no short run of the step ladder covered it (at most {:.1} at {} steps)",
-                most.coverage, most.steps
-            );
-            crate::clip_rule::not_calm_after_all(&config, choice.reading, &why)
+            clip_rule::not_calm_after_all(config, choice.reading, most.coverage, most.steps)
         }
-    };
-    chosen
-        .lines
-        .push("step ladder (each rung's samples, scored):".into());
-    chosen
-        .lines
-        .extend(rungs.iter().map(|r| format!("  {}", r.line())));
-    Trainer::start_chosen(clip, data, chosen, run, device).map(Some)
+    }
 }
 
 /// The ladder folder of the run folder `run`.

@@ -97,7 +97,7 @@ mod tests {
     use ndarray::Array2;
 
     fn default_model() -> ModelConfig {
-        TrainConfig::parse(include_str!("../../configs/default.yaml"))
+        TrainConfig::parse(include_str!("../../../configs/default.yaml"))
             .unwrap()
             .model
     }

@@ -7,11 +7,11 @@ use burn::module::Module;
 use burn::optim::ModuleOptimizer;
 use serde::{Deserialize, Serialize};
 
-use crate::clip_data::ClipFacts;
+use crate::clip::ClipFacts;
 use crate::config::{BatchShape, TrainConfig};
 use crate::error::{TrainError, io};
 use crate::model::QnaUnet;
-use crate::recovery::RecoveryRecord;
+use crate::run::recovery::RecoveryRecord;
 
 /// Checkpoints kept on disk (older ones are removed after a new one is complete).
 pub const KEPT_CHECKPOINTS: usize = 2;

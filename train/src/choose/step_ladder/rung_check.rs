@@ -7,8 +7,8 @@ use serde::{Deserialize, Serialize};
 
 use sinmdm_eval::KinematicScores;
 
+use crate::choose::ladder_settings::goals;
 use crate::error::TrainError;
-use crate::ladder_settings::goals;
 
 /// The scores file of a finished rung.
 const CHECK_FILE: &str = "check.json";

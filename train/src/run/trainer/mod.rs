@@ -11,26 +11,24 @@ use burn::tensor::{Device, Tensor, TensorData};
 
 use sinmdm::diffusion::Schedule;
 
-use crate::checkpoint::{self, CheckpointState};
-use crate::clip_data::ClipData;
-use crate::clip_rule::RuleChoice;
+use crate::chosen::Choices;
+use crate::clip::ClipData;
+use crate::clip::batch::make_batch;
+use crate::clip::motion_span;
 use crate::config::TrainConfig;
-use crate::data::make_batch;
 use crate::error::TrainError;
-use crate::loss_log::LossLog;
 use crate::model::QnaUnet;
-pub use crate::pace::StepReport;
-use crate::recovery::RecoveryEvent;
-pub use crate::run_folder::{CLIP_COPY, CONFIG_COPY, LOSS_LOG, saved_clip};
-use crate::step::step_with_fault;
-pub use crate::step::{StepOutcome, new_optimizer, optimisation_step};
-use crate::weight_average::WeightAverage;
+use crate::run::checkpoint::{self, CheckpointState};
+pub use crate::run::folder::{CLIP_COPY, CONFIG_COPY, LOSS_LOG, saved_clip};
+use crate::run::loss_log::LossLog;
+pub use crate::run::pace::StepReport;
+use crate::run::recovery::RecoveryEvent;
+use crate::run::step::step_with_fault;
+pub use crate::run::step::{StepOutcome, new_optimizer, optimisation_step};
+use crate::run::weight_average::WeightAverage;
 
 mod roll_back;
 mod start;
-mod timing_probe;
-
-pub use timing_probe::seconds_per_step;
 
 /// Steps averaged into `recent_loss`.
 const RECENT_STEPS: usize = 100;
@@ -61,8 +59,8 @@ pub struct Trainer {
     last_checkpoint: Option<PathBuf>,
     /// Steps (1-based) whose gradients tests turn into NaN, once each.
     injected_faults: BTreeSet<u64>,
-    /// What the rule that reads the clip chose for a new run started here.
-    rule: Option<RuleChoice>,
+    /// What the rule that reads the clip chose for a new run started here, and why.
+    chosen: Option<Choices>,
 }
 
 /// A new network, its weight average and optimiser for `config`, drawn from the run's seed.
@@ -125,21 +123,21 @@ impl Trainer {
     }
 
     /// A line for the user when the clip's motion stays correlated for much longer than the
-    /// network sees at once ([`crate::motion_span::wider_window_hint`]); none when the rule that
-    /// reads the clip chose the window.
+    /// network sees at once ([`motion_span::wider_window_hint`]); none when the rule that reads
+    /// the clip chose the window.
     pub fn wider_window_hint(&self) -> Option<String> {
-        if self.rule.as_ref().is_some_and(|r| r.window_from_clip) {
+        if self.chosen.as_ref().is_some_and(Choices::window_from_clip) {
             return None;
         }
         let fps = self.clip.facts.layout.fps;
-        let frames = crate::motion_span::decorrelation_frames(self.clip.features.view(), fps)?;
-        crate::motion_span::wider_window_hint(frames, fps, &self.state.config.model)
+        let frames = motion_span::decorrelation_frames(self.clip.features.view(), fps)?;
+        motion_span::wider_window_hint(frames, fps, &self.state.config.model)
     }
 
-    /// What the rule that reads the clip chose for this run, a line per setting, when it was
-    /// started here with a configuration that asks for the rule ([`crate::clip_rule`]).
-    pub fn rule_lines(&self) -> Option<&[String]> {
-        self.rule.as_ref().map(|r| r.lines.as_slice())
+    /// What the rule that reads the clip chose for this run, and why, when it was started here
+    /// with a configuration that asked for the rule.
+    pub fn chosen(&self) -> Option<&Choices> {
+        self.chosen.as_ref()
     }
 
     /// Whether all configured steps are done.
@@ -153,7 +151,7 @@ impl Trainer {
 
     /// Runs one optimiser step and returns its report. A step whose loss or gradients are not
     /// finite changes nothing and is skipped, and repeated ones roll the run back
-    /// ([`crate::recovery`]); the report's `event` says so. The error is for a run that could
+    /// ([`crate::run::recovery`]); the report's `event` says so. The error is for a run that could
     /// not be recovered, or a checkpoint that could not be read or written.
     pub fn step(&mut self) -> Result<StepReport, TrainError> {
         let config = &self.state.config;

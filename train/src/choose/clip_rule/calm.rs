@@ -2,6 +2,8 @@
 //! rung covers trains as a varied one.
 
 use super::{CALM_INTRA_BELOW, ClipReading, RuleChoice, choose_kind};
+use crate::choose::ladder_settings::LADDER_STEPS;
+use crate::chosen::{Chosen, ClipKind, Reason};
 use crate::config::TrainConfig;
 
 /// Warm-up steps of a calm clip's cosine schedule: a third of its steps.
@@ -11,34 +13,31 @@ pub fn calm_warmup_steps(steps: u64) -> u64 {
 
 /// The most steps a calm clip trains: the step ladder's top rung.
 pub fn calm_most_steps() -> u64 {
-    crate::ladder_settings::LADDER_STEPS[crate::ladder_settings::LADDER_STEPS.len() - 1]
+    LADDER_STEPS[LADDER_STEPS.len() - 1]
 }
 
 /// The rule's choice for a calm clip that no rung of the step ladder covered: it trains as a
-/// varied clip. `ladder` says how far the ladder got.
-pub fn not_calm_after_all(config: &TrainConfig, reading: ClipReading, ladder: &str) -> RuleChoice {
-    let kind = format!(
-        "varied: its own intra diversity {:.3} is under {CALM_INTRA_BELOW}, but {ladder}",
-        reading.intra_diversity
-    );
-    choose_kind(config, reading, false, kind)
-}
-
-/// The ladder's rungs as words: "50, 75, ... and 300".
-pub(super) fn ladder_list() -> String {
-    let steps: Vec<String> = crate::ladder_settings::LADDER_STEPS
-        .iter()
-        .map(u64::to_string)
-        .collect();
-    let (last, rest) = steps.split_last().expect("the ladder has rungs");
-    format!("{} and {last}", rest.join(", "))
+/// varied clip. The best rung covered `most_coverage` at `at_steps` steps.
+pub fn not_calm_after_all(
+    config: &TrainConfig,
+    reading: ClipReading,
+    most_coverage: f64,
+    at_steps: u64,
+) -> RuleChoice {
+    let reason = Reason::NotCalmAfterAll {
+        intra_diversity: reading.intra_diversity,
+        below: CALM_INTRA_BELOW,
+        most_coverage,
+        at_steps,
+    };
+    choose_kind(config, reading, Chosen::new(ClipKind::Varied, reason))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::clip_rule::tests::{DEFAULT, reading};
-    use crate::clip_rule::{VARIED_WINDOW, choose};
+    use crate::choose::clip_rule::tests::{DEFAULT, reading};
+    use crate::choose::clip_rule::{VARIED_WINDOW, choose};
 
     #[test]
     fn a_calm_clip_leaves_its_steps_to_the_ladder_and_keeps_the_shape() {
@@ -52,12 +51,12 @@ mod tests {
         assert_eq!(out.model.window, config.model.window);
         assert_eq!(out.model.dropout, config.model.dropout);
         assert!(out.from_clip.is_off());
-        assert!(choice.lines[0].contains("calm: its own intra diversity 0.500 is under 0.7"));
+        assert!(choice.lines()[0].contains("calm: its own intra diversity 0.500 is under 0.7"));
         assert!(
-            choice.lines[1]
+            choice.lines()[1]
                 .contains("short runs of 50, 75, 100, 150, 200, 250, 300, 400, 600 and 1000 steps"),
             "{:?}",
-            choice.lines
+            choice.lines()
         );
         out.validate().unwrap();
         // Not asked for the steps, the rule leaves them as written and climbs nothing.
@@ -70,15 +69,18 @@ mod tests {
     #[test]
     fn a_calm_clip_no_rung_covers_trains_as_a_varied_one() {
         let config = TrainConfig::parse(DEFAULT).unwrap();
-        let choice = not_calm_after_all(&config, reading(0.6), "no rung covered it");
+        let choice = not_calm_after_all(&config, reading(0.6), 80.0, 1000);
         assert!(!choice.climb_ladder);
         assert_eq!(choice.config.training.steps, config.training.steps);
         assert_eq!(choice.config.model.window, VARIED_WINDOW);
         assert_eq!(choice.config.model.dropout, config.model.dropout);
         assert!(
-            choice.lines[0].contains("varied") && choice.lines[0].contains("no rung covered it"),
+            choice.lines()[0].contains("varied")
+                && choice.lines()[0].contains(
+                    "no short run of the step ladder covered it (at most 80.0 at 1000 steps)"
+                ),
             "{:?}",
-            choice.lines
+            choice.lines()
         );
     }
 }

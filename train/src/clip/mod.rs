@@ -1,4 +1,5 @@
-//! The clip a model learns: read, encoded, normalised, and fingerprinted.
+//! The clip a model learns: read, encoded, normalised, and fingerprinted; the noised batches
+//! drawn from it ([`batch`]); how long its motion stays correlated ([`motion_span`]).
 
 use std::path::Path;
 
@@ -17,6 +18,9 @@ use sinmdm_formats::{
 
 use crate::config::{DataConfig, ModelConfig};
 use crate::error::TrainError;
+
+pub mod batch;
+pub mod motion_span;
 
 /// What a trained model must remember about its clip (saved in every checkpoint, and later in
 /// the ONNX metadata).

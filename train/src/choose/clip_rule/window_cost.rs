@@ -31,8 +31,8 @@ pub fn steps_at_window(steps: u64, at_30: usize, trained: usize) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::clip_rule::tests::{DEFAULT, reading};
-    use crate::clip_rule::{
+    use crate::choose::clip_rule::tests::{DEFAULT, reading};
+    use crate::choose::clip_rule::{
         ClipReading, MANY_FEET_STEPS, MANY_FEET_WINDOW, VARIED_WINDOW, calm_most_steps, choose,
     };
     use crate::config::TrainConfig;
@@ -73,11 +73,11 @@ mod tests {
             );
             assert!(out.training.warmup_steps <= out.training.steps / 10);
             assert!(
-                choice.lines[1].starts_with(&format!("steps           {}:", out.training.steps))
-                    && choice.lines[1].contains(&format!("at 60 fps the window is {trained}"))
-                    && choice.lines[1].contains(&format!("meant at 30 fps, {steps}")),
+                choice.lines()[1].starts_with(&format!("steps           {}:", out.training.steps))
+                    && choice.lines()[1].contains(&format!("at 60 fps the window is {trained}"))
+                    && choice.lines()[1].contains(&format!("meant at 30 fps, {steps}")),
                 "{:?}",
-                choice.lines
+                choice.lines()
             );
             out.validate().unwrap();
             // At 30 fps, or with a window that does not follow the frame rate, nothing falls.

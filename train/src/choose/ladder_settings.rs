@@ -1,5 +1,5 @@
 //! The step ladder's settings: its rungs, how a rung is checked and the goals it is held to
-//! ([`crate::step_ladder`] climbs it; [`crate::clip_rule`] describes it before training).
+//! ([`super::step_ladder`] climbs it; [`super::clip_rule`] describes it before training).
 
 /// The steps of each rung, fewest first.
 pub const LADDER_STEPS: [u64; 10] = [50, 75, 100, 150, 200, 250, 300, 400, 600, 1000];

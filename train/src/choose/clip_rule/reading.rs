@@ -2,7 +2,7 @@
 //! and feet, and whether that makes it calm or a clip on many feet.
 
 use super::{CALM_INTRA_BELOW, MANY_FEET};
-use crate::clip_data::ClipData;
+use crate::clip::ClipData;
 
 /// What the rule reads from a clip before training.
 #[derive(Debug, Clone, Copy, PartialEq)]

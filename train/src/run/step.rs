@@ -6,8 +6,8 @@ use burn::tensor::Tensor;
 
 use crate::config::TrainConfig;
 use crate::model::{QnaUnet, on_cpu};
-use crate::recovery::NonFinite;
-use crate::shards::{gradients_are_finite, poison_first_gradient, sharded_gradients};
+use crate::run::recovery::NonFinite;
+use crate::run::shards::{gradients_are_finite, poison_first_gradient, sharded_gradients};
 
 /// How one optimiser step ended.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -12,7 +12,7 @@ const WINDOW: usize = 100;
 
 /// Draws the loss log at `log` as a PNG at `png`.
 pub fn write(log: &Path, png: &Path) -> Result<(), TrainError> {
-    let rows = crate::loss_log::read(log)?;
+    let rows = crate::run::loss_log::read(log)?;
     let raw: Vec<(f64, f64)> = rows.iter().map(|&(s, l)| (s as f64, l)).collect();
     let mut mean = Vec::with_capacity(raw.len());
     let mut sum = 0.0;

@@ -4,10 +4,10 @@
 use std::time::Instant;
 
 use super::{LOSS_LOG, StepReport, Trainer, fresh_parts, load_parts};
-use crate::checkpoint::{self, CheckpointState};
 use crate::error::TrainError;
-use crate::loss_log::LossLog;
-use crate::recovery::{NonFinite, RecoveryEvent, RecoveryRecord};
+use crate::run::checkpoint::{self, CheckpointState};
+use crate::run::loss_log::LossLog;
+use crate::run::recovery::{NonFinite, RecoveryEvent, RecoveryRecord};
 
 impl Trainer {
     /// A step whose update was skipped: recorded, then either passed over (its batch dropped,
@@ -47,6 +47,7 @@ impl Trainer {
             return Err(TrainError::Unrecoverable {
                 step: at,
                 to: target.step,
+                rollbacks: crate::run::recovery::MAX_ROLLBACKS,
                 tried: record.summary(),
                 last_checkpoint: checkpoint,
             });
