@@ -68,6 +68,20 @@ def ladder_rungs(run: pathlib.Path) -> list[dict]:
     return sorted(checks, key=lambda c: c["steps"])
 
 
+def kinematic_cells(rung: dict) -> str:
+    """A rung's kinematic figures as three table cells (blank for a rung scored before the
+    check measured them)."""
+    k = rung.get("kinematics")
+    if not k:
+        return " | | "
+    p25, p50, p90 = k["speed_ratios"]
+    return (
+        f"{100 * k['still_share']:.1f} ({100 * rung['clip_still_share']:.1f}) | "
+        f"{p25:.2f} / {p50:.2f} / {p90:.2f} | "
+        f"{k['speed_distance']:.2f} / {k['acceleration_distance']:.2f}"
+    )
+
+
 def ladder_section(rungs: list[dict], chosen: int) -> list[str]:
     """The card's table of the step ladder: each rung's samples as the trainer scored them."""
     if not rungs:
@@ -79,14 +93,15 @@ def ladder_section(rungs: list[dict], chosen: int) -> list[str]:
         "ladder: lab/EXPERIMENTS.md, *The step ladder*; 20 samples of twice the clip, "
         f"seed 1, default sampling). It trained the {chosen}-step rung:",
         "",
-        "| rung | coverage | replay (s) | jitter x clip | global diversity | train + check (s) |",
-        "|---|---|---|---|---|---|",
+        "| rung | coverage | replay (s) | jitter x clip | global diversity | still % (clip) "
+        "| speed p25 / p50 / p90 x clip | speed / acc. distance | train + check (s) |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rungs:
         mark = " (chosen)" if r["steps"] == chosen else ""
         text.append(
             f"| {r['steps']}{mark} | {r['coverage']:.1f} | {r['replay_seconds']:.2f} | "
-            f"{r['jitter_ratio']:.2f} | {r['global_diversity']:.3f} | "
+            f"{r['jitter_ratio']:.2f} | {r['global_diversity']:.3f} | {kinematic_cells(r)} | "
             f"{r['train_seconds']:.0f} + {r['check_seconds']:.0f} |"
         )
     return text + [""]
