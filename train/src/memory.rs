@@ -2,9 +2,8 @@
 //!
 //! A training step allocates and frees hundreds of tensors of several megabytes. glibc's
 //! allocator hands blocks that large back to the kernel on every free, so each new tensor
-//! costs page faults and page clearing: about a third of a step's time at the paper size.
-//! Keeping freed memory in the heap removes that (1.6 s instead of 2.4 s per step at C 256,
-//! batch 64, on 2 cores).
+//! costs page faults and page clearing, a large share of a step at the paper size; keeping freed
+//! memory in the heap removes that (docs/PERFORMANCE.md).
 
 /// Tells the C allocator to serve large blocks from the heap and not to give freed memory back.
 /// Call once at start-up, before tensors are made. A no-op outside glibc.

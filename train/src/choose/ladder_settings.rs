@@ -11,8 +11,8 @@ pub const CHECK_SEED: u64 = 1;
 /// The goals a calm clip's samples are held to: the adaptive default's (coverage, replay, jitter
 /// at most 1.5x the clip's), and one it does not set, jitter at least the clip's divided by 1.5.
 /// Without that mirror bound the ladder would choose the least-trained rung whenever every rung
-/// covers the clip, and those samples are smoother than the clip (a happy walk after 50 steps:
-/// 0.26x its jitter; lab/EXPERIMENTS.md, "The step ladder").
+/// covers the clip, and those samples are smoother than the clip (lab/EXPERIMENTS.md, "The step
+/// ladder").
 pub mod goals {
     /// Least coverage, in percent of the clip's windows.
     pub const COVERAGE: f64 = 95.0;

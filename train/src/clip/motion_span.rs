@@ -1,13 +1,11 @@
 //! How long a clip's motion stays correlated, read from its features before training, and the
 //! wider QnA window that a clip of long, slow motifs may want.
 //!
-//! The network sees a fixed number of frames at once (23 with the default window of 3: 0.77 s
-//! at 30 fps). Most clips decorrelate well within that: every feature's autocorrelation falls
-//! below zero in 0.2-0.7 s, the CMU walk's in 1.4 s. The MANN dog walk, a 17.6 s mix of walking,
-//! turning and stopping, stays correlated for 2.9 s, and its samples covered it far better with a
-//! wider field (coverage 80 % at window 3, 92 % at 7, 94 % at 11, at 30 fps). The trainer does
-//! not widen the window by itself (one clip in nine measured needs it, too few to fit a rule);
-//! it tells the user, who may train with `--window` (or set `model.window` in a `--config`).
+//! The network sees a fixed number of frames at once. A clip whose motion stays correlated for
+//! much longer than that (a long mix of walking, turning and stopping) is covered better with a
+//! wider field. The trainer does not widen the window by itself, as too few clips need it to fit
+//! a rule (lab/EXPERIMENTS.md, "The dog: half windows, wider windows, more channels"); it tells
+//! the user, who may train with `--window` (or set `model.window` in a `--config`).
 
 use ndarray::ArrayView2;
 

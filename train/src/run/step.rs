@@ -38,7 +38,7 @@ pub fn new_optimizer(config: &TrainConfig) -> ModuleOptimizer {
 /// The batch is cut into as many shards as rayon has threads (at least one item each), whose
 /// forward and backward passes run in parallel on their own threads. burn-flex runs element-wise
 /// operations on one thread, so this is what puts the other cores to work outside the matrix
-/// products (1.3-1.6x on 2 cores). Each shard's loss is weighted by its share of the batch, so the
+/// products (docs/PERFORMANCE.md). Each shard's loss is weighted by its share of the batch, so the
 /// summed gradients are those of the whole batch's mean loss; GroupNorm's statistics are per
 /// item and the dropout masks are keyed by item, so nothing else depends on the split, which
 /// is fixed for a given thread count (same seed and `--threads`, same run). The loss is the

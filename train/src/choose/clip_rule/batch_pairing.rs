@@ -8,9 +8,8 @@ use crate::config::TrainConfig;
 /// A varied clip that would train an odd count of copies of the clip a step, 3 or more, trains
 /// an even one: a multiple of this. The trainer shares a step's items among the cores, item by
 /// item, so an odd count leaves one of the two cores of the 10-minute goal's machine idle for
-/// part of every step: 3 items take as long as 4 (the rule's setting trained 13 000 steps of a
-/// dog of 409 frames in 13.2 minutes in 3 items, 7.2 in 2; lab/EXPERIMENTS.md, "Items
-/// in pairs"). A single copy is left alone: pairing it would double a step's frames, unmeasured.
+/// part of every step (lab/EXPERIMENTS.md, "Items in pairs"). A single copy is left alone:
+/// pairing it would double a step's frames.
 pub const BATCH_ITEMS_MULTIPLE: usize = 2;
 
 /// The rule's batch; it sets `out.training.frames_per_step` where it pairs the items.

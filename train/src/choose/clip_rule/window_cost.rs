@@ -3,9 +3,8 @@
 
 /// How much of a training step does not grow with the QnA window, in window frames: a step at
 /// window `k` costs about as much as `WINDOW_STEP_COST_OFFSET + k` frames of window
-/// ([`window_step_cost`]). Whole runs of the dog walk with 96 channels on 2 cores took 0.040 s a
-/// step at window 7 (30 fps) and 0.066 s at window 19 (60 fps), 1.65x, against 1.71x here
-/// (lab/EXPERIMENTS.md, "Steps at a higher frame rate").
+/// ([`window_step_cost`]), fitted to whole runs of a dog at two windows (lab/EXPERIMENTS.md,
+/// "Steps at a higher frame rate").
 pub const WINDOW_STEP_COST_OFFSET: f64 = 10.0;
 /// The steps fitted to a wider window's cost are rounded down to a multiple of this.
 pub const FITTED_STEPS_ROUNDING: u64 = 500;
