@@ -153,7 +153,6 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, kind: Chosen<ClipKind
     let window = choosing.window(&mut out, asked.window);
     let dropout = choosing.dropout(&mut out, asked.dropout);
     let channels = choosing.channels(&mut out, asked.channels);
-    let batch = batch_pairing::batch(config, &mut out, reading, asked.batch, calm);
     // The steps above are meant at 30 fps. At a higher rate the window follows the frame rate,
     // a step costs more, and a varied clip's steps fall to fit the same time.
     let steps = if asked.steps && !calm {
@@ -161,6 +160,7 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, kind: Chosen<ClipKind
     } else {
         meant
     };
+    let batch = batch_pairing::batch(config, &mut out, reading, asked.batch, calm);
     RuleChoice {
         reading,
         config: out,
