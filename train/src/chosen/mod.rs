@@ -64,6 +64,21 @@ pub enum FieldNeed {
 pub enum Reason {
     /// The configuration's: its `from_clip` section does not ask the rule for this setting.
     NotAsked,
+    /// The configuration's, kept for a calm clip: the rule changes the window, dropout, channels
+    /// and batch of a varied clip only.
+    CalmKeeps,
+    /// A varied clip on this many feet (three or more): the many-feet setting (more dropout, a
+    /// wider network).
+    ManyFeet {
+        /// The clip's feet.
+        feet: usize,
+    },
+    /// The configuration's, kept for a varied clip on this many feet (two or fewer): more
+    /// dropout damps its samples, and the configuration's width serves.
+    FewFeet {
+        /// The clip's feet.
+        feet: usize,
+    },
 
     /// The clip is calm: its own intra diversity is under `below`.
     CalmClip {
@@ -138,8 +153,6 @@ pub enum Reason {
         meant: Box<Chosen<u64>>,
     },
 
-    /// A calm clip keeps the configuration's window (the rule widens only a varied clip's).
-    CalmKeepsWindow,
     /// A varied clip's wider window.
     WiderField {
         /// Whether the window is meant at 30 fps (it follows the frame rate).
@@ -166,23 +179,6 @@ pub enum Reason {
         field: usize,
     },
 
-    /// A calm clip keeps the configuration's dropout.
-    CalmKeepsDropout,
-    /// A varied clip on many feet trains more dropout, which keeps its samples varied.
-    ManyFeetDropout {
-        /// The clip's feet.
-        feet: usize,
-    },
-    /// A varied clip on two feet keeps the configuration's dropout: more damps its samples.
-    FewFeetKeepDropout,
-
-    /// A calm clip keeps the configuration's channels.
-    CalmKeepsChannels,
-    /// A varied clip on many feet trains a wider network.
-    ManyFeetChannels {
-        /// The clip's feet.
-        feet: usize,
-    },
     /// A varied clip on many feet keeps the configuration's width: it is already as wide, or
     /// its heads do not divide the wider width.
     ChannelsStayAsConfigured {
@@ -191,16 +187,9 @@ pub enum Reason {
         /// The configuration's heads.
         heads: usize,
     },
-    /// A varied clip on few feet: the configuration's width serves.
-    FewFeetKeepChannels {
-        /// The clip's feet.
-        feet: usize,
-    },
 
     /// The configuration sets no frames a step: its batch of whole copies.
     NoFrameBudget,
-    /// A calm clip keeps the configuration's items (the rule pairs only a varied clip's).
-    CalmKeepsBatch,
     /// A varied clip's odd item count raised or lowered to an even one, which the cores share.
     PairedItems {
         /// The items the configuration's budget makes.

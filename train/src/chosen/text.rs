@@ -130,7 +130,7 @@ fn window_text(window: &Chosen<usize>) -> String {
     let value = window.value;
     match &window.reason {
         Reason::NotAsked => format!("{value} ({NOT_ASKED})"),
-        Reason::CalmKeepsWindow => {
+        Reason::CalmKeeps => {
             format!("{value} (the configuration's): the rule widens only a varied clip's")
         }
         Reason::WiderField { at_30, need } => {
@@ -157,13 +157,13 @@ fn dropout_text(dropout: &Chosen<f64>) -> String {
     let value = dropout.value;
     match &dropout.reason {
         Reason::NotAsked => format!("{value} ({NOT_ASKED})"),
-        Reason::CalmKeepsDropout => format!(
+        Reason::CalmKeeps => format!(
             "{value} (the configuration's): the rule raises only a varied clip's on three feet or more"
         ),
-        Reason::ManyFeetDropout { feet } => format!(
+        Reason::ManyFeet { feet } => format!(
             "{value}: on {feet} feet, keeps a varied clip's samples varied (more costs it coverage)"
         ),
-        Reason::FewFeetKeepDropout => format!(
+        Reason::FewFeet { .. } => format!(
             "{value} (the configuration's): more damps a varied clip's samples on two feet (their median speed falls below the clip's)"
         ),
         other => unexpected(other),
@@ -174,16 +174,16 @@ fn channels_text(channels: &Chosen<usize>) -> String {
     let value = channels.value;
     match &channels.reason {
         Reason::NotAsked => format!("{value} ({NOT_ASKED})"),
-        Reason::CalmKeepsChannels => {
+        Reason::CalmKeeps => {
             format!("{value} (the configuration's): the rule widens only a varied clip's network")
         }
-        Reason::ManyFeetChannels { feet } => format!(
+        Reason::ManyFeet { feet } => format!(
             "{value}: on {feet} feet, the network needs the width to hold every leg's phase at once"
         ),
         Reason::ChannelsStayAsConfigured { wide, heads } => format!(
             "{value} (the configuration's): at least {wide}, or {heads} heads do not divide {wide}"
         ),
-        Reason::FewFeetKeepChannels { feet } => format!(
+        Reason::FewFeet { feet } => format!(
             "{value} (the configuration's): on {feet} feet, the configuration's width serves"
         ),
         other => unexpected(other),
@@ -196,6 +196,7 @@ fn batch_text(batch: &Chosen<Batch>) -> String {
         frames,
         budget,
     } = batch.value;
+    // Without a budget the reason is `Reason::NoFrameBudget`, and its line says so.
     let Some(budget) = budget else {
         return format!(
             "{items} copies of the whole clip (the configuration's batch_size; it sets no frames_per_step)"
@@ -206,7 +207,7 @@ fn batch_text(batch: &Chosen<Batch>) -> String {
         format!("{items} {noun} of the clip's {frames} frames from {budget} frames a step");
     match &batch.reason {
         Reason::NotAsked => format!("{theirs} ({NOT_ASKED})"),
-        Reason::CalmKeepsBatch => {
+        Reason::CalmKeeps => {
             format!("{theirs} (the configuration's): the rule pairs only a varied clip's items")
         }
         Reason::PairedItems { configured_items } => format!(
@@ -221,9 +222,6 @@ fn batch_text(batch: &Chosen<Batch>) -> String {
         ),
         Reason::EvenItems { multiple } => format!(
             "{theirs} (the configuration's): a multiple of {multiple}, which the cores share evenly"
-        ),
-        Reason::NoFrameBudget => format!(
-            "{items} copies of the whole clip (the configuration's batch_size; it sets no frames_per_step)"
         ),
         other => unexpected(other),
     }

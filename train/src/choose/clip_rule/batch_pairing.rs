@@ -35,7 +35,7 @@ pub(super) fn batch(
         return Chosen::new(theirs, Reason::NotAsked);
     }
     if calm {
-        return Chosen::new(theirs, Reason::CalmKeepsBatch);
+        return Chosen::new(theirs, Reason::CalmKeeps);
     }
     match paired_items(items, frames, budget, config.training.batch_size) {
         Some(paired) => {

@@ -72,7 +72,7 @@ impl Choosing<'_> {
         let configured = config.model.window;
         match (asked, calm) {
             (false, _) => Chosen::new(configured, Reason::NotAsked),
-            (true, true) => Chosen::new(configured, Reason::CalmKeepsWindow),
+            (true, true) => Chosen::new(configured, Reason::CalmKeeps),
             (true, false) => {
                 let (wanted, need) = if reading.has_many_feet() {
                     let need = FieldNeed::ManyFeet { feet: reading.feet };
@@ -131,13 +131,13 @@ impl Choosing<'_> {
         let configured = config.model.dropout;
         match (asked, calm) {
             (false, _) => Chosen::new(configured, Reason::NotAsked),
-            (true, true) => Chosen::new(configured, Reason::CalmKeepsDropout),
+            (true, true) => Chosen::new(configured, Reason::CalmKeeps),
             (true, false) if reading.has_many_feet() => {
                 out.model.dropout = MANY_FEET_DROPOUT;
-                let reason = Reason::ManyFeetDropout { feet: reading.feet };
+                let reason = Reason::ManyFeet { feet: reading.feet };
                 Chosen::new(MANY_FEET_DROPOUT, reason)
             }
-            (true, false) => Chosen::new(configured, Reason::FewFeetKeepDropout),
+            (true, false) => Chosen::new(configured, Reason::FewFeet { feet: reading.feet }),
         }
     }
 
@@ -152,10 +152,10 @@ impl Choosing<'_> {
         let configured = config.model.channels;
         match (asked, calm) {
             (false, _) => Chosen::new(configured, Reason::NotAsked),
-            (true, true) => Chosen::new(configured, Reason::CalmKeepsChannels),
+            (true, true) => Chosen::new(configured, Reason::CalmKeeps),
             (true, false) if widen => {
                 out.model.channels = MANY_FEET_CHANNELS;
-                let reason = Reason::ManyFeetChannels { feet: reading.feet };
+                let reason = Reason::ManyFeet { feet: reading.feet };
                 Chosen::new(MANY_FEET_CHANNELS, reason)
             }
             (true, false) if reading.has_many_feet() => {
@@ -166,7 +166,7 @@ impl Choosing<'_> {
                 Chosen::new(configured, reason)
             }
             (true, false) => {
-                let reason = Reason::FewFeetKeepChannels { feet: reading.feet };
+                let reason = Reason::FewFeet { feet: reading.feet };
                 Chosen::new(configured, reason)
             }
         }

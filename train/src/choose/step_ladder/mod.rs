@@ -280,12 +280,7 @@ pub fn start_run(
     let data = ClipData::load(clip, &config.data, &config.model)?;
     let choice = match clip_rule::apply(&config, &data) {
         Some(choice) if choice.climb_ladder => choice,
-        Some(choice) => {
-            let RuleChoice {
-                config, choices, ..
-            } = choice;
-            return Trainer::start_chosen(clip, data, config, Some(choices), run, device).map(Some);
-        }
+        Some(choice) => return start_chosen(clip, data, choice, run, device).map(Some),
         None => return Trainer::start_chosen(clip, data, config, None, run, device).map(Some),
     };
     let on_clip = LadderClip {
@@ -305,10 +300,21 @@ pub fn start_run(
     };
     let mut chosen = climbed(&config, choice, &rungs);
     chosen.choices.rungs = rungs.iter().map(RungCheck::line).collect();
+    start_chosen(clip, data, chosen, run, device).map(Some)
+}
+
+/// Starts the run the rule chose: its configuration, and the record of what it chose and why.
+fn start_chosen(
+    clip: &Path,
+    data: ClipData,
+    choice: RuleChoice,
+    run: &Path,
+    device: Device,
+) -> Result<Trainer, TrainError> {
     let RuleChoice {
         config, choices, ..
-    } = chosen;
-    Trainer::start_chosen(clip, data, config, Some(choices), run, device).map(Some)
+    } = choice;
+    Trainer::start_chosen(clip, data, config, Some(choices), run, device)
 }
 
 /// The rule's choice once the ladder has climbed: `choice` with the steps of the rung it
