@@ -110,6 +110,15 @@ namespace Sinmdm
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_stream_next(StreamHandle stream, ModelHandle model, UIntPtr frames, ref PoseBuffers buffers);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_stream_step(StreamHandle stream, ModelHandle model, UIntPtr maxSteps, UIntPtr ahead, out UIntPtr ready, out UIntPtr done, out UIntPtr total);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern void sinmdm_stream_free(IntPtr stream);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_new(ModelHandle model, out CrowdHandle crowd);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_join(CrowdHandle crowd, ref StreamOptions options, out ulong id);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_leave(CrowdHandle crowd, ulong id);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_count(CrowdHandle crowd, out UIntPtr count);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_steer(CrowdHandle crowd, ulong id, SteerFrame[] commands, UIntPtr count);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_supply(CrowdHandle crowd, ModelHandle model, ulong id, ref PosesIn poses);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_step(CrowdHandle crowd, ModelHandle model, UIntPtr maxRounds, UIntPtr ahead, out UIntPtr rounds, out UIntPtr waiting);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_next(CrowdHandle crowd, ModelHandle model, ulong id, UIntPtr frames, ref PoseBuffers buffers);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern void sinmdm_crowd_free(IntPtr crowd);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_write_bvh(ModelHandle model, ref PosesIn poses, byte[] path);
 
         internal static byte[] Utf8(string text)
@@ -243,5 +252,13 @@ namespace Sinmdm
         public StreamHandle() : base(IntPtr.Zero, true) { }
         public override bool IsInvalid => handle == IntPtr.Zero;
         protected override bool ReleaseHandle() { Native.sinmdm_stream_free(handle); return true; }
+    }
+
+    /// <summary>The native handle of a crowd.</summary>
+    public sealed class CrowdHandle : SafeHandle
+    {
+        public CrowdHandle() : base(IntPtr.Zero, true) { }
+        public override bool IsInvalid => handle == IntPtr.Zero;
+        protected override bool ReleaseHandle() { Native.sinmdm_crowd_free(handle); return true; }
     }
 }

@@ -614,6 +614,84 @@ namespace Sinmdm
 
     /// <summary>Endless motion, a chunk at a time (the same whatever chunk sizes are asked).
     /// Named so as not to clash with System.IO.Stream.</summary>
+    /// <summary>Many characters of one model, each an endless stream, made together: one
+    /// network call per step for the whole crowd, each character the same bits as its
+    /// MotionStream alone. Characters join and leave at any frame.</summary>
+    public sealed class Crowd : IDisposable
+    {
+        readonly CrowdHandle handle;
+        readonly Model model;
+
+        public Crowd(Model model)
+        {
+            if (model == null) throw new ArgumentNullException(nameof(model));
+            this.model = model;
+            int status = Native.sinmdm_crowd_new(model.Handle, out handle);
+            if (status != 0) { handle.Dispose(); Native.Check(status); }
+        }
+
+        /// <summary>A new character with a stream's settings; its number, never given again.</summary>
+        public ulong Join(StreamSettings settings)
+        {
+            var joints = Native.Indices(settings.ComposeJoints, nameof(settings.ComposeJoints));
+            var pinned = GCHandle.Alloc(joints, GCHandleType.Pinned);
+            try
+            {
+                var options = new Native.StreamOptions
+                {
+                    Seed = settings.Seed, Steps = settings.Steps, BlockFrames = settings.BlockFrames, Feet = (uint)settings.Feet,
+                    ComposeJoints = joints.Length > 0 ? pinned.AddrOfPinnedObject() : IntPtr.Zero,
+                    ComposeJointCount = (UIntPtr)joints.Length, ComposeRoot = settings.ComposeRoot ? 1 : 0,
+                    Method = (uint)settings.Method, Eta = settings.Eta,
+                };
+                Native.Check(Native.sinmdm_crowd_join(handle, ref options, out ulong id));
+                return id;
+            }
+            finally { pinned.Free(); }
+        }
+
+        /// <summary>Takes character `id` out of the crowd.</summary>
+        public void Leave(ulong id) => Native.Check(Native.sinmdm_crowd_leave(handle, id));
+
+        /// <summary>Characters in the crowd.</summary>
+        public int Count
+        {
+            get { Native.Check(Native.sinmdm_crowd_count(handle, out UIntPtr count)); return (int)count; }
+        }
+
+        /// <summary>Character `id`'s steering commands, as MotionStream.Steer takes them.</summary>
+        public void Steer(ulong id, SteerFrame[] commands)
+        {
+            if (commands == null) throw new ArgumentNullException(nameof(commands));
+            Native.Check(Native.sinmdm_crowd_steer(handle, id, commands, (UIntPtr)commands.Length));
+        }
+
+        /// <summary>Character `id`'s poses for the frames after the last supplied ones.</summary>
+        public void Supply(ulong id, Poses poses) =>
+            Native.Check(Native.WithInput(poses, model.Joints, input => Native.sinmdm_crowd_supply(handle, model.Handle, id, ref input)));
+
+        /// <summary>Prepares frames ahead with at most `maxRounds` rounds (call it each frame):
+        /// in each, every character with fewer than `ahead` frames ready takes one step, all
+        /// together; returns the characters still short of `ahead`.</summary>
+        public int Prepare(int maxRounds, int ahead)
+        {
+            Native.Check(Native.sinmdm_crowd_step(handle, model.Handle, Native.Size(maxRounds, nameof(maxRounds)),
+                                                  Native.Size(ahead, nameof(ahead)), out UIntPtr rounds, out UIntPtr waiting));
+            return (int)waiting;
+        }
+
+        /// <summary>Character `id`'s next `frames` frames.</summary>
+        public Poses Next(ulong id, int frames)
+        {
+            var n = Native.Size(frames, nameof(frames));
+            var poses = new Poses(frames, model.Joints);
+            Native.Check(Native.WithBuffers(poses, b => Native.sinmdm_crowd_next(handle, model.Handle, id, n, ref b)));
+            return poses;
+        }
+
+        public void Dispose() => handle.Dispose();
+    }
+
     public sealed class MotionStream : IDisposable
     {
         readonly StreamHandle handle;

@@ -38,6 +38,12 @@
  *   preview, the network's latest clean prediction); sinmdm_run_free cancels. A stream is
  *   prepared ahead with sinmdm_stream_step so sinmdm_stream_next never waits. Stepping a
  *   run any number of steps at a time gives the bits of the one-call task.
+ * - Crowds: sinmdm_crowd_new holds many characters of one model, each a stream
+ *   (sinmdm_crowd_join with SinmdmStreamOptions, sinmdm_crowd_leave at any frame,
+ *   sinmdm_crowd_steer and sinmdm_crowd_supply per character); sinmdm_crowd_step steps
+ *   every character short of frames together, one network call for many blocks, and
+ *   sinmdm_crowd_next reads one character. A character is the same bits as its stream alone,
+ *   whatever else is in the crowd and whatever threads is.
  * - Progress and cancel on a worker thread: sinmdm_model_set_progress sets a callback
  *   (userdata first) called after each step of a blocking task, the last included (never by
  *   sinmdm_run_step); returning SINMDM_PROGRESS_CANCEL after any step makes the call return
@@ -50,8 +56,8 @@
  *   onnxruntime's environment may start threads of its own (at most one with onnxruntime
  *   1.31.1, which waits on a timer, and none where the environment variable CI is set), and
  *   they live until the process ends, since the environment is made once per process and never
- *   freed; for each run or stream block in progress, one that
- *   draws the next step's noise (it ends on its own soon after the run is finished or freed,
+ *   freed; for each run or stream block in progress (not a crowd's: it draws on the calling
+ *   thread), one that draws the next step's noise (it ends on its own soon after the run is finished or freed,
  *   or the block is done); for a batch of several samples on a model opened with threads >
  *   1, up to threads - 1 that each run samples during a denoising call and are joined
  *   before it returns. onnxruntime runs the network on the calling thread (one intra-op
@@ -99,6 +105,7 @@
  *   (it gave SINMDM_OK and the result).
  * - SinmdmSteerFrame's and SinmdmSteerCommand's reserved other than 0, and more steering
  *   commands than frames, give SINMDM_INVALID_ARGUMENT (they were ignored).
+ * - New: crowds (sinmdm_crowd_*, SINMDM_MAX_CROWD_CHARACTERS).
  * - New: the SINMDM_VERSION_* macros and sinmdm_model_values_per_frame (the factor of
  *   SINMDM_MAX_RUN_VALUES); the onnxruntime-not-found message names every place searched.
  */
@@ -172,6 +179,11 @@
  The largest crowd one run makes (`SinmdmSampling.count`).
  */
 #define SINMDM_MAX_SAMPLES 1024
+
+/*
+ The most characters a crowd holds at once (`sinmdm_crowd_join`).
+ */
+#define SINMDM_MAX_CROWD_CHARACTERS 65536
 
 /*
  The largest working set one run may need, in f32 values (1 GiB): a request is refused
@@ -358,6 +370,11 @@ typedef enum SinmdmStatus {
 } SinmdmStatus;
 
 /*
+ A crowd (opaque): characters of one model, each an endless stream, made together.
+ */
+typedef struct SinmdmCrowd SinmdmCrowd;
+
+/*
  An open model (opaque): the network and its metadata.
  */
 typedef struct SinmdmModel SinmdmModel;
@@ -377,6 +394,85 @@ typedef struct SinmdmRun SinmdmRun;
  A stream (opaque): motion handed out a chunk at a time, forever, in flat memory.
  */
 typedef struct SinmdmStream SinmdmStream;
+
+/*
+ How a stream makes its motion; zeros give the defaults.
+ */
+typedef struct SinmdmStreamOptions {
+  /*
+   Seed of the portable noise.
+   */
+  uint64_t seed;
+  /*
+   Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STREAM_STEPS`, `SINMDM_ALL_STEPS` for
+   all of the model's T.
+   */
+  uint32_t steps;
+  /*
+   Frames each block makes final; 0 for the length of the model's training clip.
+   */
+  uint32_t block_frames;
+  /*
+   `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
+   */
+  uint32_t feet;
+  /*
+   Joints taken from poses supplied with `sinmdm_stream_supply` (NULL with count 0: none).
+   */
+  const size_t *compose_joints;
+  /*
+   Entries of `compose_joints`.
+   */
+  size_t compose_joint_count;
+  /*
+   Not 0: the root's travel and height also come from the supplied poses.
+   */
+  int32_t compose_root;
+  /*
+   `SINMDM_METHOD_ANCESTRAL` (0, the default), `SINMDM_METHOD_DDIM` or `SINMDM_METHOD_DPM2M`.
+   */
+  uint32_t method;
+  /*
+   DDIM's share of the ancestral noise, 0 to 1.
+   */
+  double eta;
+} SinmdmStreamOptions;
+
+/*
+ One frame's steering command with every kind, facings included (file frame: the model's up
+ axis and units): `SinmdmSteerFrame` and a facing.
+ */
+typedef struct SinmdmSteerCommand {
+  /*
+   `SINMDM_STEER_FREE`, `_VELOCITY`, `_POSITION`, `_FACING` or `_POSITION_FACING`.
+   */
+  uint32_t kind;
+  /*
+   Set to 0; anything else gives `SINMDM_INVALID_ARGUMENT` (it keeps the numbers below
+   8-byte aligned on every platform, 32-bit ones included, so the struct is 72 bytes
+   everywhere, and stays free for later use).
+   */
+  uint32_t reserved;
+  /*
+   `SINMDM_STEER_VELOCITY`: forward speed, file units per second.
+   */
+  double forward;
+  /*
+   `SINMDM_STEER_VELOCITY`: turn rate, radians per second; positive turns left
+   (counter-clockwise seen from above).
+   */
+  double turn;
+  /*
+   `SINMDM_STEER_POSITION` and `_POSITION_FACING`: the root's position, file frame (the up
+   component is ignored).
+   */
+  double position[3];
+  /*
+   `SINMDM_STEER_FACING` and `_POSITION_FACING`: the direction the character faces, file
+   frame (the up component is ignored; the rest must not be zero).
+   */
+  double facing[3];
+} SinmdmSteerCommand;
 
 /*
  Poses given to the library, `frames` of them for the model's `joints` joints, as flat
@@ -401,6 +497,38 @@ typedef struct SinmdmPoses {
    */
   const float *translations;
 } SinmdmPoses;
+
+/*
+ Caller-owned arrays the library fills with poses; capacities are in floats. Needed: root
+ positions `3 x frames`, rotations `4 x joints x frames`, translations `3 x joints x frames`
+ (translations may be NULL when not wanted).
+ */
+typedef struct SinmdmPoseBuffers {
+  /*
+   Root position per frame.
+   */
+  float *root_positions;
+  /*
+   Capacity of `root_positions`.
+   */
+  size_t root_positions_capacity;
+  /*
+   Local rotation (`x, y, z, w`) per frame and joint.
+   */
+  float *rotations;
+  /*
+   Capacity of `rotations`.
+   */
+  size_t rotations_capacity;
+  /*
+   Local translation per frame and joint, or NULL.
+   */
+  float *translations;
+  /*
+   Capacity of `translations`.
+   */
+  size_t translations_capacity;
+} SinmdmPoseBuffers;
 
 /*
  Sampling settings shared by every task. The same model, settings and arguments give the same
@@ -533,38 +661,6 @@ typedef struct SinmdmModelInfo {
 } SinmdmModelInfo;
 
 /*
- Caller-owned arrays the library fills with poses; capacities are in floats. Needed: root
- positions `3 x frames`, rotations `4 x joints x frames`, translations `3 x joints x frames`
- (translations may be NULL when not wanted).
- */
-typedef struct SinmdmPoseBuffers {
-  /*
-   Root position per frame.
-   */
-  float *root_positions;
-  /*
-   Capacity of `root_positions`.
-   */
-  size_t root_positions_capacity;
-  /*
-   Local rotation (`x, y, z, w`) per frame and joint.
-   */
-  float *rotations;
-  /*
-   Capacity of `rotations`.
-   */
-  size_t rotations_capacity;
-  /*
-   Local translation per frame and joint, or NULL.
-   */
-  float *translations;
-  /*
-   Capacity of `translations`.
-   */
-  size_t translations_capacity;
-} SinmdmPoseBuffers;
-
-/*
  The range of commands a model's clip supports (what is beyond it is clamped).
  */
 typedef struct SinmdmSteerLimits {
@@ -612,42 +708,6 @@ typedef struct SinmdmSteerFrame {
 } SinmdmSteerFrame;
 
 /*
- One frame's steering command with every kind, facings included (file frame: the model's up
- axis and units): `SinmdmSteerFrame` and a facing.
- */
-typedef struct SinmdmSteerCommand {
-  /*
-   `SINMDM_STEER_FREE`, `_VELOCITY`, `_POSITION`, `_FACING` or `_POSITION_FACING`.
-   */
-  uint32_t kind;
-  /*
-   Set to 0; anything else gives `SINMDM_INVALID_ARGUMENT` (it keeps the numbers below
-   8-byte aligned on every platform, 32-bit ones included, so the struct is 72 bytes
-   everywhere, and stays free for later use).
-   */
-  uint32_t reserved;
-  /*
-   `SINMDM_STEER_VELOCITY`: forward speed, file units per second.
-   */
-  double forward;
-  /*
-   `SINMDM_STEER_VELOCITY`: turn rate, radians per second; positive turns left
-   (counter-clockwise seen from above).
-   */
-  double turn;
-  /*
-   `SINMDM_STEER_POSITION` and `_POSITION_FACING`: the root's position, file frame (the up
-   component is ignored).
-   */
-  double position[3];
-  /*
-   `SINMDM_STEER_FACING` and `_POSITION_FACING`: the direction the character faces, file
-   frame (the up component is ignored; the rest must not be zero).
-   */
-  double facing[3];
-} SinmdmSteerCommand;
-
-/*
  How fast a model's clip went sideways: a path walked in a facing of its own is followed no
  faster sideways than this.
  */
@@ -661,49 +721,6 @@ typedef struct SinmdmSteerSideways {
    */
   double leftward_max;
 } SinmdmSteerSideways;
-
-/*
- How a stream makes its motion; zeros give the defaults.
- */
-typedef struct SinmdmStreamOptions {
-  /*
-   Seed of the portable noise.
-   */
-  uint64_t seed;
-  /*
-   Respaced denoising steps per block; 0 for `SINMDM_DEFAULT_STREAM_STEPS`, `SINMDM_ALL_STEPS` for
-   all of the model's T.
-   */
-  uint32_t steps;
-  /*
-   Frames each block makes final; 0 for the length of the model's training clip.
-   */
-  uint32_t block_frames;
-  /*
-   `SINMDM_FEET_PLANTED` or `SINMDM_FEET_RAW`.
-   */
-  uint32_t feet;
-  /*
-   Joints taken from poses supplied with `sinmdm_stream_supply` (NULL with count 0: none).
-   */
-  const size_t *compose_joints;
-  /*
-   Entries of `compose_joints`.
-   */
-  size_t compose_joint_count;
-  /*
-   Not 0: the root's travel and height also come from the supplied poses.
-   */
-  int32_t compose_root;
-  /*
-   `SINMDM_METHOD_ANCESTRAL` (0, the default), `SINMDM_METHOD_DDIM` or `SINMDM_METHOD_DPM2M`.
-   */
-  uint32_t method;
-  /*
-   DDIM's share of the ancestral noise, 0 to 1.
-   */
-  double eta;
-} SinmdmStreamOptions;
 
 /*
  A span of frames `start..end` (end excluded).
@@ -722,6 +739,108 @@ typedef struct SinmdmSpan {
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
+
+/*
+ Makes an empty crowd of `model` and writes its handle to `out`.
+
+ # Safety
+ `model` is a live handle; `out` writable.
+ */
+enum SinmdmStatus sinmdm_crowd_new(const struct SinmdmModel *model, struct SinmdmCrowd **out);
+
+/*
+ Adds a character whose motion is a stream with `options` (as `sinmdm_stream_new` takes
+ them) and writes its number to `id`: numbers count up from 0 and are never given again. At
+ most `SINMDM_MAX_CROWD_CHARACTERS` characters at once.
+
+ # Safety
+ `crowd` is a live handle; `options` readable (its joint array as it says); `id` writable.
+ */
+enum SinmdmStatus sinmdm_crowd_join(struct SinmdmCrowd *crowd,
+                                    const struct SinmdmStreamOptions *options,
+                                    uint64_t *id);
+
+/*
+ Takes character `id` out of the crowd (its motion ends); `SINMDM_INVALID_ARGUMENT` if no
+ such character is in it.
+
+ # Safety
+ `crowd` is a live handle.
+ */
+enum SinmdmStatus sinmdm_crowd_leave(struct SinmdmCrowd *crowd, uint64_t id);
+
+/*
+ Characters in the crowd, written to `count`.
+
+ # Safety
+ `crowd` is a live handle; `count` writable.
+ */
+enum SinmdmStatus sinmdm_crowd_count(const struct SinmdmCrowd *crowd, size_t *count);
+
+/*
+ Queues character `id`'s steering commands, as `sinmdm_stream_steer_commands` does for a
+ stream.
+
+ # Safety
+ `crowd` is a live handle; `commands` readable for `count` values.
+ */
+enum SinmdmStatus sinmdm_crowd_steer(struct SinmdmCrowd *crowd,
+                                     uint64_t id,
+                                     const struct SinmdmSteerCommand *commands,
+                                     size_t count);
+
+/*
+ Supplies character `id`'s poses for the frames after the last supplied ones, as
+ `sinmdm_stream_supply` does for a stream made with composed joints.
+
+ # Safety
+ `crowd` and `model` are live handles (the crowd's model); `poses` as its documentation says.
+ */
+enum SinmdmStatus sinmdm_crowd_supply(struct SinmdmCrowd *crowd,
+                                      const struct SinmdmModel *model,
+                                      uint64_t id,
+                                      const struct SinmdmPoses *poses);
+
+/*
+ Prepares frames ahead on `model` (the crowd's), spending at most `max_rounds` rounds: while
+ some character has fewer than `ahead` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) ready,
+ every such character takes one denoising step, all of them through the network together. A
+ game calls it each frame with a small `max_rounds`, then reads each character with
+ `sinmdm_crowd_next`, which then never waits. `rounds` (if not NULL) gets the rounds taken,
+ `waiting` (if not NULL) the characters still short of `ahead` frames.
+
+ # Safety
+ `crowd` and `model` are live handles; `rounds` and `waiting` NULL or writable.
+ */
+enum SinmdmStatus sinmdm_crowd_step(struct SinmdmCrowd *crowd,
+                                    struct SinmdmModel *model,
+                                    size_t max_rounds,
+                                    size_t ahead,
+                                    size_t *rounds,
+                                    size_t *waiting);
+
+/*
+ Character `id`'s next `frames` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) into `buffers`,
+ the same bits as its stream alone; frames not yet prepared by `sinmdm_crowd_step` are made
+ for this character alone on `model` (the crowd's). `buffers` is checked as for
+ `sinmdm_stream_next`.
+
+ # Safety
+ `crowd` and `model` are live handles; `buffers` as its documentation says.
+ */
+enum SinmdmStatus sinmdm_crowd_next(struct SinmdmCrowd *crowd,
+                                    struct SinmdmModel *model,
+                                    uint64_t id,
+                                    size_t frames,
+                                    const struct SinmdmPoseBuffers *buffers);
+
+/*
+ Frees a crowd and its characters (NULL is fine).
+
+ # Safety
+ `crowd` is NULL or a handle from this library, not used again.
+ */
+void sinmdm_crowd_free(struct SinmdmCrowd *crowd);
 
 /*
  Writes the beats of the `reference` poses that a dance places (its speed minima on the

@@ -37,6 +37,12 @@
 //!   preview, the network's latest clean prediction); `sinmdm_run_free` cancels. A stream is
 //!   prepared ahead with `sinmdm_stream_step` so `sinmdm_stream_next` never waits. Stepping a
 //!   run any number of steps at a time gives the bits of the one-call task.
+//! - Crowds: `sinmdm_crowd_new` holds many characters of one model, each a stream
+//!   (`sinmdm_crowd_join` with `SinmdmStreamOptions`, `sinmdm_crowd_leave` at any frame,
+//!   `sinmdm_crowd_steer` and `sinmdm_crowd_supply` per character); `sinmdm_crowd_step` steps
+//!   every character short of frames together, one network call for many blocks, and
+//!   `sinmdm_crowd_next` reads one character. A character is the same bits as its stream alone,
+//!   whatever else is in the crowd and whatever `threads` is.
 //! - Progress and cancel on a worker thread: `sinmdm_model_set_progress` sets a callback
 //!   (`userdata` first) called after each step of a blocking task, the last included (never by
 //!   `sinmdm_run_step`); returning `SINMDM_PROGRESS_CANCEL` after any step makes the call return
@@ -49,8 +55,8 @@
 //!   onnxruntime's environment may start threads of its own (at most one with onnxruntime
 //!   1.31.1, which waits on a timer, and none where the environment variable `CI` is set), and
 //!   they live until the process ends, since the environment is made once per process and never
-//!   freed; for each run or stream block in progress, one that
-//!   draws the next step's noise (it ends on its own soon after the run is finished or freed,
+//!   freed; for each run or stream block in progress (not a crowd's: it draws on the calling
+//!   thread), one that draws the next step's noise (it ends on its own soon after the run is finished or freed,
 //!   or the block is done); for a batch of several samples on a model opened with `threads` >
 //!   1, up to `threads - 1` that each run samples during a denoising call and are joined
 //!   before it returns. onnxruntime runs the network on the calling thread (one intra-op
@@ -98,11 +104,13 @@
 //!   (it gave `SINMDM_OK` and the result).
 //! - `SinmdmSteerFrame`'s and `SinmdmSteerCommand`'s `reserved` other than 0, and more steering
 //!   commands than frames, give `SINMDM_INVALID_ARGUMENT` (they were ignored).
+//! - New: crowds (`sinmdm_crowd_*`, `SINMDM_MAX_CROWD_CHARACTERS`).
 //! - New: the `SINMDM_VERSION_*` macros and `sinmdm_model_values_per_frame` (the factor of
 //!   `SINMDM_MAX_RUN_VALUES`); the onnxruntime-not-found message names every place searched.
 
 #![warn(missing_docs)]
 
+mod crowd;
 mod dance;
 mod limits;
 mod model;
@@ -116,6 +124,11 @@ mod stream;
 mod tasks;
 mod text;
 
+pub use crowd::{
+    SinmdmCrowd, sinmdm_crowd_count, sinmdm_crowd_free, sinmdm_crowd_join, sinmdm_crowd_leave,
+    sinmdm_crowd_new, sinmdm_crowd_next, sinmdm_crowd_steer, sinmdm_crowd_step,
+    sinmdm_crowd_supply,
+};
 pub use dance::{
     SINMDM_DANCE_HOLD, SINMDM_DANCE_LEVEL_AUTO, SINMDM_DANCE_LEVEL_EVERY,
     SINMDM_DANCE_LEVEL_EVERY_OTHER, SINMDM_DANCE_LEVEL_HALF, SINMDM_DANCE_ORDER_REFERENCE,
@@ -123,8 +136,9 @@ pub use dance::{
     sinmdm_dance_reference_beats,
 };
 pub use limits::{
-    SINMDM_MAX_JOINT_INDICES, SINMDM_MAX_MODEL_BYTES, SINMDM_MAX_RAMP_FRAMES,
-    SINMDM_MAX_RUN_VALUES, SINMDM_MAX_SAMPLE_FRAMES, SINMDM_MAX_SAMPLES, SINMDM_MAX_THREADS,
+    SINMDM_MAX_CROWD_CHARACTERS, SINMDM_MAX_JOINT_INDICES, SINMDM_MAX_MODEL_BYTES,
+    SINMDM_MAX_RAMP_FRAMES, SINMDM_MAX_RUN_VALUES, SINMDM_MAX_SAMPLE_FRAMES, SINMDM_MAX_SAMPLES,
+    SINMDM_MAX_THREADS,
 };
 pub use model::{
     SINMDM_PROGRESS_CANCEL, SINMDM_PROGRESS_CONTINUE, SINMDM_VERSION_MAJOR, SINMDM_VERSION_MINOR,

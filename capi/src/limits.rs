@@ -10,6 +10,8 @@ pub const SINMDM_MAX_SAMPLE_FRAMES: usize = 100_000;
 pub const SINMDM_MAX_RAMP_FRAMES: usize = 100_000;
 /// The largest crowd one run makes (`SinmdmSampling.count`).
 pub const SINMDM_MAX_SAMPLES: usize = 1024;
+/// The most characters a crowd holds at once (`sinmdm_crowd_join`).
+pub const SINMDM_MAX_CROWD_CHARACTERS: usize = 65_536;
 /// The largest working set one run may need, in f32 values (1 GiB): a request is refused
 /// before anything runs when `count x frames x values` passes it, `values` being what
 /// `sinmdm_model_values_per_frame` gives for the model: `max(F + 8 C, 12 x joints)`, with F
@@ -38,6 +40,7 @@ mod tests {
         assert_eq!(SINMDM_MAX_SAMPLE_FRAMES, limits::MAX_SAMPLE_FRAMES);
         assert_eq!(SINMDM_MAX_RAMP_FRAMES, limits::MAX_RAMP_FRAMES);
         assert_eq!(SINMDM_MAX_SAMPLES, limits::MAX_SAMPLES);
+        assert_eq!(SINMDM_MAX_CROWD_CHARACTERS, limits::MAX_CROWD_CHARACTERS);
         assert_eq!(SINMDM_MAX_RUN_VALUES, limits::MAX_RUN_VALUES);
         assert_eq!(SINMDM_MAX_THREADS, limits::MAX_THREADS);
         assert_eq!(SINMDM_MAX_SPANS, limits::MAX_SAMPLE_FRAMES);

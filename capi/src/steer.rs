@@ -261,10 +261,26 @@ where
 {
     guard(|| {
         let stream = unsafe { handle_mut(stream, "stream") }?;
-        let commands = unsafe { commands_arg(commands, count, last_kind) }?;
-        stream.stream.steer(&commands)?;
-        Ok(())
+        unsafe { steer_stream(&mut stream.stream, commands, count, last_kind) }
     })
+}
+
+/// Queues steering commands from a caller array of either command struct on `stream`.
+///
+/// # Safety
+/// `commands` readable for `count` values.
+pub(crate) unsafe fn steer_stream<T>(
+    stream: &mut sinmdm::Stream,
+    commands: *const T,
+    count: usize,
+    last_kind: u32,
+) -> Result<(), Failure>
+where
+    for<'a> &'a T: Into<SinmdmSteerCommand>,
+{
+    let commands = unsafe { commands_arg(commands, count, last_kind) }?;
+    stream.steer(&commands)?;
+    Ok(())
 }
 
 impl From<&SinmdmSteerCommand> for SinmdmSteerCommand {

@@ -11,7 +11,7 @@ use crate::text::{give, handle_mut, handle_ref, slice_arg};
 
 /// An error of a stream's block, whose arguments were checked when the stream was made: motion
 /// that cannot be decoded came from the network, so it is a failed run, not a bad argument.
-fn made_by_the_run(e: sinmdm::TaskError) -> Failure {
+pub(crate) fn made_by_the_run(e: sinmdm::TaskError) -> Failure {
     match e {
         sinmdm::TaskError::Motion(m) => Failure::new(SinmdmStatus::TaskFailed, m.to_string()),
         other => Failure::from(other),
@@ -50,6 +50,33 @@ pub struct SinmdmStreamOptions {
     pub eta: f64,
 }
 
+/// The stream options a caller's struct asks for, checked.
+///
+/// # Safety
+/// `o`'s joint array as it says.
+pub(crate) unsafe fn stream_options(o: &SinmdmStreamOptions) -> Result<StreamOptions, Failure> {
+    if o.compose_joint_count > SINMDM_MAX_JOINT_INDICES {
+        return Err(Failure::invalid(format!(
+            "compose_joint_count is {}; at most {SINMDM_MAX_JOINT_INDICES} joint indices are taken",
+            o.compose_joint_count
+        )));
+    }
+    let joints = unsafe { slice_arg(o.compose_joints, o.compose_joint_count, "compose_joints") }?;
+    let compose = (!joints.is_empty() || o.compose_root != 0).then(|| StreamCompose {
+        joints: joints.to_vec(),
+        root: o.compose_root != 0,
+    });
+    Ok(StreamOptions {
+        seed: o.seed,
+        steps: steps_or(o.steps, sinmdm::DEFAULT_STREAM_STEPS),
+        block_frames: (o.block_frames > 0).then_some(o.block_frames as usize),
+        feet: feet_arg(o.feet)?,
+        compose,
+        method: method_arg(o.method, o.eta)?,
+        ..StreamOptions::default()
+    })
+}
+
 /// Makes a stream of `model`'s motion with `options` and writes its handle to `out`.
 ///
 /// # Safety
@@ -63,27 +90,7 @@ pub unsafe extern "C" fn sinmdm_stream_new(
     unsafe {
         guard_out(out, |out| {
             let model = handle_ref(model, "model")?;
-            let o = *handle_ref(options, "options")?;
-            if o.compose_joint_count > SINMDM_MAX_JOINT_INDICES {
-                return Err(Failure::invalid(format!(
-                    "compose_joint_count is {}; at most {SINMDM_MAX_JOINT_INDICES} joint indices are taken",
-                    o.compose_joint_count
-                )));
-            }
-            let joints = slice_arg(o.compose_joints, o.compose_joint_count, "compose_joints")?;
-            let compose = (!joints.is_empty() || o.compose_root != 0).then(|| StreamCompose {
-                joints: joints.to_vec(),
-                root: o.compose_root != 0,
-            });
-            let options = StreamOptions {
-                seed: o.seed,
-                steps: steps_or(o.steps, sinmdm::DEFAULT_STREAM_STEPS),
-                block_frames: (o.block_frames > 0).then_some(o.block_frames as usize),
-                feet: feet_arg(o.feet)?,
-                compose,
-                method: method_arg(o.method, o.eta)?,
-                ..StreamOptions::default()
-            };
+            let options = stream_options(handle_ref(options, "options")?)?;
             let stream = Stream::new(model.model.metadata(), options)?;
             give(
                 out,

@@ -106,6 +106,20 @@ static class Example
                 Print("steerstream20", stream.Next(20));
                 Print("steerstream25", stream.Next(25));
             }
+            // A crowd: the steered character is the same bits as the stream above, whoever
+            // else is in the crowd.
+            using (var crowd = new Crowd(zombie))
+            {
+                var stranger = crowd.Join(new StreamSettings { Seed = 12, Steps = 3, BlockFrames = 30, Feet = Feet.Raw });
+                var walker = crowd.Join(new StreamSettings { Seed = 11, Steps = 3, BlockFrames = 30 });
+                var told = new SteerFrame[60];
+                for (int i = 0; i < told.Length; i++) told[i] = SteerFrame.Velocity(10.0, -0.2);
+                crowd.Steer(walker, told);
+                while (crowd.Prepare(4, 45) > 0) { }
+                Print("crowdsteer20", crowd.Next(walker, 20));
+                crowd.Leave(stranger);
+                Print("crowdsteer25", crowd.Next(walker, 25));
+            }
         }
         return 0;
     }

@@ -1,6 +1,8 @@
-//! Characters per core with today's streams: N steered walks, each its own [`Stream`] on one
-//! shared model run on one thread, advanced as a game advances them, one model frame at a time:
-//! each frame every character prepares ahead within a step budget, then takes its frame.
+//! Characters per core: N steered walks on one shared model run on one thread, advanced as a
+//! game advances them, one model frame at a time, two ways side by side: each character its own
+//! [`Stream`] (each frame every character prepares ahead within a step budget, then takes its
+//! frame), and one [`Crowd`] (each frame the crowd prepares within a budget of rounds, every
+//! character short of frames stepping together, then every character takes its frame).
 //! Characters join at staggered block phases (their first frames are pulled, and the next
 //! prepared, before the clock starts), as characters of a game do, so their blocks do not all
 //! start on one frame.
@@ -14,14 +16,15 @@
 //! `SINMDM_CROWD_SIZES=1,8,64,512` and `SINMDM_CROWD_SECONDS=20` (motion per character) change
 //! the run; `SINMDM_CROWD_BUDGET=4` is the steps a character may spend preparing per frame;
 //! `SINMDM_CROWD_FREE=1` leaves the characters unsteered; `SINMDM_CROWD_CHUNK=30` reads 30
-//! frames a call (then a "frame" below is one such read).
+//! frames a call (then a "frame" below is one such read); `SINMDM_CROWD_WAY=streams` or `crowd`
+//! runs one way only; `SINMDM_CROWD_STEPS=20` sets the denoising steps per block.
 
 use std::time::Instant;
 
 mod common;
 
 use sinmdm::steer::SteerFrame;
-use sinmdm::{Feet, Model, ModelOptions, Stream, StreamOptions};
+use sinmdm::{Crowd, Feet, Model, ModelOptions, Stream, StreamOptions};
 
 fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
     std::env::var(name)
@@ -67,45 +70,62 @@ fn commands(i: usize, frames: usize, fps: f64) -> Vec<SteerFrame> {
 struct Figures {
     cpu_ms_per_character_second: f64,
     worst_frame_ms: f64,
-    worst_character_ms: f64,
+    worst_character_ms: Option<f64>,
     bytes_per_character: f64,
 }
 
-fn crowd(
-    model: &mut Model,
+/// How the characters of one run are made.
+#[derive(Clone, Copy)]
+struct Run {
     size: usize,
     seconds: f64,
     budget: usize,
     free: bool,
     chunk: usize,
-) -> Figures {
+    steps: usize,
+}
+
+impl Run {
+    fn options(&self, i: usize) -> StreamOptions {
+        StreamOptions {
+            seed: i as u64,
+            steps: Some(self.steps),
+            feet: Feet::Planted,
+            ..StreamOptions::default()
+        }
+    }
+
+    /// Character `i`'s join frame (staggered over a block) and its commands, if steered.
+    fn start(&self, i: usize, stream: &Stream, fps: f64) -> (usize, Option<Vec<SteerFrame>>) {
+        let block = stream.sizes().block;
+        let join = i * block / self.size.max(1);
+        let frames = (self.seconds * fps).round() as usize;
+        let steer =
+            (!self.free).then(|| commands(i, join + frames + stream.lookahead() + block, fps));
+        (join, steer)
+    }
+}
+
+/// One way of making a run's characters.
+type Way = fn(&mut Model, Run) -> Figures;
+
+/// Each character its own stream.
+fn streams(model: &mut Model, run: Run) -> Figures {
     let fps = model.metadata().layout.fps;
-    let frames = (seconds * fps).round() as usize;
+    let frames = (run.seconds * fps).round() as usize;
     let before = resident_bytes();
-    let mut streams: Vec<Stream> = (0..size)
+    let mut streams: Vec<Stream> = (0..run.size)
         .map(|i| {
-            let options = StreamOptions {
-                seed: i as u64,
-                feet: Feet::Planted,
-                ..StreamOptions::default()
-            };
-            let mut stream = Stream::new(model.metadata(), options).expect("stream");
-            let block = stream.sizes().block;
-            let join = i * block / size.max(1);
-            if !free {
-                stream
-                    .steer(&commands(
-                        i,
-                        join + frames + stream.lookahead() + block,
-                        fps,
-                    ))
-                    .expect("steer");
+            let mut stream = Stream::new(model.metadata(), run.options(i)).expect("stream");
+            let (join, steer) = run.start(i, &stream, fps);
+            if let Some(commands) = steer {
+                stream.steer(&commands).expect("steer");
             }
             stream.next(model, join + 1).expect("join");
             stream
         })
         .collect();
-    let held = resident_bytes().saturating_sub(before) as f64 / size as f64;
+    let held = resident_bytes().saturating_sub(before) as f64 / run.size as f64;
     // Every character starts the clock prepared as far ahead as the loop keeps it, so the
     // worst frame is the loop's own, not the crowd's first frame.
     let ahead = streams[0].sizes().block / 4;
@@ -115,21 +135,60 @@ fn crowd(
     let clock = Instant::now();
     let cpu = thread_cpu_ns(clock);
     let (mut worst_frame, mut worst_character) = (0f64, 0f64);
-    for _ in 0..frames / chunk {
+    for _ in 0..frames / run.chunk {
         let frame = Instant::now();
         for stream in &mut streams {
             let one = Instant::now();
-            stream.prepare(model, budget, ahead).expect("prepare");
-            stream.next(model, chunk).expect("next");
+            stream.prepare(model, run.budget, ahead).expect("prepare");
+            stream.next(model, run.chunk).expect("next");
             worst_character = worst_character.max(one.elapsed().as_secs_f64());
         }
         worst_frame = worst_frame.max(frame.elapsed().as_secs_f64());
     }
     let cpu_s = (thread_cpu_ns(clock) - cpu) as f64 / 1e9;
     Figures {
-        cpu_ms_per_character_second: 1e3 * cpu_s / (size as f64 * seconds),
+        cpu_ms_per_character_second: 1e3 * cpu_s / (run.size as f64 * run.seconds),
         worst_frame_ms: 1e3 * worst_frame,
-        worst_character_ms: 1e3 * worst_character,
+        worst_character_ms: Some(1e3 * worst_character),
+        bytes_per_character: held,
+    }
+}
+
+/// One crowd of every character.
+fn crowd(model: &mut Model, run: Run) -> Figures {
+    let fps = model.metadata().layout.fps;
+    let frames = (run.seconds * fps).round() as usize;
+    let before = resident_bytes();
+    let mut crowd = Crowd::new(model.metadata());
+    let mut block = 0;
+    for i in 0..run.size {
+        let id = crowd.join(run.options(i)).expect("join");
+        let stream = crowd.character_mut(id).expect("joined");
+        block = stream.sizes().block;
+        let (join, steer) = run.start(i, stream, fps);
+        if let Some(commands) = steer {
+            stream.steer(&commands).expect("steer");
+        }
+        stream.next(model, join + 1).expect("join");
+    }
+    let held = resident_bytes().saturating_sub(before) as f64 / run.size as f64;
+    let ahead = block / 4;
+    crowd.prepare(model, usize::MAX, ahead).expect("prepare");
+    let clock = Instant::now();
+    let cpu = thread_cpu_ns(clock);
+    let mut worst_frame = 0f64;
+    for _ in 0..frames / run.chunk {
+        let frame = Instant::now();
+        crowd.prepare(model, run.budget, ahead).expect("prepare");
+        let chunks = crowd.next(model, run.chunk).expect("next");
+        std::hint::black_box(chunks);
+        worst_frame = worst_frame.max(frame.elapsed().as_secs_f64());
+    }
+    let cpu_s = (thread_cpu_ns(clock) - cpu) as f64 / 1e9;
+    Figures {
+        cpu_ms_per_character_second: 1e3 * cpu_s / (run.size as f64 * run.seconds),
+        worst_frame_ms: 1e3 * worst_frame,
+        worst_character_ms: None,
         bytes_per_character: held,
     }
 }
@@ -141,31 +200,48 @@ fn main() {
         .split(',')
         .filter_map(|s| s.trim().parse().ok())
         .collect();
-    let seconds: f64 = env_or("SINMDM_CROWD_SECONDS", 20.0);
-    let budget: usize = env_or("SINMDM_CROWD_BUDGET", 4);
-    let free = std::env::var("SINMDM_CROWD_FREE").is_ok_and(|v| v == "1");
-    let chunk: usize = env_or("SINMDM_CROWD_CHUNK", 1usize).max(1);
+    let way = std::env::var("SINMDM_CROWD_WAY").unwrap_or_else(|_| "both".into());
+    let base = Run {
+        size: 0,
+        seconds: env_or("SINMDM_CROWD_SECONDS", 20.0),
+        budget: env_or("SINMDM_CROWD_BUDGET", 4),
+        free: std::env::var("SINMDM_CROWD_FREE").is_ok_and(|v| v == "1"),
+        chunk: env_or("SINMDM_CROWD_CHUNK", 1usize).max(1),
+        steps: env_or("SINMDM_CROWD_STEPS", sinmdm::DEFAULT_STREAM_STEPS),
+    };
     let mut model = Model::open(&path, &ModelOptions { threads: Some(1) }).expect("model");
     let fps = model.metadata().layout.fps;
     println!(
-        "{path}: {seconds} s of {} walk per character at {fps} fps, one thread, \
-         prepare budget {budget} steps per character per frame",
-        if free { "unsteered" } else { "steered" }
+        "{path}: {} s of {} walk per character at {fps} fps, {} steps per block, one thread, \
+         prepare budget {} steps (a stream) or rounds (a crowd) per frame",
+        base.seconds,
+        if base.free { "unsteered" } else { "steered" },
+        base.steps,
+        base.budget
     );
     println!(
-        "| characters | CPU ms per character-second | characters per core at {fps} fps | \
+        "| way | characters | CPU ms per character-second | characters per core at {fps} fps | \
          worst frame, whole crowd (ms) | worst frame, one character (ms) | memory per character (KiB) |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|");
     for size in sizes {
-        let f = crowd(&mut model, size, seconds, budget, free, chunk);
-        println!(
-            "| {size} | {:.2} | {:.0} | {:.1} | {:.1} | {:.0} |",
-            f.cpu_ms_per_character_second,
-            1e3 / f.cpu_ms_per_character_second,
-            f.worst_frame_ms,
-            f.worst_character_ms,
-            f.bytes_per_character / 1024.0
-        );
+        let run = Run { size, ..base };
+        let ways: &[(&str, Way)] = match way.as_str() {
+            "streams" => &[("streams", streams)],
+            "crowd" => &[("crowd", crowd)],
+            _ => &[("streams", streams), ("crowd", crowd)],
+        };
+        for (name, go) in ways {
+            let f = go(&mut model, run);
+            println!(
+                "| {name} | {size} | {:.2} | {:.0} | {:.1} | {} | {:.0} |",
+                f.cpu_ms_per_character_second,
+                1e3 / f.cpu_ms_per_character_second,
+                f.worst_frame_ms,
+                f.worst_character_ms
+                    .map_or("-".to_string(), |ms| format!("{ms:.1}")),
+                f.bytes_per_character / 1024.0
+            );
+        }
     }
 }

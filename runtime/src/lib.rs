@@ -80,5 +80,8 @@ pub use onnxruntime::{
     ONNXRUNTIME_VERSION, OnnxRuntime, RuntimeLibraryError, init as init_onnxruntime,
     load_onnxruntime,
 };
-pub use stream::{DEFAULT_STREAM_STEPS, Stream, StreamChunk, StreamCompose, StreamOptions};
+pub use stream::{
+    CharacterId, Crowd, CrowdProgress, DEFAULT_STREAM_STEPS, Stream, StreamChunk, StreamCompose,
+    StreamOptions,
+};
 pub use tasks::{Generated, Plan, Progress, Request, Run, Span, Task, TaskError, plan, run};

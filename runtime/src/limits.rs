@@ -11,6 +11,9 @@ pub const MAX_SAMPLE_FRAMES: usize = 100_000;
 pub const MAX_RAMP_FRAMES: usize = MAX_SAMPLE_FRAMES;
 /// The largest crowd one run makes.
 pub const MAX_SAMPLES: usize = 1024;
+/// The most characters a [`crate::Crowd`] holds at once (each keeps its stream's blocks,
+/// about half a megabyte for the shipped walk).
+pub const MAX_CROWD_CHARACTERS: usize = 65_536;
 /// The largest working set one run may need, in f32 values (1 GiB): `samples x frames x` the
 /// larger of `F + 8 C` (the network's layers: F feature rows, C channels) and `12 x joints`
 /// (the decoded motion); `tasks::run_values_per_frame` gives the per-frame factor of a model.

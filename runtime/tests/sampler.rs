@@ -162,3 +162,40 @@ fn a_sampler_refuses_guidance_of_the_wrong_shape() {
     assert!(sampler.step(&mut wrong).is_err());
     assert_eq!(sampler.done(), 0);
 }
+
+#[test]
+fn a_step_split_around_the_network_call_is_the_same_bits_and_can_be_given_up() {
+    let mut m = model();
+    let plan = sinmdm::plan(m.metadata(), &request(Task::Generate { frames: 40 }, 2)).unwrap();
+    let mut whole = plan.sampler().unwrap();
+    while !whole.is_finished() {
+        whole.step(&mut m).unwrap();
+    }
+    let mut split = plan.sampler().unwrap();
+    assert!(matches!(
+        split.finish_step(whole.current()),
+        Err(sinmdm::diffusion::SamplerError::StepNotBegun)
+    ));
+    let mut given_up = 0;
+    while let Some(t) = split.begin_step() {
+        // Beginning twice asks for nothing more.
+        assert_eq!(split.begin_step(), Some(t));
+        if split.done() % 5 == 2 && given_up < split.done() {
+            // The network "failed": the step is given up and begun again.
+            split.abandon_step();
+            given_up = split.done();
+            continue;
+        }
+        let rows = split.current().dim().0;
+        let x0 = m.denoise(split.current(), &vec![t; rows]).unwrap();
+        split.finish_step(x0.view()).unwrap();
+    }
+    assert!(given_up > 0);
+    let bits = |s: Sampler| {
+        s.into_sample()
+            .iter()
+            .map(|v| v.to_bits())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(bits(split), bits(whole));
+}

@@ -428,6 +428,77 @@ static void check_steering(const char *path, const char *world_path) {
   sinmdm_model_free(world);
 }
 
+/* A crowd of the zombie walk on two threads: a steered character is the same bits as the steered
+   stream alone ("crowdsteer" against "steerstream"), with a stranger beside it that leaves
+   between its reads and another that joins; and the crowd's refusals. */
+static void check_crowd(const char *path, const char *world_path) {
+  SinmdmModel *zombie = NULL, *world = NULL;
+  CHECK_OK(sinmdm_model_open(path, 2, &zombie));
+  CHECK_OK(sinmdm_model_open(world_path, 1, &world));
+  SinmdmModelInfo info;
+  CHECK_OK(sinmdm_model_info(zombie, &info));
+  SinmdmCrowd *crowd = NULL;
+  CHECK_OK(sinmdm_crowd_new(zombie, &crowd));
+  SinmdmStreamOptions stranger = {12, 3, 30, SINMDM_FEET_RAW, NULL, 0, 0, SINMDM_METHOD_ANCESTRAL, 0.0};
+  SinmdmStreamOptions steered = {11, 3, 30, SINMDM_FEET_PLANTED, NULL, 0, 0, SINMDM_METHOD_ANCESTRAL, 0.0};
+  SinmdmStreamOptions late = {13, 5, 40, SINMDM_FEET_PLANTED, NULL, 0, 0, SINMDM_METHOD_ANCESTRAL, 0.0};
+  uint64_t first = 99, second = 99, third = 99;
+  CHECK_OK(sinmdm_crowd_join(crowd, &stranger, &first));
+  CHECK_OK(sinmdm_crowd_join(crowd, &steered, &second));
+  expect_true(first == 0 && second == 1, "characters are numbered from 0 in the order they join");
+  SinmdmSteerCommand commands[60];
+  for (size_t i = 0; i < 60; i++) {
+    SinmdmSteerCommand c = {SINMDM_STEER_VELOCITY, 0, 10.0, -0.2, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+    commands[i] = c;
+  }
+  CHECK_OK(sinmdm_crowd_steer(crowd, second, commands, 60));
+  size_t rounds = 0, waiting = 0, count = 0;
+  CHECK_OK(sinmdm_crowd_step(crowd, zombie, 2, 45, &rounds, &waiting));
+  expect_true(rounds == 2 && waiting == 2, "two rounds of three-step blocks leave both waiting");
+  CHECK_OK(sinmdm_crowd_step(crowd, zombie, 100, 45, NULL, &waiting));
+  expect_true(waiting == 0, "enough rounds prepare every character");
+  Poses a = poses_alloc(20, info.joints), b = poses_alloc(25, info.joints);
+  SinmdmPoseBuffers ba = buffers_of(&a), bb = buffers_of(&b);
+  CHECK_OK(sinmdm_crowd_next(crowd, zombie, second, 20, &ba));
+  CHECK_OK(sinmdm_crowd_leave(crowd, first));
+  CHECK_OK(sinmdm_crowd_join(crowd, &late, &third));
+  CHECK_OK(sinmdm_crowd_count(crowd, &count));
+  expect_true(third == 2 && count == 2, "a number is never given again");
+  CHECK_OK(sinmdm_crowd_step(crowd, zombie, 100, 30, NULL, NULL));
+  CHECK_OK(sinmdm_crowd_next(crowd, zombie, second, 25, &bb));
+  print_poses("crowdsteer20", &a);
+  print_poses("crowdsteer25", &b);
+
+  /* Refusals: a character not in the crowd, another model, bounds, NULLs. */
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_crowd_leave(crowd, first));
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_crowd_next(crowd, zombie, 77, 1, &ba));
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_crowd_steer(crowd, 77, commands, 1));
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_crowd_step(crowd, world, 1, 1, NULL, NULL));
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_crowd_next(crowd, world, second, 1, &ba));
+  EXPECT(SINMDM_INVALID_ARGUMENT,
+         sinmdm_crowd_step(crowd, zombie, 1, SINMDM_MAX_SAMPLE_FRAMES + 1, NULL, NULL));
+  EXPECT(SINMDM_INVALID_ARGUMENT,
+         sinmdm_crowd_next(crowd, zombie, second, SINMDM_MAX_SAMPLE_FRAMES + 1, &ba));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_crowd_next(crowd, zombie, second, 0, NULL));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_crowd_join(crowd, NULL, &third));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_crowd_join(crowd, &late, NULL));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_crowd_step(NULL, zombie, 1, 1, NULL, NULL));
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_crowd_count(crowd, NULL));
+  SinmdmStreamOptions bad = {1, 3, 1, SINMDM_FEET_PLANTED, NULL, 0, 0, SINMDM_METHOD_ANCESTRAL, 0.0};
+  EXPECT(SINMDM_INVALID_ARGUMENT, sinmdm_crowd_join(crowd, &bad, &third));
+  SinmdmCrowd *refused = NULL;
+  EXPECT(SINMDM_NULL_ARGUMENT, sinmdm_crowd_new(NULL, &refused));
+  expect_true(refused == NULL, "a refused crowd gives no handle");
+  CHECK_OK(sinmdm_crowd_count(crowd, &count));
+  expect_true(count == 2, "refusals change no character");
+  poses_free(&a);
+  poses_free(&b);
+  sinmdm_crowd_free(crowd);
+  sinmdm_crowd_free(NULL);
+  sinmdm_model_free(zombie);
+  sinmdm_model_free(world);
+}
+
 /* The library's version is the header's: "MAJOR.MINOR.PATCH" of the SINMDM_VERSION_* macros. */
 static void check_version(void) {
   unsigned major = 999, minor = 999, patch = 999;
@@ -672,6 +743,7 @@ int main(int argc, char **argv) {
   print_poses("stream25", &chunk_b);
 
   check_steering(argv[4], argv[5]);
+  check_crowd(argv[4], argv[5]);
 
   CHECK_OK(sinmdm_write_bvh(model, &reference, argv[3]));
 

@@ -87,6 +87,7 @@ static Model models[2];
 static SinmdmRun *runs[POOL];
 static SinmdmResult *results[POOL];
 static SinmdmStream *streams[POOL];
+static SinmdmCrowd *crowds[POOL];
 
 /* A live handle of a pool, NULL now and then. */
 #define ANY_OF(pool) (coin() && pool[pick(POOL)] ? pool[pick(POOL)] : pool[pick(POOL)])
@@ -100,6 +101,7 @@ static void keep(void **pool, void *handle, void (*free_fn)(void *)) {
 static void free_run(void *p) { sinmdm_run_free(p); }
 static void free_result(void *p) { sinmdm_result_free(p); }
 static void free_stream(void *p) { sinmdm_stream_free(p); }
+static void free_crowd(void *p) { sinmdm_crowd_free(p); }
 
 /* Poses input: real sizes for up to FRAMES frames of the larger skeleton. */
 #define FRAMES 64
@@ -199,10 +201,11 @@ static void one_case(const char *model_a, const char *work) {
   SinmdmRun *run = NULL;
   SinmdmResult *result = NULL;
   SinmdmStream *stream = NULL;
+  SinmdmCrowd *crowd = NULL;
   SinmdmRun **run_out = pick(10) ? &run : NULL;
   SinmdmResult **result_out = pick(10) ? &result : NULL;
   size_t needed = 0;
-  switch (pick(32)) {
+  switch (pick(33)) {
     case 0: {
       SinmdmModel *opened = NULL;
       const char *paths[] = {NULL, "", "/no/such/model.onnx", model_a, work};
@@ -485,6 +488,61 @@ static void one_case(const char *model_a, const char *work) {
       }
       break;
     }
+    case 31: {
+      /* Crowds: characters of any options, numbers that are and are not in the crowd, either
+         model, bounds and NULLs. */
+      uint32_t steps_pool[] = {1, 2, 3, UINT32_MAX - 1};
+      uint32_t blocks_pool[] = {5, 30, 45, UINT32_MAX, 200000};
+      SinmdmStreamOptions options = {next_random(), steps_pool[pick(4)], blocks_pool[pick(5)],
+                                     pick(4) ? (uint32_t)pick(2) : any_u32(), NULL, 0, 0,
+                                     pick(4) ? (uint32_t)pick(3) : any_u32(), coin() ? 0.0 : any_double()};
+      uint64_t id = coin() ? pick(4) : next_random();
+      size_t rounds, waiting, count;
+      SinmdmPoseBuffers b = any_buffers();
+      size_t frames_pool[] = {0, 1, 20, 45, SINMDM_MAX_SAMPLE_FRAMES + 1, SIZE_MAX};
+      static SinmdmSteerCommand told[4];
+      for (size_t i = 0; i < 4; i++) {
+        SinmdmSteerCommand c = {pick(4) ? SINMDM_STEER_VELOCITY : any_u32(), 0, coin() ? 12.0 : any_double(),
+                                coin() ? 0.2 : any_double(), {0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}};
+        told[i] = c;
+      }
+      switch (pick(9)) {
+        case 0:
+          CALL("crowd_new", sinmdm_crowd_new(model, pick(10) ? &crowd : NULL));
+          break;
+        case 1:
+        case 2:
+          CALL("crowd_join", sinmdm_crowd_join(ANY_OF(crowds), pick(10) ? &options : NULL, pick(10) ? &id : NULL));
+          break;
+        case 3:
+          CALL("crowd_leave", sinmdm_crowd_leave(ANY_OF(crowds), id));
+          break;
+        case 4:
+          CALL("crowd_count", sinmdm_crowd_count(ANY_OF(crowds), coin() ? &count : NULL));
+          break;
+        case 5:
+          CALL("crowd_steer", sinmdm_crowd_steer(ANY_OF(crowds), id, pick(6) ? told : NULL, pick(5)));
+          break;
+        case 6:
+          CALL("crowd_supply", sinmdm_crowd_supply(ANY_OF(crowds), any_model_handle(), id, poses_ptr));
+          break;
+        case 7:
+          CALL("crowd_step", sinmdm_crowd_step(ANY_OF(crowds), any_model_handle(), pick(3),
+                                               coin() ? 1 + pick(60) : any_size(SINMDM_MAX_SAMPLE_FRAMES),
+                                               coin() ? &rounds : NULL, coin() ? &waiting : NULL));
+          break;
+        default:
+          CALL("crowd_next", sinmdm_crowd_next(ANY_OF(crowds), any_model_handle(), id,
+                                               frames_pool[pick(6)], pick(10) ? &b : NULL));
+          break;
+      }
+      if (pick(20) == 0) {
+        size_t slot = pick(POOL);
+        sinmdm_crowd_free(crowds[slot]);
+        crowds[slot] = NULL;
+      }
+      break;
+    }
     default:
       CALL("model_set_progress", sinmdm_model_set_progress(model, coin() ? one_step : NULL, NULL));
       if (model == NULL) break;
@@ -494,6 +552,7 @@ static void one_case(const char *model_a, const char *work) {
   if (run != NULL) keep((void **)runs, run, free_run);
   if (result != NULL) keep((void **)results, result, free_result);
   if (stream != NULL) keep((void **)streams, stream, free_stream);
+  if (crowd != NULL) keep((void **)crowds, crowd, free_crowd);
   if (strlen(sinmdm_version()) == 0) exit(1);
 }
 
@@ -527,6 +586,7 @@ int main(int argc, char **argv) {
     sinmdm_run_free(runs[i]);
     sinmdm_result_free(results[i]);
     sinmdm_stream_free(streams[i]);
+    sinmdm_crowd_free(crowds[i]);
   }
   sinmdm_model_free(models[0].handle);
   sinmdm_model_free(models[1].handle);

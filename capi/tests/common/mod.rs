@@ -326,6 +326,13 @@ fn steer_lines(
         &steer_commands(60, 10.0, -0.2),
         out,
     );
+    // A character of a crowd is the same bits as its stream alone.
+    stream_lines(
+        &mut zombie,
+        "crowdsteer",
+        &steer_commands(60, 10.0, -0.2),
+        out,
+    );
 }
 
 /// `label hex hex ...` lines of a program's output, by label.

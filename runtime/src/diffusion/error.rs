@@ -33,6 +33,9 @@ pub enum SamplerError {
     /// A sampling method with a setting out of range.
     #[error("{0}")]
     Method(String),
+    /// A step finished that was not begun.
+    #[error("a step was finished without being begun (call begin_step first)")]
+    StepNotBegun,
     /// A denoiser whose feature rows are not the run's.
     #[error("the denoiser has {denoiser} feature rows, the run {run}")]
     Features {

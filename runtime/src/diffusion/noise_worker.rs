@@ -60,6 +60,17 @@ impl NoiseWorker {
         }
     }
 
+    /// A worker that draws every stream on the calling thread when it is received.
+    pub(crate) fn in_place(seed: u64, shape: (usize, usize, usize)) -> NoiseWorker {
+        NoiseWorker {
+            seed,
+            shape,
+            channels: None,
+            pending: VecDeque::new(),
+            spare: Vec::new(),
+        }
+    }
+
     fn buffer(&mut self) -> Array3<f32> {
         self.spare
             .pop()

@@ -70,6 +70,8 @@ pub struct Sampler {
     x0_prev: Option<Array3<f32>>,
     /// The buffer the next step's prediction is written into (the one before last, reused).
     spare: Option<Array3<f32>>,
+    /// Whether [`Sampler::begin_step`] has asked for the next step's noise.
+    begun: bool,
 }
 
 impl std::fmt::Debug for Sampler {
@@ -93,6 +95,30 @@ impl Sampler {
         frames: usize,
         seed: u64,
     ) -> Result<Sampler, SamplerError> {
+        Sampler::build(schedule, guidance, (batch, features, frames), seed, true)
+    }
+
+    /// [`Sampler::new`] drawing each step's noise on the calling thread, the same values: for
+    /// many runs on one thread (a crowd), where a worker thread per run would cost more than
+    /// it overlaps.
+    pub fn new_on_this_thread(
+        schedule: &Schedule,
+        guidance: &Guidance,
+        batch: usize,
+        features: usize,
+        frames: usize,
+        seed: u64,
+    ) -> Result<Sampler, SamplerError> {
+        Sampler::build(schedule, guidance, (batch, features, frames), seed, false)
+    }
+
+    fn build(
+        schedule: &Schedule,
+        guidance: &Guidance,
+        (batch, features, frames): (usize, usize, usize),
+        seed: u64,
+        worker: bool,
+    ) -> Result<Sampler, SamplerError> {
         if batch == 0 || frames == 0 {
             return Err(SamplerError::Empty { batch, frames });
         }
@@ -113,7 +139,12 @@ impl Sampler {
             free,
             // A step's noise does not depend on the network's output: it is drawn on the
             // worker while the network runs (for a crowd it costs a twentieth of a step).
-            noise: NoiseWorker::start(seed, shape),
+            noise: if worker {
+                NoiseWorker::start(seed, shape)
+            } else {
+                NoiseWorker::in_place(seed, shape)
+            },
+            begun: false,
             method: Method::Ancestral,
             x0_prev: None,
             spare: None,
@@ -175,24 +206,87 @@ impl Sampler {
                 run: features,
             }));
         }
-        let steps = self.schedule.len();
-        let step = self.done;
-        let k = steps - 1 - step;
-        let t = vec![self.schedule.timesteps[k] as i64; batch];
-        let harmonizing = self.guidance.harmonization.is_some() && step < steps - self.free;
-        let c = self.method.coefficients(&self.schedule, k);
-        let noisy_step = k > 0 && c.sigma > 0.0;
-        if noisy_step {
-            self.noise.request(step as u64 + 1);
-        }
-        if k > 0 && harmonizing {
-            self.noise.request(HARMONIZE_STREAM_BASE + step as u64 + 1);
-        }
+        let Some(t) = self.begin_step() else {
+            return Ok(());
+        };
         let mut x0 = self
             .spare
             .take()
             .unwrap_or_else(|| Array3::zeros(self.shape));
-        let called = denoiser.denoise_into(self.x.view(), &t, &mut x0);
+        if let Err(e) = denoiser.denoise_into(self.x.view(), &vec![t; batch], &mut x0) {
+            self.abandon_step();
+            return Err(StepError::Denoiser(e));
+        }
+        self.complete_step(x0).map_err(StepError::Setup)
+    }
+
+    /// Starts the next step where the caller runs the network itself (a crowd batching many
+    /// runs into one call): asks for the step's noise and gives the original timestep at which
+    /// to denoise [`Sampler::current`]; `None` once finished. Calling it again before
+    /// [`Sampler::finish_step`] or [`Sampler::abandon_step`] starts nothing new.
+    pub fn begin_step(&mut self) -> Option<i64> {
+        if self.is_finished() {
+            return None;
+        }
+        let k = self.schedule.len() - 1 - self.done;
+        if !self.begun {
+            let (noisy, harmonizing) = self.draws(k);
+            if noisy {
+                self.noise.request(self.done as u64 + 1);
+            }
+            if k > 0 && harmonizing {
+                self.noise
+                    .request(HARMONIZE_STREAM_BASE + self.done as u64 + 1);
+            }
+            self.begun = true;
+        }
+        Some(self.schedule.timesteps[k] as i64)
+    }
+
+    /// Ends the step [`Sampler::begin_step`] started with the network's clean prediction `x0`
+    /// `[B, F, N]`: the same update [`Sampler::step`] makes (it is the same code).
+    pub fn finish_step(&mut self, x0: ArrayView3<'_, f32>) -> Result<(), SamplerError> {
+        if !self.begun {
+            return Err(SamplerError::StepNotBegun);
+        }
+        let mut buffer = match self.spare.take() {
+            Some(b) if b.dim() == x0.dim() => b,
+            _ => Array3::zeros(x0.dim()),
+        };
+        buffer.assign(&x0);
+        self.complete_step(buffer)
+    }
+
+    /// Gives up the step [`Sampler::begin_step`] started (the network failed): the sample stays
+    /// as it was before the step, and the step can be begun again.
+    pub fn abandon_step(&mut self) {
+        if !self.begun {
+            return;
+        }
+        let k = self.schedule.len() - 1 - self.done;
+        let (noisy, harmonizing) = self.draws(k);
+        for _ in 0..usize::from(noisy) + usize::from(k > 0 && harmonizing) {
+            if let Some(noise) = self.noise.receive() {
+                self.noise.recycle(noise);
+            }
+        }
+        self.begun = false;
+    }
+
+    /// Whether step index `k` draws the update's noise, and whether it harmonizes.
+    fn draws(&self, k: usize) -> (bool, bool) {
+        let steps = self.schedule.len();
+        let harmonizing = self.guidance.harmonization.is_some() && self.done < steps - self.free;
+        let c = self.method.coefficients(&self.schedule, k);
+        (k > 0 && c.sigma > 0.0, harmonizing)
+    }
+
+    /// The update of a begun step from the network's clean prediction `x0`.
+    fn complete_step(&mut self, mut x0: Array3<f32>) -> Result<(), SamplerError> {
+        let (_, features, frames) = self.shape;
+        let k = self.schedule.len() - 1 - self.done;
+        let (noisy_step, harmonizing) = self.draws(k);
+        let c = self.method.coefficients(&self.schedule, k);
         let eps = if noisy_step {
             self.noise.receive()
         } else {
@@ -203,14 +297,14 @@ impl Sampler {
         } else {
             None
         };
-        called.map_err(StepError::Denoiser)?;
+        self.begun = false;
         if x0.dim() != self.shape {
-            return Err(StepError::Setup(SamplerError::Shape {
+            return Err(SamplerError::Shape {
                 what: "denoiser's output",
                 got: (x0.dim().1, x0.dim().2),
                 features,
-                frames: self.shape.2,
-            }));
+                frames,
+            });
         }
         self.guide_prediction(&mut x0);
         let (c0, ct) = (c.x0 as f32, c.xt as f32);

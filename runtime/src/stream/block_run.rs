@@ -103,8 +103,12 @@ impl Stream {
             .map(|s| s.travel_commanded())
             .unwrap_or_default();
         let seed = block_seed(self.seed, self.blocks as u64);
-        let sampler =
-            Sampler::new(&self.schedule, &guidance, 1, f, n, seed)?.with_method(self.method)?;
+        let sampler = if self.noise_on_this_thread {
+            Sampler::new_on_this_thread(&self.schedule, &guidance, 1, f, n, seed)?
+        } else {
+            Sampler::new(&self.schedule, &guidance, 1, f, n, seed)?
+        };
+        let sampler = sampler.with_method(self.method)?;
         Ok(PendingBlock {
             window,
             sampler,

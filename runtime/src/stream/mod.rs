@@ -15,6 +15,7 @@
 
 mod block_run;
 pub mod blocks;
+mod crowd;
 mod guide;
 
 use std::collections::VecDeque;
@@ -32,6 +33,7 @@ use crate::steer::{SteerFrame, SteerLimits};
 use crate::tasks::{INBETWEEN_RAMP, Progress, TaskError};
 use block_run::PendingBlock;
 use blocks::{BlockSizes, block_seed};
+pub use crowd::{CharacterId, Crowd, CrowdProgress};
 use guide::Guide;
 
 /// Joints (and the root's travel) that a stream takes from poses the game supplies.
@@ -152,6 +154,9 @@ pub struct Stream {
     /// The next block, when its run has been started ahead of need.
     pending: Option<PendingBlock>,
     guide: Guide,
+    /// Whether blocks draw their noise on the calling thread (a crowd's streams) rather than
+    /// on a worker of their own; the values are the same.
+    noise_on_this_thread: bool,
 }
 
 impl Stream {
@@ -238,6 +243,7 @@ impl Stream {
             ready: VecDeque::new(),
             pending: None,
             guide: Guide::default(),
+            noise_on_this_thread: false,
         })
     }
 
@@ -336,6 +342,12 @@ impl Stream {
         while self.ready.len() < frames {
             self.advance(denoiser, usize::MAX)?;
         }
+        Ok(self.hand_out(frames))
+    }
+
+    /// Hands out the first `frames` ready frames (at most [`Stream::ready_frames`]).
+    fn hand_out(&mut self, frames: usize) -> StreamChunk {
+        let frames = frames.min(self.ready.len());
         let layout = &self.metadata.layout;
         let joints = layout.skeleton.len();
         let mut features = Array2::<f32>::zeros((self.metadata.network.features, frames));
@@ -351,7 +363,7 @@ impl Stream {
             translations.extend(frame.translations);
         }
         self.handed_out += frames;
-        Ok(StreamChunk {
+        StreamChunk {
             motion: LocalMotion {
                 skeleton: layout.skeleton.clone(),
                 fps: layout.fps,
@@ -359,7 +371,7 @@ impl Stream {
                 translations,
             },
             features,
-        })
+        }
     }
 
     /// Final frames made and not yet handed out: [`Stream::next`] for at most this many frames

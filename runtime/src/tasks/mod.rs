@@ -155,6 +155,14 @@ pub enum TaskError {
     /// Dance beats that cannot be placed.
     #[error("{0}")]
     Dance(String),
+    /// What went wrong with one character of a crowd.
+    #[error("character {id}: {source}")]
+    Character {
+        /// The character ([`crate::CharacterId`]'s number).
+        id: u64,
+        /// What went wrong.
+        source: Box<TaskError>,
+    },
 }
 
 impl From<Infallible> for TaskError {
