@@ -116,7 +116,7 @@ namespace Sinmdm
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_count(CrowdHandle crowd, out UIntPtr count);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_steer(CrowdHandle crowd, ulong id, SteerFrame[] commands, UIntPtr count);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_supply(CrowdHandle crowd, ModelHandle model, ulong id, ref PosesIn poses);
-        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_step(CrowdHandle crowd, ModelHandle model, UIntPtr maxRounds, UIntPtr ahead, out UIntPtr rounds, out UIntPtr waiting);
+        [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_step(CrowdHandle crowd, ModelHandle model, UIntPtr maxSteps, UIntPtr ahead, out UIntPtr steps, out UIntPtr waiting);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_crowd_next(CrowdHandle crowd, ModelHandle model, ulong id, UIntPtr frames, ref PoseBuffers buffers);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern void sinmdm_crowd_free(IntPtr crowd);
         [DllImport(Lib, CallingConvention = CallingConvention.Cdecl)] internal static extern int sinmdm_write_bvh(ModelHandle model, ref PosesIn poses, byte[] path);

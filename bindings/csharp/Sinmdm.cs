@@ -670,13 +670,13 @@ namespace Sinmdm
         public void Supply(ulong id, Poses poses) =>
             Native.Check(Native.WithInput(poses, model.Joints, input => Native.sinmdm_crowd_supply(handle, model.Handle, id, ref input)));
 
-        /// <summary>Prepares frames ahead with at most `maxRounds` rounds (call it each frame):
-        /// in each, every character with fewer than `ahead` frames ready takes one step, all
-        /// together; returns the characters still short of `ahead`.</summary>
-        public int Prepare(int maxRounds, int ahead)
+        /// <summary>Prepares frames ahead with at most `maxSteps` denoising steps, one step of
+        /// one character each (call it each frame): characters with fewer than `ahead` frames
+        /// ready step, the fewest ready first; returns the characters still short of `ahead`.</summary>
+        public int Prepare(int maxSteps, int ahead)
         {
-            Native.Check(Native.sinmdm_crowd_step(handle, model.Handle, Native.Size(maxRounds, nameof(maxRounds)),
-                                                  Native.Size(ahead, nameof(ahead)), out UIntPtr rounds, out UIntPtr waiting));
+            Native.Check(Native.sinmdm_crowd_step(handle, model.Handle, Native.Size(maxSteps, nameof(maxSteps)),
+                                                  Native.Size(ahead, nameof(ahead)), out UIntPtr steps, out UIntPtr waiting));
             return (int)waiting;
         }
 

@@ -802,21 +802,22 @@ enum SinmdmStatus sinmdm_crowd_supply(struct SinmdmCrowd *crowd,
                                       const struct SinmdmPoses *poses);
 
 /*
- Prepares frames ahead on `model` (the crowd's), spending at most `max_rounds` rounds: while
- some character has fewer than `ahead` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) ready,
- every such character takes one denoising step, all of them through the network together. A
- game calls it each frame with a small `max_rounds`, then reads each character with
- `sinmdm_crowd_next`, which then never waits. `rounds` (if not NULL) gets the rounds taken,
- `waiting` (if not NULL) the characters still short of `ahead` frames.
+ Prepares frames ahead on `model` (the crowd's), spending at most `max_steps` denoising steps
+ (one step of one character each): in rounds, each character with fewer than `ahead` frames
+ (at most `SINMDM_MAX_SAMPLE_FRAMES`) ready takes one step, those with the fewest ready first,
+ all of a round through the network together. A game calls it each frame with the steps it
+ can afford, then reads each character with `sinmdm_crowd_next`, which then never waits.
+ `steps` (if not NULL) gets the steps taken, `waiting` (if not NULL) the characters still
+ short of `ahead` frames.
 
  # Safety
- `crowd` and `model` are live handles; `rounds` and `waiting` NULL or writable.
+ `crowd` and `model` are live handles; `steps` and `waiting` NULL or writable.
  */
 enum SinmdmStatus sinmdm_crowd_step(struct SinmdmCrowd *crowd,
                                     struct SinmdmModel *model,
-                                    size_t max_rounds,
+                                    size_t max_steps,
                                     size_t ahead,
-                                    size_t *rounds,
+                                    size_t *steps,
                                     size_t *waiting);
 
 /*

@@ -149,22 +149,23 @@ pub unsafe extern "C" fn sinmdm_crowd_supply(
     })
 }
 
-/// Prepares frames ahead on `model` (the crowd's), spending at most `max_rounds` rounds: while
-/// some character has fewer than `ahead` frames (at most `SINMDM_MAX_SAMPLE_FRAMES`) ready,
-/// every such character takes one denoising step, all of them through the network together. A
-/// game calls it each frame with a small `max_rounds`, then reads each character with
-/// `sinmdm_crowd_next`, which then never waits. `rounds` (if not NULL) gets the rounds taken,
-/// `waiting` (if not NULL) the characters still short of `ahead` frames.
+/// Prepares frames ahead on `model` (the crowd's), spending at most `max_steps` denoising steps
+/// (one step of one character each): in rounds, each character with fewer than `ahead` frames
+/// (at most `SINMDM_MAX_SAMPLE_FRAMES`) ready takes one step, those with the fewest ready first,
+/// all of a round through the network together. A game calls it each frame with the steps it
+/// can afford, then reads each character with `sinmdm_crowd_next`, which then never waits.
+/// `steps` (if not NULL) gets the steps taken, `waiting` (if not NULL) the characters still
+/// short of `ahead` frames.
 ///
 /// # Safety
-/// `crowd` and `model` are live handles; `rounds` and `waiting` NULL or writable.
+/// `crowd` and `model` are live handles; `steps` and `waiting` NULL or writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn sinmdm_crowd_step(
     crowd: *mut SinmdmCrowd,
     model: *mut SinmdmModel,
-    max_rounds: usize,
+    max_steps: usize,
     ahead: usize,
-    rounds: *mut usize,
+    steps: *mut usize,
     waiting: *mut usize,
 ) -> SinmdmStatus {
     guard(|| {
@@ -178,9 +179,9 @@ pub unsafe extern "C" fn sinmdm_crowd_step(
         }
         let progress = crowd
             .crowd
-            .prepare(&mut model.model, max_rounds, ahead)
+            .prepare(&mut model.model, max_steps, ahead)
             .map_err(made_by_the_run)?;
-        for (slot, value) in [(rounds, progress.rounds), (waiting, progress.waiting)] {
+        for (slot, value) in [(steps, progress.steps), (waiting, progress.waiting)] {
             if !slot.is_null() {
                 unsafe { *slot = value };
             }

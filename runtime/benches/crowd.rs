@@ -1,8 +1,8 @@
 //! Characters per core: N steered walks on one shared model run on one thread, advanced as a
 //! game advances them, one model frame at a time, two ways side by side: each character its own
 //! [`Stream`] (each frame every character prepares ahead within a step budget, then takes its
-//! frame), and one [`Crowd`] (each frame the crowd prepares within a budget of rounds, every
-//! character short of frames stepping together, then every character takes its frame).
+//! frame), and one [`Crowd`] (each frame the crowd prepares within a budget of steps, the same
+//! budget per character as the streams', then every character takes its frame).
 //! Characters join at staggered block phases (their first frames are pulled, and the next
 //! prepared, before the clock starts), as characters of a game do, so their blocks do not all
 //! start on one frame.
@@ -10,7 +10,8 @@
 //! Prints, for each crowd size: CPU time of this thread per character-second of motion (and the
 //! characters one core animates in real time at the model's frame rate), the worst frame's wait
 //! for the whole crowd and per character, and the memory the crowd's streams hold per
-//! character. Linux: CPU time from /proc/thread-self/schedstat, memory from /proc/self/status.
+//! character. Linux: CPU time of the whole process (every thread, the streams' noise workers
+//! included) from /proc/self/stat, memory from /proc/self/status.
 //!
 //! `cargo bench -p sinmdm --bench crowd [-- MODEL.onnx]` (default: the shipped walk).
 //! `SINMDM_CROWD_SIZES=1,8,64,512` and `SINMDM_CROWD_SECONDS=20` (motion per character) change
@@ -33,11 +34,20 @@ fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
         .unwrap_or(default)
 }
 
-/// Nanoseconds this thread has run on a CPU (wall time where /proc says nothing).
-fn thread_cpu_ns(start: Instant) -> u128 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
+/// Nanoseconds the whole process has run on a CPU, user and system, every thread (wall time
+/// where /proc says nothing). /proc counts in clock ticks, 100 a second on Linux.
+fn process_cpu_ns(start: Instant) -> u128 {
+    std::fs::read_to_string("/proc/self/stat")
         .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse().ok())
+        .and_then(|s| {
+            // Fields after the command's closing parenthesis; utime and stime are the 12th and
+            // 13th of them.
+            let rest = &s[s.rfind(')')? + 2..];
+            let fields: Vec<&str> = rest.split_whitespace().collect();
+            let ticks: u128 =
+                fields.get(11)?.parse::<u128>().ok()? + fields.get(12)?.parse::<u128>().ok()?;
+            Some(ticks * 10_000_000)
+        })
         .unwrap_or_else(|| start.elapsed().as_nanos())
 }
 
@@ -133,7 +143,7 @@ fn streams(model: &mut Model, run: Run) -> Figures {
         stream.prepare(model, usize::MAX, ahead).expect("prepare");
     }
     let clock = Instant::now();
-    let cpu = thread_cpu_ns(clock);
+    let cpu = process_cpu_ns(clock);
     let (mut worst_frame, mut worst_character) = (0f64, 0f64);
     for _ in 0..frames / run.chunk {
         let frame = Instant::now();
@@ -145,7 +155,7 @@ fn streams(model: &mut Model, run: Run) -> Figures {
         }
         worst_frame = worst_frame.max(frame.elapsed().as_secs_f64());
     }
-    let cpu_s = (thread_cpu_ns(clock) - cpu) as f64 / 1e9;
+    let cpu_s = (process_cpu_ns(clock) - cpu) as f64 / 1e9;
     Figures {
         cpu_ms_per_character_second: 1e3 * cpu_s / (run.size as f64 * run.seconds),
         worst_frame_ms: 1e3 * worst_frame,
@@ -175,16 +185,18 @@ fn crowd(model: &mut Model, run: Run) -> Figures {
     let ahead = block / 4;
     crowd.prepare(model, usize::MAX, ahead).expect("prepare");
     let clock = Instant::now();
-    let cpu = thread_cpu_ns(clock);
+    let cpu = process_cpu_ns(clock);
     let mut worst_frame = 0f64;
     for _ in 0..frames / run.chunk {
         let frame = Instant::now();
-        crowd.prepare(model, run.budget, ahead).expect("prepare");
+        crowd
+            .prepare(model, run.budget * run.size, ahead)
+            .expect("prepare");
         let chunks = crowd.next(model, run.chunk).expect("next");
         std::hint::black_box(chunks);
         worst_frame = worst_frame.max(frame.elapsed().as_secs_f64());
     }
-    let cpu_s = (thread_cpu_ns(clock) - cpu) as f64 / 1e9;
+    let cpu_s = (process_cpu_ns(clock) - cpu) as f64 / 1e9;
     Figures {
         cpu_ms_per_character_second: 1e3 * cpu_s / (run.size as f64 * run.seconds),
         worst_frame_ms: 1e3 * worst_frame,
@@ -213,7 +225,7 @@ fn main() {
     let fps = model.metadata().layout.fps;
     println!(
         "{path}: {} s of {} walk per character at {fps} fps, {} steps per block, one thread, \
-         prepare budget {} steps (a stream) or rounds (a crowd) per frame",
+         prepare budget {} steps per character per frame",
         base.seconds,
         if base.free { "unsteered" } else { "steered" },
         base.steps,

@@ -163,25 +163,32 @@ fn joining_and_leaving_do_not_change_the_others() {
 }
 
 #[test]
-fn prepare_makes_frames_ahead_within_its_rounds() {
+fn prepare_makes_frames_ahead_within_its_steps_the_most_urgent_first() {
     let mut model = tiny(1);
     let mut crowd = Crowd::new(model.metadata());
     for i in 0..3 {
         crowd.join(options(i)).unwrap();
     }
-    // Each character needs 2-4 steps for its first block: one round makes nothing ready.
-    let progress = crowd.prepare(&mut model, 1, 10).unwrap();
-    assert_eq!(progress.rounds, 1);
+    // Each character needs 2-4 steps for its first block: a step each makes nothing ready.
+    let progress = crowd.prepare(&mut model, 3, 10).unwrap();
+    assert_eq!(progress.steps, 3);
     assert_eq!(progress.waiting, 3);
-    let progress = crowd.prepare(&mut model, 100, 10).unwrap();
-    assert_eq!(progress.waiting, 0);
-    // The slowest first block takes 4 steps, one of them already taken.
-    assert_eq!(progress.rounds, 3);
+    // A budget of one step goes to the most urgent (fewest ready, then first joined).
+    let progress = crowd.prepare(&mut model, 1, 10).unwrap();
+    assert_eq!(progress.steps, 1);
+    assert!(
+        crowd
+            .character(sinmdm::CharacterId(0))
+            .unwrap()
+            .ready_frames()
+            >= 10
+    );
+    assert_eq!(crowd.prepare(&mut model, 100, 10).unwrap().waiting, 0);
     for id in crowd.ids().collect::<Vec<_>>() {
         assert!(crowd.character(id).unwrap().ready_frames() >= 10);
     }
-    // Nothing is short: no round is taken.
-    assert_eq!(crowd.prepare(&mut model, 100, 10).unwrap().rounds, 0);
+    // Nothing is short: no step is taken.
+    assert_eq!(crowd.prepare(&mut model, 100, 10).unwrap().steps, 0);
 }
 
 #[test]

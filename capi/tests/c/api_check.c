@@ -452,11 +452,11 @@ static void check_crowd(const char *path, const char *world_path) {
     commands[i] = c;
   }
   CHECK_OK(sinmdm_crowd_steer(crowd, second, commands, 60));
-  size_t rounds = 0, waiting = 0, count = 0;
-  CHECK_OK(sinmdm_crowd_step(crowd, zombie, 2, 45, &rounds, &waiting));
-  expect_true(rounds == 2 && waiting == 2, "two rounds of three-step blocks leave both waiting");
+  size_t steps = 0, waiting = 0, count = 0;
+  CHECK_OK(sinmdm_crowd_step(crowd, zombie, 2, 45, &steps, &waiting));
+  expect_true(steps == 2 && waiting == 2, "a step each of three-step blocks leaves both waiting");
   CHECK_OK(sinmdm_crowd_step(crowd, zombie, 100, 45, NULL, &waiting));
-  expect_true(waiting == 0, "enough rounds prepare every character");
+  expect_true(waiting == 0, "enough steps prepare every character");
   Poses a = poses_alloc(20, info.joints), b = poses_alloc(25, info.joints);
   SinmdmPoseBuffers ba = buffers_of(&a), bb = buffers_of(&b);
   CHECK_OK(sinmdm_crowd_next(crowd, zombie, second, 20, &ba));

@@ -497,7 +497,7 @@ static void one_case(const char *model_a, const char *work) {
                                      pick(4) ? (uint32_t)pick(2) : any_u32(), NULL, 0, 0,
                                      pick(4) ? (uint32_t)pick(3) : any_u32(), coin() ? 0.0 : any_double()};
       uint64_t id = coin() ? pick(4) : next_random();
-      size_t rounds, waiting, count;
+      size_t steps, waiting, count;
       SinmdmPoseBuffers b = any_buffers();
       size_t frames_pool[] = {0, 1, 20, 45, SINMDM_MAX_SAMPLE_FRAMES + 1, SIZE_MAX};
       static SinmdmSteerCommand told[4];
@@ -529,7 +529,7 @@ static void one_case(const char *model_a, const char *work) {
         case 7:
           CALL("crowd_step", sinmdm_crowd_step(ANY_OF(crowds), any_model_handle(), pick(3),
                                                coin() ? 1 + pick(60) : any_size(SINMDM_MAX_SAMPLE_FRAMES),
-                                               coin() ? &rounds : NULL, coin() ? &waiting : NULL));
+                                               coin() ? &steps : NULL, coin() ? &waiting : NULL));
           break;
         default:
           CALL("crowd_next", sinmdm_crowd_next(ANY_OF(crowds), any_model_handle(), id,

@@ -1,6 +1,6 @@
-//! Many characters' streams advanced together: a [`Crowd`] steps every character that needs
-//! frames once per round, handing the network all of their blocks of one window length in one
-//! call, so a game makes one call per step for its whole crowd instead of one per character.
+//! Many characters' streams advanced together: a [`Crowd`] steps the characters that need
+//! frames in rounds, the most urgent first and within a budget of steps, handing the network
+//! their blocks of one window length together.
 //!
 //! Each character is a [`Stream`] of its own (its own seed, options, steering and supplied
 //! poses), and its motion is the same bits as that stream read alone: a block's run does not
@@ -32,9 +32,9 @@ impl std::fmt::Display for CharacterId {
 /// What one [`Crowd::prepare`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct CrowdProgress {
-    /// Rounds taken: in each, every character short of frames took one denoising step.
-    pub rounds: usize,
-    /// Characters still short of the frames asked for (more rounds will make them).
+    /// Denoising steps taken, one per character stepped.
+    pub steps: usize,
+    /// Characters still short of the frames asked for (more steps will make them).
     pub waiting: usize,
 }
 
@@ -117,14 +117,15 @@ impl Crowd {
         self.characters.binary_search_by_key(&id, |(c, _)| *c).ok()
     }
 
-    /// Makes frames ahead of need, spending at most `max_rounds` rounds: while some character
-    /// has fewer than `ahead` frames ready, every such character takes one denoising step (all
-    /// of them through the network together). A game calls it every frame with a small
-    /// `max_rounds`, then reads each character's frame, which then never waits.
+    /// Makes frames ahead of need, spending at most `max_steps` denoising steps (one step of
+    /// one character each): in rounds, each character with fewer than `ahead` frames ready
+    /// takes one step, those with the fewest ready first, all of a round through the network
+    /// together. A game calls it every frame with the steps it can afford (its frame budget
+    /// over a step's cost), then reads each character's frame, which then never waits.
     pub fn prepare<D: Denoiser>(
         &mut self,
         denoiser: &mut D,
-        max_rounds: usize,
+        max_steps: usize,
         ahead: usize,
     ) -> Result<CrowdProgress, TaskError>
     where
@@ -136,12 +137,15 @@ impl Crowd {
                 reason: format!("at most {MAX_SAMPLE_FRAMES} frames are prepared ahead"),
             });
         }
-        let mut rounds = 0;
-        while rounds < max_rounds && self.round(denoiser, ahead)? {
-            rounds += 1;
+        let mut steps = 0;
+        while steps < max_steps {
+            match self.round(denoiser, ahead, max_steps - steps)? {
+                0 => break,
+                taken => steps += taken,
+            }
         }
         Ok(CrowdProgress {
-            rounds,
+            steps,
             waiting: self.waiting(ahead),
         })
     }
@@ -162,7 +166,7 @@ impl Crowd {
                 reason: format!("one chunk holds at most {MAX_SAMPLE_FRAMES} frames"),
             });
         }
-        while self.round(denoiser, frames)? {}
+        while self.round(denoiser, frames, usize::MAX)? > 0 {}
         Ok(self
             .characters
             .iter_mut()
@@ -178,25 +182,35 @@ impl Crowd {
             .count()
     }
 
-    /// One step for every character with fewer than `ahead` frames ready (starting its next
-    /// block where none is under way); `false` when none needed one.
-    fn round<D: Denoiser>(&mut self, denoiser: &mut D, ahead: usize) -> Result<bool, TaskError>
+    /// One step for each character with fewer than `ahead` frames ready (starting its next
+    /// block where none is under way), at most `most` of them, the fewest ready first (then
+    /// in the order joined); gives the steps taken.
+    fn round<D: Denoiser>(
+        &mut self,
+        denoiser: &mut D,
+        ahead: usize,
+        most: usize,
+    ) -> Result<usize, TaskError>
     where
         TaskError: From<D::Error>,
     {
-        let mut working = Vec::new();
-        for (at, (id, stream)) in self.characters.iter_mut().enumerate() {
-            if stream.ready.len() >= ahead {
-                continue;
-            }
+        let mut short: Vec<(usize, usize)> = self
+            .characters
+            .iter()
+            .enumerate()
+            .filter(|(_, (_, s))| s.ready.len() < ahead)
+            .map(|(at, (_, s))| (s.ready.len(), at))
+            .collect();
+        short.sort_unstable();
+        short.truncate(most);
+        let mut working = Vec::with_capacity(short.len());
+        for &(_, at) in &short {
+            let (id, stream) = &mut self.characters[at];
             if stream.pending.is_none() {
                 let block = stream.start_block().map_err(|e| e.of(*id))?;
                 stream.pending = Some(block);
             }
             working.push((stream.pending_frames(), at));
-        }
-        if working.is_empty() {
-            return Ok(false);
         }
         // Blocks of one window length go through the network together, in the order joined.
         working.sort_unstable();
@@ -206,7 +220,7 @@ impl Crowd {
                 self.step_together(denoiser, call[0].0, &members)?;
             }
         }
-        Ok(true)
+        Ok(working.len())
     }
 
     /// One step of the blocks under way of the characters at `members` (windows of `frames`
