@@ -254,3 +254,21 @@ fn a_character_s_bad_options_are_refused_when_it_joins() {
     assert!(matches!(err, TaskError::Stream(_)), "{err}");
     assert!(crowd.is_empty());
 }
+
+#[test]
+fn preparing_some_characters_steps_none_of_the_others() {
+    let mut model = tiny(1);
+    let mut crowd = Crowd::new(model.metadata());
+    let ids: Vec<CharacterId> = (0..4).map(|i| crowd.join(options(i)).unwrap()).collect();
+    let chosen = [ids[1], ids[3], CharacterId(99)];
+    let progress = crowd
+        .prepare_characters(&mut model, &chosen, usize::MAX, 10)
+        .unwrap();
+    assert_eq!(progress.waiting, 0);
+    // Characters 1 and 3 take 3 and 2 steps (2 + i % 3) for their first blocks.
+    assert_eq!(progress.steps, 5);
+    let ready = |k: usize| crowd.character(ids[k]).unwrap().ready_frames();
+    assert_eq!((ready(0), ready(2)), (0, 0));
+    assert!(ready(1) >= 10 && ready(3) >= 10);
+    assert_eq!(crowd.character(ids[0]).unwrap().block_progress().total, 0);
+}

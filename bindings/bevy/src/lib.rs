@@ -13,10 +13,15 @@
 //! Poses are placed in Bevy's frame (+Y up, metres) by [`EngineFrame`]: the model's up axis
 //! comes from its file, its unit is guessed from the figure's height unless given.
 //!
+//! Many characters of one model can share a [`MotionCrowd`] ([`spawn_crowd`],
+//! [`spawn_crowd_character`]): one request on the compute pool makes the next chunk of every
+//! character that needs one, their blocks through the network together.
+//!
 //! With the `animation-clip` feature, [`bake`] turns generated poses into an
 //! `AnimationClip` that Bevy's animation graph can blend with authored clips.
 
 pub mod character;
+pub mod crowd;
 pub mod frame;
 pub mod steering;
 
@@ -32,6 +37,7 @@ use bevy_transform::components::Transform;
 pub use character::{
     CharacterOptions, MotionCharacter, MotionModel, spawn_character, spawn_skeleton,
 };
+pub use crowd::{CrowdCharacter, CrowdOptions, MotionCrowd, spawn_crowd, spawn_crowd_character};
 pub use frame::EngineFrame;
 pub use steering::Steering;
 
@@ -55,7 +61,10 @@ impl Plugin for SinmdmPlugin {
                 .after(AnimationSystems)
                 .before(TransformSystems::Propagate),
         )
-        .add_systems(PostUpdate, drive_characters.in_set(SinmdmSystems::Drive));
+        .add_systems(
+            PostUpdate,
+            (drive_characters, crowd::drive_crowds).in_set(SinmdmSystems::Drive),
+        );
     }
 }
 

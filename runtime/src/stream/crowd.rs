@@ -131,6 +131,35 @@ impl Crowd {
     where
         TaskError: From<D::Error>,
     {
+        self.prepare_among(denoiser, None, max_steps, ahead)
+    }
+
+    /// [`Crowd::prepare`] for the characters `ids` only (the others' blocks are not stepped): for
+    /// a game that prepares the characters on screen first, or hands out chunks to some
+    /// characters only. Numbers not in the crowd are passed over.
+    pub fn prepare_characters<D: Denoiser>(
+        &mut self,
+        denoiser: &mut D,
+        ids: &[CharacterId],
+        max_steps: usize,
+        ahead: usize,
+    ) -> Result<CrowdProgress, TaskError>
+    where
+        TaskError: From<D::Error>,
+    {
+        self.prepare_among(denoiser, Some(ids), max_steps, ahead)
+    }
+
+    fn prepare_among<D: Denoiser>(
+        &mut self,
+        denoiser: &mut D,
+        among: Option<&[CharacterId]>,
+        max_steps: usize,
+        ahead: usize,
+    ) -> Result<CrowdProgress, TaskError>
+    where
+        TaskError: From<D::Error>,
+    {
         if ahead > MAX_SAMPLE_FRAMES {
             return Err(TaskError::Length {
                 frames: ahead,
@@ -139,15 +168,17 @@ impl Crowd {
         }
         let mut steps = 0;
         while steps < max_steps {
-            match self.round(denoiser, ahead, max_steps - steps)? {
+            match self.round(denoiser, among, ahead, max_steps - steps)? {
                 0 => break,
                 taken => steps += taken,
             }
         }
-        Ok(CrowdProgress {
-            steps,
-            waiting: self.waiting(ahead),
-        })
+        let waiting = self
+            .characters
+            .iter()
+            .filter(|(id, s)| s.ready.len() < ahead && among.is_none_or(|ids| ids.contains(id)))
+            .count();
+        Ok(CrowdProgress { steps, waiting })
     }
 
     /// Every character's next `frames` frames, in the order they joined, making the blocks
@@ -166,7 +197,7 @@ impl Crowd {
                 reason: format!("one chunk holds at most {MAX_SAMPLE_FRAMES} frames"),
             });
         }
-        while self.round(denoiser, frames, usize::MAX)? > 0 {}
+        while self.round(denoiser, None, frames, usize::MAX)? > 0 {}
         Ok(self
             .characters
             .iter_mut()
@@ -182,12 +213,13 @@ impl Crowd {
             .count()
     }
 
-    /// One step for each character with fewer than `ahead` frames ready (starting its next
-    /// block where none is under way), at most `most` of them, the fewest ready first (then
+    /// One step for each character (of `among`, where given) with fewer than `ahead` frames
+    /// ready (starting its next block where none is under way), at most `most` of them, the fewest ready first (then
     /// in the order joined); gives the steps taken.
     fn round<D: Denoiser>(
         &mut self,
         denoiser: &mut D,
+        among: Option<&[CharacterId]>,
         ahead: usize,
         most: usize,
     ) -> Result<usize, TaskError>
@@ -198,7 +230,9 @@ impl Crowd {
             .characters
             .iter()
             .enumerate()
-            .filter(|(_, (_, s))| s.ready.len() < ahead)
+            .filter(|(_, (id, s))| {
+                s.ready.len() < ahead && among.is_none_or(|ids| ids.contains(id))
+            })
             .map(|(at, (_, s))| (s.ready.len(), at))
             .collect();
         short.sort_unstable();
