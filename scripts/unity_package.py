@@ -182,7 +182,8 @@ def main(argv=None):
     write(os.path.join(root, "Runtime", "Sinmdm.Runtime.asmdef"), json.dumps(asmdef, indent=2) + "\n")
     for source in sorted(glob.glob(os.path.join(REPO, "bindings", "csharp", "*.cs"))):
         shutil.copyfile(source, os.path.join(root, "Runtime", os.path.basename(source)))
-    shutil.copyfile(os.path.join(REPO, "bindings", "unity", "SinmdmAnimator.cs"), os.path.join(root, "Runtime", "SinmdmAnimator.cs"))
+    for component in ["SinmdmAnimator.cs", "SinmdmCrowdAnimator.cs"]:
+        shutil.copyfile(os.path.join(REPO, "bindings", "unity", component), os.path.join(root, "Runtime", component))
     os.makedirs(os.path.join(root, plugins), exist_ok=True)
     shutil.copyfile(built, os.path.join(root, plugins, library))
     ort = onnxruntime_library()
@@ -207,7 +208,8 @@ def main(argv=None):
         "# sinmdm for Unity\n\n"
         "New, varied motion at run time from a model trained on one clip. `Runtime/Sinmdm*.cs` are the C# binding "
         "(models, tasks, stepped runs, endless streams, progress and cancel); `Runtime/SinmdmAnimator.cs` plays a "
-        "stream on a character's bones, preparing frames a few denoising steps per frame so no frame waits. "
+        "stream on a character's bones, preparing frames a few denoising steps per frame so no frame waits; "
+        "`Runtime/SinmdmCrowdAnimator.cs` plays one crowd of many characters, each with its own seed and turn. "
         "The sample `Walker` uses the shipped CMU walk.\n\n"
         f"Native libraries: `{plugins}/` (built for this platform by `scripts/unity_package.py`; onnxruntime sits "
         "next to sinmdm_c, where the runtime looks for it). Same model, seed and settings give the same poses on any "

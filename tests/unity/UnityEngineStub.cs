@@ -1,5 +1,6 @@
-// The few UnityEngine types the package's Runtime/ uses, as empty stand-ins, so CI can compile
-// the package's scripts with mcs where Unity is not installed. Signatures follow Unity's.
+// The few UnityEngine types the package's Runtime/ uses, as stand-ins, so CI can compile the
+// package's scripts with mcs where Unity is not installed, and run its components headless
+// (tests/unity/CrowdCheck.cs). Signatures follow Unity's.
 using System;
 
 namespace UnityEngine
@@ -9,11 +10,23 @@ namespace UnityEngine
     {
         public Transform transform;
         public GameObject gameObject;
-        public T[] GetComponentsInChildren<T>() { return new T[0]; }
+        public T[] GetComponentsInChildren<T>() { return gameObject != null ? gameObject.GetComponentsInChildren<T>() : new T[0]; }
     }
     public class Behaviour : Component { }
     public class MonoBehaviour : Behaviour { }
-    public class GameObject : Object { public T AddComponent<T>() where T : Component, new() { return new T(); } }
+    // A game object holds its components, its children's flattened into it (enough for a rig
+    // whose bones are found by name).
+    public class GameObject : Object
+    {
+        readonly System.Collections.Generic.List<Component> components = new System.Collections.Generic.List<Component>();
+        public T AddComponent<T>() where T : Component, new() { var c = new T(); c.gameObject = this; components.Add(c); return c; }
+        public T[] GetComponentsInChildren<T>()
+        {
+            var found = new System.Collections.Generic.List<T>();
+            foreach (var c in components) if (c is T t) found.Add(t);
+            return found.ToArray();
+        }
+    }
     public class Transform : Component
     {
         public Quaternion localRotation;
