@@ -18,14 +18,15 @@
 //! the run; `SINMDM_CROWD_BUDGET=4` is the steps a character may spend preparing per frame;
 //! `SINMDM_CROWD_FREE=1` leaves the characters unsteered; `SINMDM_CROWD_CHUNK=30` reads 30
 //! frames a call (then a "frame" below is one such read); `SINMDM_CROWD_WAY=streams` or `crowd`
-//! runs one way only; `SINMDM_CROWD_STEPS=20` sets the denoising steps per block.
+//! runs one way only (`crowd-one-call`: a crowd whose blocks are one onnxruntime call per
+//! thread, `OneCallPerThread`); `SINMDM_CROWD_STEPS=20` sets the denoising steps per block.
 
 use std::time::Instant;
 
 mod common;
 
 use sinmdm::steer::SteerFrame;
-use sinmdm::{Crowd, Feet, Model, ModelOptions, Stream, StreamOptions};
+use sinmdm::{Crowd, Feet, Model, ModelOptions, OneCallPerThread, Stream, StreamOptions};
 
 fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
     std::env::var(name)
@@ -166,6 +167,25 @@ fn streams(model: &mut Model, run: Run) -> Figures {
 
 /// One crowd of every character.
 fn crowd(model: &mut Model, run: Run) -> Figures {
+    crowd_run(model, run, false)
+}
+
+/// One crowd of every character, its blocks denoised in one onnxruntime call per thread.
+fn crowd_one_call(model: &mut Model, run: Run) -> Figures {
+    crowd_run(model, run, true)
+}
+
+/// [`Crowd::prepare`] on the model, or on it one call per thread.
+fn prepare(crowd: &mut Crowd, model: &mut Model, one_call: bool, steps: usize, ahead: usize) {
+    if one_call {
+        crowd.prepare(&mut OneCallPerThread(model), steps, ahead)
+    } else {
+        crowd.prepare(model, steps, ahead)
+    }
+    .expect("prepare");
+}
+
+fn crowd_run(model: &mut Model, run: Run, one_call: bool) -> Figures {
     let fps = model.metadata().layout.fps;
     let frames = (run.seconds * fps).round() as usize;
     let before = resident_bytes();
@@ -183,16 +203,19 @@ fn crowd(model: &mut Model, run: Run) -> Figures {
     }
     let held = resident_bytes().saturating_sub(before) as f64 / run.size as f64;
     let ahead = block / 4;
-    crowd.prepare(model, usize::MAX, ahead).expect("prepare");
+    prepare(&mut crowd, model, one_call, usize::MAX, ahead);
     let clock = Instant::now();
     let cpu = process_cpu_ns(clock);
     let mut worst_frame = 0f64;
     for _ in 0..frames / run.chunk {
         let frame = Instant::now();
-        crowd
-            .prepare(model, run.budget * run.size, ahead)
-            .expect("prepare");
-        let chunks = crowd.next(model, run.chunk).expect("next");
+        prepare(&mut crowd, model, one_call, run.budget * run.size, ahead);
+        let chunks = if one_call {
+            crowd.next(&mut OneCallPerThread(model), run.chunk)
+        } else {
+            crowd.next(model, run.chunk)
+        }
+        .expect("next");
         std::hint::black_box(chunks);
         worst_frame = worst_frame.max(frame.elapsed().as_secs_f64());
     }
@@ -241,7 +264,12 @@ fn main() {
         let ways: &[(&str, Way)] = match way.as_str() {
             "streams" => &[("streams", streams)],
             "crowd" => &[("crowd", crowd)],
-            _ => &[("streams", streams), ("crowd", crowd)],
+            "crowd-one-call" => &[("crowd, one call", crowd_one_call)],
+            _ => &[
+                ("streams", streams),
+                ("crowd", crowd),
+                ("crowd, one call", crowd_one_call),
+            ],
         };
         for (name, go) in ways {
             let f = go(&mut model, run);

@@ -43,6 +43,7 @@
 // modules are the plumbing that the project's other crates (training, export, formats, the
 // command line, the C ABI) and its tests build on: public so they can, hidden from the
 // documentation so an engine programmer is not asked to read them.
+pub mod batched;
 #[cfg(feature = "bvh")]
 pub mod bvh;
 #[doc(hidden)]
@@ -69,6 +70,7 @@ pub mod stream;
 #[doc(hidden)]
 pub mod tasks;
 
+pub use batched::OneCallPerThread;
 pub use diffusion::{DEFAULT_STEPS, Denoiser, Method, Sampler, SamplerError, StepError};
 pub use model::{Model, ModelError, ModelOptions};
 pub use model_file::ModelMetadata;

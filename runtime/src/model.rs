@@ -292,6 +292,13 @@ impl Model {
         Ok(())
     }
 
+    /// The first `count` sessions (made as needed) and the model file's path, for a denoiser
+    /// that calls them its own way ([`crate::batched`]).
+    pub(crate) fn sessions(&mut self, count: usize) -> Result<(&mut [Session], &Path), ModelError> {
+        self.sessions_for(count)?;
+        Ok((&mut self.sessions[..count], self.path.as_path()))
+    }
+
     /// One denoiser call: noisy normalised features `x_t` `[B, F, N]` at diffusion steps `t`
     /// (one per batch row) to the predicted clean features `[B, F, N]`.
     pub fn denoise(

@@ -5,7 +5,10 @@
 mod common;
 
 use sinmdm::steer::SteerFrame;
-use sinmdm::{CharacterId, Crowd, Feet, Model, ModelOptions, Stream, StreamOptions, TaskError};
+use sinmdm::{
+    CharacterId, Crowd, Feet, Model, ModelOptions, OneCallPerThread, Stream, StreamOptions,
+    TaskError,
+};
 
 fn tiny(threads: usize) -> Model {
     Model::open(
@@ -68,6 +71,26 @@ fn alone(model: &mut Model, i: usize, frames: usize, chunk: usize) -> Vec<u64> {
     while made < frames {
         let n = chunk.min(frames - made);
         out.extend(bits(&stream.next(model, n).unwrap()));
+        made += n;
+    }
+    out
+}
+
+/// [`crowd`] with the crowd's blocks denoised in one onnxruntime call per thread.
+fn crowd_one_call(model: &mut Model, size: usize, frames: usize, chunk: usize) -> Vec<Vec<u64>> {
+    let mut crowd = Crowd::new(model.metadata());
+    for i in 0..size {
+        crowd.join(options(i)).unwrap();
+    }
+    let mut batched = OneCallPerThread(model);
+    let mut out = vec![Vec::new(); size];
+    let mut made = 0;
+    while made < frames {
+        let n = chunk.min(frames - made);
+        crowd.prepare(&mut batched, 3 * size, n + 5).unwrap();
+        for (k, (_, part)) in crowd.next(&mut batched, n).unwrap().into_iter().enumerate() {
+            out[k].extend(bits(&part));
+        }
         made += n;
     }
     out
@@ -271,4 +294,26 @@ fn preparing_some_characters_steps_none_of_the_others() {
     assert_eq!((ready(0), ready(2)), (0, 0));
     assert!(ready(1) >= 10 && ready(3) >= 10);
     assert_eq!(crowd.character(ids[0]).unwrap().block_progress().total, 0);
+}
+
+#[test]
+fn one_call_per_thread_keeps_each_character_s_bits_here() {
+    // onnxruntime does not promise it (so it is an opt-in); this checks it holds here.
+    let frames = 50;
+    let mut one = tiny(1);
+    let watched = [0, 4, 13];
+    let expected: Vec<Vec<u64>> = watched
+        .iter()
+        .map(|&i| alone(&mut one, i, frames, frames))
+        .collect();
+    for threads in [1, 2] {
+        let mut model = tiny(threads);
+        let got = crowd_one_call(&mut model, 16, frames, 7);
+        for (&i, want) in watched.iter().zip(&expected) {
+            assert!(
+                &got[i] == want,
+                "character {i} batched on {threads} threads differs from it alone"
+            );
+        }
+    }
 }

@@ -214,8 +214,8 @@ impl Crowd {
     }
 
     /// One step for each character (of `among`, where given) with fewer than `ahead` frames
-    /// ready (starting its next block where none is under way), at most `most` of them, the fewest ready first (then
-    /// in the order joined); gives the steps taken.
+    /// ready (starting its next block where none is under way), at most `most` of them, the
+    /// fewest ready first (then in the order joined); gives the steps taken.
     fn round<D: Denoiser>(
         &mut self,
         denoiser: &mut D,
