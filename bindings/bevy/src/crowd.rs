@@ -6,8 +6,8 @@
 //! skeleton whose entity holds a [`CrowdCharacter`] of that crowd, steered by a [`Steering`] on
 //! it. Every frame the plugin advances each character's clock; when any character has fewer
 //! than its chunk plus [`CrowdOptions::ahead_frames`] frames ready and the crowd is idle, the
-//! steering of every character is queued on its stream and one request makes the next chunk of
-//! every character that needs one.
+//! steering of every character that needs frames is queued on its stream and one request makes
+//! their next chunks. A despawned character leaves the crowd at its next request.
 
 use std::collections::VecDeque;
 use std::sync::Mutex;
@@ -81,11 +81,17 @@ pub struct MotionCrowd {
     /// idle.
     joining: Vec<(Entity, StreamOptions)>,
     requests: u64,
+    members: usize,
     slowest_request: f64,
     error: Option<String>,
 }
 
 impl MotionCrowd {
+    /// Characters in the crowd as of its last request (a despawned character leaves then).
+    pub fn characters(&self) -> usize {
+        self.members
+    }
+
     /// Requests made so far (each makes the next chunk of every character that needs one).
     pub fn requests(&self) -> u64 {
         self.requests
@@ -186,6 +192,7 @@ pub fn spawn_crowd(
             options,
             joining: Vec::new(),
             requests: 0,
+            members: 0,
             slowest_request: 0.0,
             error: None,
         })
@@ -380,6 +387,22 @@ fn request(
             Err(e) => crowd.error = Some(format!("a character could not join: {e}")),
         }
     }
+    // Characters whose entities are gone leave the crowd.
+    let mut present: Vec<CharacterId> = characters
+        .iter()
+        .filter(|(_, c, _)| c.crowd == crowd_entity)
+        .filter_map(|(_, c, _)| c.id)
+        .collect();
+    present.sort_unstable();
+    let gone: Vec<CharacterId> = engine
+        .crowd
+        .ids()
+        .filter(|id| present.binary_search(id).is_err())
+        .collect();
+    for id in gone {
+        engine.crowd.leave(id);
+    }
+    crowd.members = engine.crowd.len();
     let chunk = options.chunk_frames.max(1);
     let mut wanted = Vec::new();
     for (_, mut c, steering) in characters.iter_mut() {

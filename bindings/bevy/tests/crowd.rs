@@ -1,7 +1,8 @@
 //! A crowd in a headless Bevy app: 200 characters of the shipped walk (heading-relative), each
 //! told its own turn, each following it (a left turn turns left, a right turn right, straight
 //! stays nearly straight); two characters with the same seed and steering move alike whatever
-//! the crowd around them, and every character has joined and moved.
+//! the crowd around them, every character has joined and moved, and ten despawned half-way have
+//! left the crowd.
 
 mod common;
 
@@ -37,7 +38,16 @@ fn two_hundred_characters_each_follow_their_own_path() {
 
     let frames = (4.0 * BEVY_FPS) as usize;
     let mut roots: Vec<Vec<Vec3>> = vec![Vec::new(); CHARACTERS];
-    for _ in 0..frames {
+    let mut characters = characters;
+    let leaving = 10;
+    for frame in 0..frames {
+        if frame == frames / 2 {
+            // The last ten walkers are despawned half-way: they leave the crowd.
+            for &c in &characters[CHARACTERS - leaving..] {
+                app.world_mut().entity_mut(c).despawn();
+            }
+            characters.truncate(CHARACTERS - leaving);
+        }
         app.update();
         let world = app.world();
         for (k, &c) in characters.iter().enumerate() {
@@ -52,6 +62,7 @@ fn two_hundred_characters_each_follow_their_own_path() {
     let world = app.world();
     let motion = world.get::<MotionCrowd>(crowd).unwrap();
     assert!(motion.error().is_none(), "{:?}", motion.error());
+    assert_eq!(motion.characters(), CHARACTERS - leaving);
     println!(
         "{CHARACTERS} characters, {frames} frames: {} requests, the slowest {:.3} s",
         motion.requests(),
@@ -76,6 +87,7 @@ fn two_hundred_characters_each_follow_their_own_path() {
     let half = (BEVY_FPS / 2.0) as usize;
     let start = frames - 6 * half;
     let mut turned = [Vec::new(), Vec::new(), Vec::new()];
+    roots.truncate(CHARACTERS - leaving);
     for (k, r) in roots.iter().enumerate() {
         let moved = (r[frames - 1] - r[start]).length();
         // Asked to walk at the clip's speed for 3 s: at least half of that.
