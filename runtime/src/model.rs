@@ -292,13 +292,6 @@ impl Model {
         Ok(())
     }
 
-    /// The first `count` sessions (made as needed) and the model file's path, for a denoiser
-    /// that calls them its own way ([`crate::batched`]).
-    pub(crate) fn sessions(&mut self, count: usize) -> Result<(&mut [Session], &Path), ModelError> {
-        self.sessions_for(count)?;
-        Ok((&mut self.sessions[..count], self.path.as_path()))
-    }
-
     /// One denoiser call: noisy normalised features `x_t` `[B, F, N]` at diffusion steps `t`
     /// (one per batch row) to the predicted clean features `[B, F, N]`.
     pub fn denoise(
@@ -319,6 +312,17 @@ impl Model {
         t: &[i64],
         out: &mut Array3<f32>,
     ) -> Result<(), ModelError> {
+        self.denoise_in_calls(x_t, t, out, Calls::PerSample)
+    }
+
+    /// [`Model::denoise_into`] with the batch's onnxruntime calls as `calls` says.
+    pub(crate) fn denoise_in_calls(
+        &mut self,
+        x_t: ArrayView3<'_, f32>,
+        t: &[i64],
+        out: &mut Array3<f32>,
+        calls: Calls,
+    ) -> Result<(), ModelError> {
         let (b, f, n) = x_t.dim();
         if f != self.features() {
             return Err(ModelError::FeatureRows {
@@ -338,11 +342,16 @@ impl Model {
             *out = Array3::zeros((b, f, n));
         }
         let path = self.path.as_path();
-        // Sample i goes to thread i mod W; each thread has its own session, and the first share
-        // runs on the calling thread.
+        // Per sample: sample i goes to thread i mod W, one call each. Per thread: thread k takes
+        // the k-th contiguous share of rows in one call. Each thread has its own session, and the
+        // first share runs on the calling thread.
+        let rows_per_call = match calls {
+            Calls::PerSample => 1,
+            Calls::PerThread => b.div_ceil(workers).max(1),
+        };
         let mut shares: Vec<Share<'_>> = (0..workers).map(|_| Vec::new()).collect();
-        for (sample, target) in out.outer_iter_mut().enumerate() {
-            shares[sample % workers].push((sample, target));
+        for (k, target) in out.axis_chunks_iter_mut(Axis(0), rows_per_call).enumerate() {
+            shares[k % workers].push((k * rows_per_call, target));
         }
         let mut sessions = self.sessions[..workers].iter_mut();
         let mut shares = shares.into_iter();
@@ -383,10 +392,19 @@ impl Model {
     }
 }
 
-/// The samples one thread denoises: each sample's index and the output it fills.
-type Share<'a> = Vec<(usize, ndarray::ArrayViewMut2<'a, f32>)>;
+/// How a batch goes through onnxruntime: one call per sample (the default, whose bits do not
+/// depend on the batch), or one call per thread over a contiguous share of rows
+/// ([`crate::OneCallPerThread`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Calls {
+    PerSample,
+    PerThread,
+}
 
-/// Denoises a share of a batch, sample by sample, through one session.
+/// The calls one thread makes: each call's first row and the output rows it fills.
+type Share<'a> = Vec<(usize, ndarray::ArrayViewMut3<'a, f32>)>;
+
+/// Makes a thread's calls through one session.
 fn denoise_share(
     session: &mut Session,
     path: &Path,
@@ -394,32 +412,34 @@ fn denoise_share(
     t: &[i64],
     share: Share<'_>,
 ) -> Result<(), ModelError> {
-    for (sample, target) in share {
-        denoise_one(
+    for (first, target) in share {
+        let rows = first..first + target.dim().0;
+        denoise_rows(
             session,
             path,
-            x_t.index_axis(Axis(0), sample),
-            t[sample],
+            x_t.slice(ndarray::s![rows.clone(), .., ..]),
+            &t[rows],
             target,
         )?;
     }
     Ok(())
 }
 
-/// One sample `[F, N]` at diffusion step `t` through `session`, written into `target`.
-fn denoise_one(
+/// Rows `x_t` `[B, F, N]` at diffusion steps `t` (one per row) through `session` in one call,
+/// written into `target`.
+fn denoise_rows(
     session: &mut Session,
     path: &Path,
-    x_t: ndarray::ArrayView2<'_, f32>,
-    t: i64,
-    mut target: ndarray::ArrayViewMut2<'_, f32>,
+    x_t: ArrayView3<'_, f32>,
+    t: &[i64],
+    mut target: ndarray::ArrayViewMut3<'_, f32>,
 ) -> Result<(), ModelError> {
-    let (f, n) = x_t.dim();
+    let (b, f, n) = x_t.dim();
     let run_failed = |e: ort::Error| ModelError::Run {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    // A contiguous sample is lent to onnxruntime as it is (no copy); any other is copied.
+    // Contiguous rows are lent to onnxruntime as they are (no copy); any others are copied.
     let copied: Vec<f32>;
     let data = match x_t.as_slice() {
         Some(s) => s,
@@ -428,19 +448,18 @@ fn denoise_one(
             &copied
         }
     };
-    let xs = TensorRef::from_array_view(([1, f, n], data)).map_err(run_failed)?;
-    let steps = [t];
-    let ts = TensorRef::from_array_view(([1], &steps[..])).map_err(run_failed)?;
+    let xs = TensorRef::from_array_view(([b, f, n], data)).map_err(run_failed)?;
+    let ts = TensorRef::from_array_view(([b], t)).map_err(run_failed)?;
     let outputs = session
         .run(ort::inputs![INPUT_FEATURES => xs, INPUT_STEP => ts])
         .map_err(run_failed)?;
     let (shape, values) = outputs[OUTPUT_FEATURES]
         .try_extract_tensor::<f32>()
         .map_err(run_failed)?;
-    if shape.to_vec() != [1, f as i64, n as i64] || values.len() != f * n {
+    if shape.to_vec() != [b as i64, f as i64, n as i64] || values.len() != b * f * n {
         return Err(ModelError::Run {
             path: path.to_path_buf(),
-            message: format!("output shape {shape:?}, expected [1, {f}, {n}]"),
+            message: format!("output shape {shape:?}, expected [{b}, {f}, {n}]"),
         });
     }
     match target.as_slice_mut() {

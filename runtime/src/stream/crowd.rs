@@ -173,12 +173,10 @@ impl Crowd {
                 taken => steps += taken,
             }
         }
-        let waiting = self
-            .characters
-            .iter()
-            .filter(|(id, s)| s.ready.len() < ahead && among.is_none_or(|ids| ids.contains(id)))
-            .count();
-        Ok(CrowdProgress { steps, waiting })
+        Ok(CrowdProgress {
+            steps,
+            waiting: self.short_of(ahead, among).count(),
+        })
     }
 
     /// Every character's next `frames` frames, in the order they joined, making the blocks
@@ -191,12 +189,7 @@ impl Crowd {
     where
         TaskError: From<D::Error>,
     {
-        if frames > MAX_SAMPLE_FRAMES {
-            return Err(TaskError::Length {
-                frames,
-                reason: format!("one chunk holds at most {MAX_SAMPLE_FRAMES} frames"),
-            });
-        }
+        super::check_chunk(frames)?;
         while self.round(denoiser, None, frames, usize::MAX)? > 0 {}
         Ok(self
             .characters
@@ -207,10 +200,23 @@ impl Crowd {
 
     /// Characters with fewer than `ahead` frames ready.
     pub fn waiting(&self, ahead: usize) -> usize {
+        self.short_of(ahead, None).count()
+    }
+
+    /// The places of the characters (of `among`, where given) with fewer than `ahead` frames
+    /// ready.
+    fn short_of<'a>(
+        &'a self,
+        ahead: usize,
+        among: Option<&'a [CharacterId]>,
+    ) -> impl Iterator<Item = usize> + 'a {
         self.characters
             .iter()
-            .filter(|(_, s)| s.ready.len() < ahead)
-            .count()
+            .enumerate()
+            .filter(move |(_, (id, s))| {
+                s.ready.len() < ahead && among.is_none_or(|ids| ids.contains(id))
+            })
+            .map(|(at, _)| at)
     }
 
     /// One step for each character (of `among`, where given) with fewer than `ahead` frames
@@ -227,13 +233,8 @@ impl Crowd {
         TaskError: From<D::Error>,
     {
         let mut short: Vec<(usize, usize)> = self
-            .characters
-            .iter()
-            .enumerate()
-            .filter(|(_, (id, s))| {
-                s.ready.len() < ahead && among.is_none_or(|ids| ids.contains(id))
-            })
-            .map(|(at, (_, s))| (s.ready.len(), at))
+            .short_of(ahead, among)
+            .map(|at| (self.characters[at].1.ready.len(), at))
             .collect();
         short.sort_unstable();
         short.truncate(most);

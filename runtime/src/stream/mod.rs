@@ -113,6 +113,17 @@ impl StreamChunk {
     }
 }
 
+/// Refuses a chunk of more frames than one sample may hold.
+fn check_chunk(frames: usize) -> Result<(), TaskError> {
+    if frames > MAX_SAMPLE_FRAMES {
+        return Err(TaskError::Length {
+            frames,
+            reason: format!("one chunk holds at most {MAX_SAMPLE_FRAMES} frames"),
+        });
+    }
+    Ok(())
+}
+
 /// One final frame waiting to be handed out.
 #[derive(Debug, Clone)]
 struct Frame {
@@ -333,12 +344,7 @@ impl Stream {
     where
         TaskError: From<D::Error>,
     {
-        if frames > MAX_SAMPLE_FRAMES {
-            return Err(TaskError::Length {
-                frames,
-                reason: format!("one chunk holds at most {MAX_SAMPLE_FRAMES} frames"),
-            });
-        }
+        check_chunk(frames)?;
         while self.ready.len() < frames {
             self.advance(denoiser, usize::MAX)?;
         }
