@@ -1,13 +1,12 @@
 //! A character driven by a stream: one entity per joint, poses written every frame from motion
 //! made ahead on Bevy's async compute pool.
 
-use std::collections::VecDeque;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use bevy_ecs::prelude::*;
-use bevy_tasks::{AsyncComputeTaskPool, Task, block_on, futures::check_ready};
+use bevy_tasks::AsyncComputeTaskPool;
 use bevy_transform::components::Transform;
 use sinmdm::steer::SteerLimits;
 use sinmdm::{
@@ -15,7 +14,8 @@ use sinmdm::{
     TaskError,
 };
 
-use crate::frame::{EngineFrame, interpolate};
+use crate::frame::EngineFrame;
+use crate::playback::{Frames, needed, on_show};
 use crate::steering::Steering;
 
 /// A model shared by any number of characters. Its metadata is read without waiting; its
@@ -96,19 +96,8 @@ impl CharacterOptions {
     }
 }
 
-/// What a character's motion maker is doing.
-enum Maker {
-    /// Waiting for the next request.
-    Idle(Box<Engine>),
-    /// A request on the compute pool.
-    Busy(Task<Made>),
-    /// Stopped by an error (kept in [`MotionCharacter::error`]).
-    Stopped,
-}
-
-/// What a request gives back: the engine, the frames (or why there are none) and the seconds
-/// it took.
-type Made = (Box<Engine>, Result<Vec<Pose>, TaskError>, f64);
+/// What a character's request gives back: the frames, or why there are none.
+type Maker = crate::playback::Maker<Engine, Result<Vec<Pose>, TaskError>>;
 
 /// The model and the stream on it, moved to the compute pool for each request.
 struct Engine {
@@ -127,8 +116,7 @@ pub struct MotionCharacter {
     /// The clip's speed range, for a heading-relative model (`None`: it cannot steer).
     limits: Option<SteerLimits>,
     clock: Option<f64>,
-    buffer: VecDeque<Pose>,
-    buffer_start: usize,
+    frames: Frames,
     /// Stream frames given a steering command so far.
     commanded: usize,
     /// In a mutex only to make the component `Sync` (a stream is `Send`, not `Sync`); reached
@@ -215,8 +203,7 @@ impl MotionCharacter {
         self.clock = Some(clock);
         self.collect(false);
         let base = clock.floor() as usize;
-        let past_shown = (self.buffer_start + self.buffer.len()).saturating_sub(base + 1);
-        if past_shown < self.ahead_frames() {
+        if self.frames.ready_past(base) < self.ahead_frames() {
             self.request(steering);
         }
     }
@@ -228,67 +215,32 @@ impl MotionCharacter {
         steering: Option<&Steering>,
         transforms: &mut Query<&mut Transform, Without<MotionCharacter>>,
     ) {
-        let clock = self.clock.unwrap_or(0.0);
-        let base = clock.floor() as usize;
-        let frac = (clock - base as f64) as f32;
-        let needed = if self.options.interpolate && frac > 0.0 {
-            base + 2
-        } else {
-            base + 1
-        };
-        if self.buffer_start + self.buffer.len() < needed && self.error.is_none() {
+        let (base, frac) = on_show(self.clock);
+        let needed = needed(base, frac, self.options.interpolate);
+        if self.frames.end() < needed && self.error.is_none() {
             self.waits.push(self.frames_shown);
-            while self.buffer_start + self.buffer.len() < needed && self.error.is_none() {
+            while self.frames.end() < needed && self.error.is_none() {
                 self.request(steering);
                 self.collect(true);
             }
         }
-        // Frames before the one on show are not needed again.
-        let drop = base
-            .saturating_sub(self.buffer_start)
-            .min(self.buffer.len().saturating_sub(1));
-        self.buffer.drain(..drop);
-        self.buffer_start += drop;
-        if let Some(pose) = self.pose_at(base, frac) {
-            for (j, &entity) in self.joints.iter().enumerate() {
-                if let Ok(mut t) = transforms.get_mut(entity) {
-                    *t = self
-                        .frame
-                        .joint_transform(&pose, j, self.parents[j].is_none());
-                }
-            }
+        let interpolated = self.options.interpolate;
+        if let Some(pose) = self.frames.show(base, frac, interpolated) {
+            self.frame
+                .write_pose(&pose, &self.joints, &self.parents, transforms);
         }
         self.frames_shown += 1;
     }
 
-    /// The pose at model frame `base` plus `frac`, from the frames ready (the last one ready
-    /// when the motion stopped short of it).
-    fn pose_at(&self, base: usize, frac: f32) -> Option<Pose> {
-        let i = base.checked_sub(self.buffer_start)?;
-        let a = self.buffer.get(i).or_else(|| self.buffer.back())?;
-        match self.buffer.get(i + 1) {
-            Some(b) if self.options.interpolate && frac > 0.0 => Some(interpolate(a, b, frac)),
-            _ => Some(a.clone()),
-        }
-    }
-
     /// Takes the frames of a finished request (waiting for it when `wait`).
     fn collect(&mut self, wait: bool) {
-        let Maker::Busy(task) = self.maker_mut() else {
-            return;
-        };
-        let done = if wait {
-            Some(block_on(task))
-        } else {
-            check_ready(task)
-        };
-        let Some((engine, result, seconds)) = done else {
+        let Some((engine, result, seconds)) = self.maker_mut().finished(wait) else {
             return;
         };
         self.slowest_request = self.slowest_request.max(seconds);
         match result {
             Ok(poses) => {
-                self.buffer.extend(poses);
+                self.frames.extend(poses);
                 if self.stream_warnings.as_slice() != engine.stream.warnings() {
                     self.stream_warnings = engine.stream.warnings().to_vec();
                 }
@@ -304,9 +256,7 @@ impl MotionCharacter {
     /// Starts the next request on the compute pool, if none is under way: steering commands
     /// for every frame the blocks it may start reach, then the next chunk of frames.
     fn request(&mut self, steering: Option<&Steering>) {
-        let maker = std::mem::replace(self.maker_mut(), Maker::Stopped);
-        let Maker::Idle(mut engine) = maker else {
-            *self.maker_mut() = maker;
+        let Some(mut engine) = self.maker_mut().take_idle() else {
             return;
         };
         let chunk = self.options.chunk_frames.max(1);
@@ -417,8 +367,7 @@ pub fn spawn_character(
         options,
         limits: SteerLimits::of(metadata),
         clock: None,
-        buffer: VecDeque::new(),
-        buffer_start: 0,
+        frames: Frames::default(),
         commanded: 0,
         maker: Mutex::new(Maker::Idle(Box::new(Engine {
             model: model.clone(),

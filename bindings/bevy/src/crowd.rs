@@ -9,18 +9,18 @@
 //! steering of every character that needs frames is queued on its stream and one request makes
 //! their next chunks. A despawned character leaves the crowd at its next request.
 
-use std::collections::VecDeque;
 use std::sync::Mutex;
 use std::time::Instant;
 
 use bevy_ecs::prelude::*;
-use bevy_tasks::{AsyncComputeTaskPool, Task, block_on, futures::check_ready};
+use bevy_tasks::AsyncComputeTaskPool;
 use bevy_transform::components::Transform;
 use sinmdm::steer::{SteerFrame, SteerLimits};
 use sinmdm::{CharacterId, Crowd, Pose, StreamOptions, TaskError};
 
 use crate::character::{MotionModel, spawn_skeleton};
-use crate::frame::{EngineFrame, interpolate};
+use crate::frame::EngineFrame;
+use crate::playback::{Frames, needed, on_show};
 use crate::steering::Steering;
 
 /// How a crowd's characters are played.
@@ -49,24 +49,13 @@ impl CrowdOptions {
     }
 }
 
-/// What one request gives back: the crowd, each member's new frames (or why there are none),
-/// and the seconds it took.
-type Made = (
-    Box<Engine>,
-    Result<Vec<(CharacterId, Vec<Pose>)>, TaskError>,
-    f64,
-);
+/// What a crowd's request gives back: each member's new frames, or why there are none.
+type Maker = crate::playback::Maker<Engine, Result<Vec<(CharacterId, Vec<Pose>)>, TaskError>>;
 
 /// The model and the crowd on it, moved to the compute pool for each request.
 struct Engine {
     model: MotionModel,
     crowd: Crowd,
-}
-
-enum Maker {
-    Idle(Box<Engine>),
-    Busy(Task<Made>),
-    Stopped,
 }
 
 /// A crowd of one model (on an entity of its own).
@@ -120,8 +109,7 @@ pub struct CrowdCharacter {
     joints: Vec<Entity>,
     parents: Vec<Option<usize>>,
     clock: Option<f64>,
-    buffer: VecDeque<Pose>,
-    buffer_start: usize,
+    frames: Frames,
     /// Frames handed to this character so far, and frames given a steering command.
     received: usize,
     commanded: usize,
@@ -154,21 +142,6 @@ impl CrowdCharacter {
     /// What became of a [`Steering`] that could not be followed as given, if any.
     pub fn steering_note(&self) -> Option<&str> {
         self.steering_note.as_deref()
-    }
-
-    /// Frames ready past model frame `base`.
-    fn ready_past(&self, base: usize) -> usize {
-        (self.buffer_start + self.buffer.len()).saturating_sub(base + 1)
-    }
-
-    /// The pose at model frame `base` plus `frac` (the last one ready when the motion stopped).
-    fn pose_at(&self, base: usize, frac: f32, interpolated: bool) -> Option<Pose> {
-        let i = base.checked_sub(self.buffer_start)?;
-        let a = self.buffer.get(i).or_else(|| self.buffer.back())?;
-        match self.buffer.get(i + 1) {
-            Some(b) if interpolated && frac > 0.0 => Some(interpolate(a, b, frac)),
-            _ => Some(a.clone()),
-        }
     }
 }
 
@@ -221,8 +194,7 @@ pub fn spawn_crowd_character(
         joints,
         parents: skeleton.joints.iter().map(|j| j.parent).collect(),
         clock: None,
-        buffer: VecDeque::new(),
-        buffer_start: 0,
+        frames: Frames::default(),
         received: 0,
         commanded: 0,
         frames_shown: 0,
@@ -256,8 +228,8 @@ pub(crate) fn drive_crowds(
             }
             let clock = c.clock.map_or(0.0, |t| t + seconds * fps);
             c.clock = Some(clock);
-            short |=
-                c.ready_past(clock.floor() as usize) < options.chunk_frames + options.ahead_frames;
+            short |= c.frames.ready_past(clock.floor() as usize)
+                < options.chunk_frames + options.ahead_frames;
         }
         collect(&mut crowd, &mut characters, crowd_entity, false);
         if short || !crowd.joining.is_empty() {
@@ -271,7 +243,8 @@ pub(crate) fn drive_crowds(
                 if c.crowd != crowd_entity || c.id.is_none() {
                     continue;
                 }
-                if c.buffer_start + c.buffer.len() < needed_frames(&c, options.interpolate) {
+                let (base, frac) = on_show(c.clock);
+                if c.frames.end() < needed(base, frac, options.interpolate) {
                     short_now = true;
                     if !waited {
                         let shown = c.frames_shown;
@@ -291,34 +264,15 @@ pub(crate) fn drive_crowds(
             if c.crowd != crowd_entity {
                 continue;
             }
-            let clock = c.clock.unwrap_or(0.0);
-            let base = clock.floor() as usize;
-            let frac = (clock - base as f64) as f32;
-            let drop = base
-                .saturating_sub(c.buffer_start)
-                .min(c.buffer.len().saturating_sub(1));
-            c.buffer.drain(..drop);
-            c.buffer_start += drop;
-            if let Some(pose) = c.pose_at(base, frac, options.interpolate) {
-                for (j, &entity) in c.joints.iter().enumerate() {
-                    if let Ok(mut t) = transforms.get_mut(entity) {
-                        *t = crowd
-                            .frame
-                            .joint_transform(&pose, j, c.parents[j].is_none());
-                    }
-                }
+            let (base, frac) = on_show(c.clock);
+            if let Some(pose) = c.frames.show(base, frac, options.interpolate) {
+                crowd
+                    .frame
+                    .write_pose(&pose, &c.joints, &c.parents, &mut transforms);
             }
             c.frames_shown += 1;
         }
     }
-}
-
-/// The frames a character needs to show its pose now (the next one too when interpolating).
-fn needed_frames(c: &CrowdCharacter, interpolated: bool) -> usize {
-    let clock = c.clock.unwrap_or(0.0);
-    let base = clock.floor() as usize;
-    let frac = clock - base as f64;
-    base + if interpolated && frac > 0.0 { 2 } else { 1 }
 }
 
 /// Takes the frames of a finished request (waiting for it when `wait`).
@@ -328,15 +282,7 @@ fn collect(
     crowd_entity: Entity,
     wait: bool,
 ) {
-    let Maker::Busy(task) = crowd.maker_mut() else {
-        return;
-    };
-    let done = if wait {
-        Some(block_on(task))
-    } else {
-        check_ready(task)
-    };
-    let Some((engine, result, seconds)) = done else {
+    let Some((engine, result, seconds)) = crowd.maker_mut().finished(wait) else {
         return;
     };
     crowd.slowest_request = crowd.slowest_request.max(seconds);
@@ -350,7 +296,7 @@ fn collect(
                     && let Some((_, poses)) = made.iter().find(|(m, _)| *m == id)
                 {
                     c.received += poses.len();
-                    c.buffer.extend(poses.iter().cloned());
+                    c.frames.extend(poses.iter().cloned());
                 }
             }
             *crowd.maker_mut() = Maker::Idle(engine);
@@ -370,9 +316,7 @@ fn request(
     characters: &mut Query<(Entity, &mut CrowdCharacter, Option<&Steering>)>,
     crowd_entity: Entity,
 ) {
-    let maker = std::mem::replace(crowd.maker_mut(), Maker::Stopped);
-    let Maker::Idle(mut engine) = maker else {
-        *crowd.maker_mut() = maker;
+    let Some(mut engine) = crowd.maker_mut().take_idle() else {
         return;
     };
     let options = crowd.options.clone();
@@ -409,8 +353,8 @@ fn request(
         let Some(id) = c.id.filter(|_| c.crowd == crowd_entity) else {
             continue;
         };
-        let base = c.clock.unwrap_or(0.0).floor() as usize;
-        if c.ready_past(base) >= chunk + options.ahead_frames {
+        let (base, _) = on_show(c.clock);
+        if c.frames.ready_past(base) >= chunk + options.ahead_frames {
             continue;
         }
         wanted.push(id);

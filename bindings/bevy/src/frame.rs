@@ -57,6 +57,22 @@ impl EngineFrame {
         }
     }
 
+    /// Writes `pose` into the transforms of `joints` (the skeleton's joint entities, their
+    /// `parents` as the skeleton has them).
+    pub(crate) fn write_pose<F: bevy_ecs::query::QueryFilter>(
+        &self,
+        pose: &Pose,
+        joints: &[bevy_ecs::entity::Entity],
+        parents: &[Option<usize>],
+        transforms: &mut bevy_ecs::system::Query<&mut Transform, F>,
+    ) {
+        for (j, &entity) in joints.iter().enumerate() {
+            if let Ok(mut t) = transforms.get_mut(entity) {
+                *t = self.joint_transform(pose, j, parents[j].is_none());
+            }
+        }
+    }
+
     /// A length in metres as file units.
     pub fn to_file_units(&self, metres: f32) -> f64 {
         f64::from(metres) / f64::from(self.metres_per_unit)

@@ -23,6 +23,7 @@
 pub mod character;
 pub mod crowd;
 pub mod frame;
+mod playback;
 pub mod steering;
 
 #[cfg(feature = "animation-clip")]

@@ -6,20 +6,14 @@
 
 mod common;
 
-use std::time::Duration;
-
-use bevy_app::{App, TaskPoolPlugin};
+use bevy_app::App;
 use bevy_math::Vec3;
-use bevy_time::{TimePlugin, TimeUpdateStrategy};
-use bevy_transform::TransformPlugin;
 use bevy_transform::components::{GlobalTransform, Transform};
 use sinmdm::StreamOptions;
 use sinmdm::steer::SteerLimits;
-use sinmdm_bevy::{
-    CrowdCharacter, CrowdOptions, EngineFrame, MotionCrowd, MotionModel, SinmdmPlugin, Steering,
-};
+use sinmdm_bevy::{CrowdCharacter, CrowdOptions, EngineFrame, MotionCrowd, MotionModel, Steering};
 
-use common::{BEVY_FPS, model_path, signed_angle};
+use common::{BEVY_FPS, headless_app, model_path, signed_angle};
 
 const CHARACTERS: usize = 200;
 
@@ -137,16 +131,7 @@ fn crowd_app(
     model: &MotionModel,
     speed: f32,
 ) -> (App, bevy_ecs::entity::Entity, Vec<bevy_ecs::entity::Entity>) {
-    let mut app = App::new();
-    app.add_plugins((
-        TaskPoolPlugin::default(),
-        TimePlugin,
-        TransformPlugin,
-        SinmdmPlugin,
-    ));
-    app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
-        1.0 / BEVY_FPS,
-    )));
+    let mut app = headless_app();
     let options = CrowdOptions::for_fps(model.fps());
     let world = app.world_mut();
     let mut commands = world.commands();

@@ -22,8 +22,8 @@ pub fn model_path(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// A headless app stepping 1/60 s a frame, with a character of `model` at `place`.
-pub fn app_with(model: &MotionModel, options: CharacterOptions, place: Transform) -> (App, Entity) {
+/// A headless app with the plugin, stepping 1/60 s a frame.
+pub fn headless_app() -> App {
     let mut app = App::new();
     app.add_plugins((
         TaskPoolPlugin::default(),
@@ -34,6 +34,12 @@ pub fn app_with(model: &MotionModel, options: CharacterOptions, place: Transform
     app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
         1.0 / BEVY_FPS,
     )));
+    app
+}
+
+/// A headless app stepping 1/60 s a frame, with a character of `model` at `place`.
+pub fn app_with(model: &MotionModel, options: CharacterOptions, place: Transform) -> (App, Entity) {
+    let mut app = headless_app();
     let world = app.world_mut();
     let mut commands = world.commands();
     let character = sinmdm_bevy::spawn_character(&mut commands, model, options, place)
