@@ -610,6 +610,28 @@ namespace Sinmdm
         public int[] ComposeJoints;
         /// <summary>Whether the root's travel and height also come from the supplied poses.</summary>
         public bool ComposeRoot;
+
+        internal delegate T WithOptions<T>(ref Native.StreamOptions options);
+
+        /// <summary>Calls `call` with these settings as the native struct, the joint array
+        /// pinned for the call only.</summary>
+        internal T Pinned<T>(WithOptions<T> call)
+        {
+            var joints = Native.Indices(ComposeJoints, nameof(ComposeJoints));
+            var pinned = GCHandle.Alloc(joints, GCHandleType.Pinned);
+            try
+            {
+                var options = new Native.StreamOptions
+                {
+                    Seed = Seed, Steps = Steps, BlockFrames = BlockFrames, Feet = (uint)Feet,
+                    ComposeJoints = joints.Length > 0 ? pinned.AddrOfPinnedObject() : IntPtr.Zero,
+                    ComposeJointCount = (UIntPtr)joints.Length, ComposeRoot = ComposeRoot ? 1 : 0,
+                    Method = (uint)Method, Eta = Eta,
+                };
+                return call(ref options);
+            }
+            finally { pinned.Free(); }
+        }
     }
 
     /// <summary>Endless motion, a chunk at a time (the same whatever chunk sizes are asked).
@@ -631,24 +653,12 @@ namespace Sinmdm
         }
 
         /// <summary>A new character with a stream's settings; its number, never given again.</summary>
-        public ulong Join(StreamSettings settings)
-        {
-            var joints = Native.Indices(settings.ComposeJoints, nameof(settings.ComposeJoints));
-            var pinned = GCHandle.Alloc(joints, GCHandleType.Pinned);
-            try
+        public ulong Join(StreamSettings settings) =>
+            settings.Pinned((ref Native.StreamOptions options) =>
             {
-                var options = new Native.StreamOptions
-                {
-                    Seed = settings.Seed, Steps = settings.Steps, BlockFrames = settings.BlockFrames, Feet = (uint)settings.Feet,
-                    ComposeJoints = joints.Length > 0 ? pinned.AddrOfPinnedObject() : IntPtr.Zero,
-                    ComposeJointCount = (UIntPtr)joints.Length, ComposeRoot = settings.ComposeRoot ? 1 : 0,
-                    Method = (uint)settings.Method, Eta = settings.Eta,
-                };
                 Native.Check(Native.sinmdm_crowd_join(handle, ref options, out ulong id));
                 return id;
-            }
-            finally { pinned.Free(); }
-        }
+            });
 
         /// <summary>Takes character `id` out of the crowd.</summary>
         public void Leave(ulong id) => Native.Check(Native.sinmdm_crowd_leave(handle, id));
@@ -701,21 +711,12 @@ namespace Sinmdm
         {
             if (model == null) throw new ArgumentNullException(nameof(model));
             this.model = model;
-            var joints = Native.Indices(settings.ComposeJoints, nameof(settings.ComposeJoints));
-            var pinned = GCHandle.Alloc(joints, GCHandleType.Pinned);
-            try
+            handle = settings.Pinned((ref Native.StreamOptions options) =>
             {
-                var options = new Native.StreamOptions
-                {
-                    Seed = settings.Seed, Steps = settings.Steps, BlockFrames = settings.BlockFrames, Feet = (uint)settings.Feet,
-                    ComposeJoints = joints.Length > 0 ? pinned.AddrOfPinnedObject() : IntPtr.Zero,
-                    ComposeJointCount = (UIntPtr)joints.Length, ComposeRoot = settings.ComposeRoot ? 1 : 0,
-                    Method = (uint)settings.Method, Eta = settings.Eta,
-                };
-                int status = Native.sinmdm_stream_new(model.Handle, ref options, out handle);
-                if (status != 0) { handle.Dispose(); Native.Check(status); }
-            }
-            finally { pinned.Free(); }
+                int status = Native.sinmdm_stream_new(model.Handle, ref options, out StreamHandle made);
+                if (status != 0) { made.Dispose(); Native.Check(status); }
+                return made;
+            });
         }
 
         public MotionStream(Model model, ulong seed, uint steps = Runtime.DefaultStreamSteps, uint blockFrames = 0, Feet feet = Feet.Planted,
