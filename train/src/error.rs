@@ -57,6 +57,16 @@ pub enum TrainError {
         /// The reason.
         reason: sinmdm::motion::MotionError,
     },
+    /// A time budget leaves no time for one step.
+    #[error(
+        "--minutes {minutes} leaves no time to train: one step takes {seconds_per_step:.3} s here"
+    )]
+    NoTimeToTrain {
+        /// The budget, in minutes.
+        minutes: f64,
+        /// Seconds one step took in the probe.
+        seconds_per_step: f64,
+    },
     /// The clip is shorter than what the network sees at once.
     #[error(
         "{}: the clip has {frames} frames at {fps} fps, fewer than the model's receptive field of {receptive_field} frames; use a longer clip or a higher data.fps",

@@ -297,15 +297,10 @@ fn train_export_evaluate(
     let mut trainer = if resumed {
         Trainer::resume(&run, Some(&entry.clip), None, device)?
     } else {
-        let started = crate::choose::start_run(
-            &entry.clip,
-            config,
-            &run,
-            device,
-            &crate::choose::step_ladder::Ladder::default(),
-            stop,
-            &mut |_| {},
-        )?;
+        let ladder = crate::choose::step_ladder::Ladder::default();
+        let steps = crate::choose::StepsFrom::Rule(&ladder);
+        let started =
+            crate::choose::start_run(&entry.clip, config, &run, device, steps, stop, &mut |_| {})?;
         match started {
             Some(trainer) => trainer,
             None => return Ok(TaskEnd::Interrupted),

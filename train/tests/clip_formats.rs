@@ -76,15 +76,10 @@ fn a_gltf_clip_gives_the_training_features_of_its_bvh() {
         ("human_walk_cmu_131_01.bvh", 0.0564),
         ("fox_survey_khronos.bvh", 0.01),
     ] {
-        let bvh = ClipData::load(
-            &root().join("tests/data/bvh").join(clip),
-            &config.data,
-            &config.model,
-        )
-        .unwrap();
+        let bvh = ClipData::load(&root().join("tests/data/bvh").join(clip), &config.data).unwrap();
         for extension in ["glb", "gltf"] {
             let file = as_gltf(clip, metres, extension, clip);
-            let gltf = ClipData::load(&file, &config.data, &config.model).unwrap();
+            let gltf = ClipData::load(&file, &config.data).unwrap();
             assert_same_features(
                 &gltf,
                 &bvh,
@@ -134,8 +129,8 @@ fn blenders_glb_and_fbx_give_the_training_features_of_their_bvh() {
             };
             let bvh_file = common::scratch("formats", clip).with_extension("bvh");
             std::fs::write(&bvh_file, sinmdm::bvh::to_bvh_string(&cut)).unwrap();
-            let bvh = ClipData::load(&bvh_file, &config.data, &config.model).unwrap();
-            let read = ClipData::load(&file, &config.data, &config.model).unwrap();
+            let bvh = ClipData::load(&bvh_file, &config.data).unwrap();
+            let read = ClipData::load(&file, &config.data).unwrap();
             // Blender reads BVH units as metres, so the files are in the BVH's units.
             assert_same_features(
                 &read,
@@ -145,7 +140,7 @@ fn blenders_glb_and_fbx_give_the_training_features_of_their_bvh() {
             );
             std::fs::remove_file(bvh_file).unwrap();
         }
-        let source = ClipData::load(&fbx, &config.data, &config.model)
+        let source = ClipData::load(&fbx, &config.data)
             .unwrap()
             .facts
             .source
@@ -204,7 +199,6 @@ fn a_run_keeps_its_gltf_clip_resumes_from_it_and_records_it() {
     let err = ClipData::load(
         &root().join("tests/data/bvh/fox_survey_khronos.bvh"),
         &wrong.data,
-        &wrong.model,
     )
     .unwrap_err();
     assert!(err.to_string().contains("data.animation"), "{err}");
@@ -324,7 +318,7 @@ fn a_gltf_clip_reads_a_buffer_outside_its_folder_only_when_allowed() {
     let gltf = top.join("clips/clip.gltf");
     std::fs::write(&gltf, serde_json::to_vec(&json).unwrap()).unwrap();
 
-    let refused = match ClipData::load(&gltf, &config.data, &config.model) {
+    let refused = match ClipData::load(&gltf, &config.data) {
         Ok(_) => panic!("the buffer outside the clip's folder was read"),
         Err(e) => e.to_string(),
     };
@@ -333,8 +327,8 @@ fn a_gltf_clip_reads_a_buffer_outside_its_folder_only_when_allowed() {
         "{refused}"
     );
     config.data.allow_outside_folder = true;
-    let split = ClipData::load(&gltf, &config.data, &config.model).unwrap();
-    let whole = ClipData::load(&glb, &config.data, &config.model).unwrap();
+    let split = ClipData::load(&gltf, &config.data).unwrap();
+    let whole = ClipData::load(&glb, &config.data).unwrap();
     assert_eq!(split.features, whole.features);
     std::fs::remove_dir_all(&top).unwrap();
     std::fs::remove_file(&glb).unwrap();

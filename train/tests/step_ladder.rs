@@ -10,8 +10,8 @@ use std::sync::atomic::AtomicBool;
 
 use burn::tensor::Device;
 use sinmdm_train::TrainConfig;
-use sinmdm_train::choose::start_run;
 use sinmdm_train::choose::step_ladder::{Ladder, RungCheck, choose, folder};
+use sinmdm_train::choose::{StepsFrom, start_run};
 
 mod common;
 use common::root;
@@ -67,7 +67,7 @@ fn start_fox(
         config,
         run,
         device(),
-        ladder,
+        StepsFrom::Rule(ladder),
         &AtomicBool::new(stop),
         on_rung,
     )

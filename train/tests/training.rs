@@ -378,7 +378,8 @@ fn a_time_budget_sets_the_steps_and_records_them() {
     let steps = recorded.training.steps;
     assert_ne!(steps, tiny().training.steps, "{err}");
     assert!(
-        err.contains(&format!("so {steps} steps")) && err.contains(&format!("done: {steps} steps")),
+        err.contains(&format!("--minutes 0.15: {steps} steps fit"))
+            && err.contains(&format!("done: {steps} steps")),
         "{err}"
     );
     // Progress lines in a log (no terminal) say how long the run has taken and has left.

@@ -129,6 +129,16 @@ pub enum Reason {
     },
     /// A varied clip's steps: the configuration's, since it covers more the longer it trains.
     VariedTrainsLonger,
+    /// The steps that fit a time budget (`sinmdm-train --minutes`), from a timing probe of the
+    /// network the rule chose.
+    TimeBudget {
+        /// The budget, in minutes.
+        minutes: f64,
+        /// Seconds one step took in the probe.
+        seconds_per_step: f64,
+        /// Its warm-up steps (at most a tenth of the steps).
+        warmup: u64,
+    },
     /// A wider network's steps: as many as fit the time the configuration's take.
     WiderNetworkSteps {
         /// The wider network's channels.

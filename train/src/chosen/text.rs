@@ -79,6 +79,13 @@ fn steps_text(steps: &Chosen<u64>) -> String {
             };
             format!("{value} (warm-up {warmup}): {why}")
         }
+        Reason::TimeBudget {
+            minutes,
+            seconds_per_step,
+            warmup,
+        } => format!(
+            "{value} (warm-up {warmup}): as many as fit --minutes {minutes} here (one step {seconds_per_step:.4} s in a timing probe)"
+        ),
         Reason::VariedTrainsLonger => {
             format!("{value} (the configuration's): a varied clip covers more the longer it trains")
         }

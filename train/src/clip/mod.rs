@@ -16,7 +16,7 @@ use sinmdm_formats::{
     read_clip_with_access,
 };
 
-use crate::config::{DataConfig, ModelConfig};
+use crate::config::DataConfig;
 use crate::error::TrainError;
 
 pub mod batch;
@@ -79,12 +79,9 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 
 impl ClipData {
     /// Reads (BVH, or glTF or FBX with `data.animation` choosing the animation), encodes and normalises
-    /// `path`; rejects a clip shorter than the receptive field.
-    pub fn load(
-        path: &Path,
-        data: &DataConfig,
-        model: &ModelConfig,
-    ) -> Result<ClipData, TrainError> {
+    /// `path`. Its length is checked against a network's field once the network is final
+    /// ([`ClipData::check_length`]): the rule that reads the clip may change the field.
+    pub fn load(path: &Path, data: &DataConfig) -> Result<ClipData, TrainError> {
         let format = ClipFormat::of(path)?;
         let bytes = sinmdm::files::read_regular_file(path, format.file_limit(), None).map_err(
             |source| TrainError::Io {
@@ -116,15 +113,6 @@ impl ClipData {
             reason: source,
         })?;
         let frames = encoded.features.ncols();
-        let receptive_field = model.at_fps(encoded.layout.fps).receptive_field();
-        if frames < receptive_field {
-            return Err(TrainError::ClipTooShort {
-                path: path.to_path_buf(),
-                frames,
-                fps: encoded.layout.fps,
-                receptive_field,
-            });
-        }
         let normalizer = Normalizer::fit(encoded.features.view());
         let features = normalizer.normalize(encoded.features.view());
         let name = path
@@ -135,7 +123,7 @@ impl ClipData {
             Some(found) => format!("{} (read from the motion)", found.describe()),
             None => format!("{} (data.up in the config)", encoded.layout.up),
         };
-        let root = describe_root(&encoded, data.root_layout);
+        let root = describe_root(&encoded);
         Ok(ClipData {
             facts: ClipFacts {
                 root,
@@ -150,6 +138,21 @@ impl ClipData {
             },
             features,
         })
+    }
+
+    /// An error naming the clip (its file `path`) when it is shorter than `receptive_field`, the
+    /// frames the network sees at once at the clip's frame rate: no window of it would fill one.
+    pub fn check_length(&self, path: &Path, receptive_field: usize) -> Result<(), TrainError> {
+        let frames = self.features.ncols();
+        if frames < receptive_field {
+            return Err(TrainError::ClipTooShort {
+                path: path.to_path_buf(),
+                frames,
+                fps: self.facts.layout.fps,
+                receptive_field,
+            });
+        }
+        Ok(())
     }
 }
 
@@ -206,9 +209,10 @@ fn read_clip(
     Ok(clip_and_source)
 }
 
-/// The root layout of `encoded` in words, with why it was chosen when `asked` was
-/// [`RootLayout::Auto`].
-fn describe_root(encoded: &sinmdm::motion::EncodedClip, asked: RootLayout) -> String {
+/// The root layout of `encoded` in words, with why it was chosen when the clip chose it
+/// ([`RootLayout::Auto`]).
+fn describe_root(encoded: &sinmdm::motion::EncodedClip) -> String {
+    let asked = encoded.root_asked;
     let skeleton = &encoded.layout.skeleton;
     let heading = encoded
         .layout

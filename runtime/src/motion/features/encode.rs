@@ -60,6 +60,9 @@ pub struct EncodedClip {
     /// Why [`RootLayout::Auto`] chose the world root (the clip lacks what the heading-relative
     /// root needs); `None` when it chose the heading root or the layout was asked for.
     pub world_root_reason: Option<String>,
+    /// The root layout the options asked for ([`RootLayout::Auto`] where the clip chose), so
+    /// that a description of the root can say who chose it.
+    pub root_asked: RootLayout,
 }
 
 /// Relative change under which a channel counts as constant.
@@ -191,6 +194,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         up_detection,
         in_place: filled.in_place,
         world_root_reason,
+        root_asked: options.root,
     })
 }
 

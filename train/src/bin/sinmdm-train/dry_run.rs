@@ -17,7 +17,7 @@ pub(super) fn dry_run(args: &Args) -> Result<()> {
         bail!("--dry-run needs a CLIP");
     };
     let config = new_run_config(args)?;
-    let data = ClipData::load(clip, &config.data, &config.model)?;
+    let data = ClipData::load(clip, &config.data)?;
     let (config, rule, ladder, window_from_clip) = match clip_rule::apply(&config, &data) {
         Some(choice) => (
             choice.config,
@@ -28,6 +28,7 @@ pub(super) fn dry_run(args: &Args) -> Result<()> {
         None => (config, None, false, false),
     };
     let config = config.at_fps(data.facts.layout.fps);
+    data.check_length(clip, config.model.receptive_field())?;
     let features = data.features.nrows();
     let model = QnaUnet::new(features, &config.model, &Device::flex());
     print_clip(clip, &data, &config);

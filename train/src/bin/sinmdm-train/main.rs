@@ -10,6 +10,7 @@ use burn::tensor::Device;
 use clap::Parser;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use sinmdm_train::choose::StepsFrom;
 use sinmdm_train::{RunEnd, TrainConfig, Trainer};
 
 mod dry_run;
@@ -196,43 +197,6 @@ fn new_run_config(args: &Args) -> Result<TrainConfig> {
     Ok(config)
 }
 
-/// Timing steps of the probe behind --minutes.
-const PROBE_STEPS: u64 = 16;
-/// Seconds kept back from a --minutes budget for loading, checkpoints and the export.
-const BUDGET_RESERVE_SECONDS: f64 = 5.0;
-/// Share of a --minutes budget kept back for steps slower than the probe's.
-const BUDGET_MARGIN: f64 = 0.06;
-
-/// Sets `config.training.steps` (and a warm-up longer than a tenth of them) so that training
-/// ends within `minutes`, from a timing probe.
-fn fit_to_budget(
-    clip: &std::path::Path,
-    config: &mut TrainConfig,
-    device: &Device,
-    minutes: f64,
-) -> Result<()> {
-    if !(minutes.is_finite() && minutes > 0.0) {
-        bail!("--minutes must be a positive number, got {minutes}");
-    }
-    let begun = std::time::Instant::now();
-    let per_step =
-        sinmdm_train::choose::budget::seconds_per_step(clip, config, device.clone(), PROBE_STEPS)?;
-    let left = minutes * 60.0 - begun.elapsed().as_secs_f64() - BUDGET_RESERVE_SECONDS;
-    let steps = (left * (1.0 - BUDGET_MARGIN) / per_step).floor();
-    if steps < 1.0 {
-        bail!("--minutes {minutes} leaves no time to train: one step takes {per_step:.3} s here");
-    }
-    config.from_clip.steps = false;
-    let training = &mut config.training;
-    training.steps = steps as u64;
-    training.warmup_steps = training.warmup_steps.min(training.steps / 10);
-    eprintln!(
-        "--minutes {minutes}: one step takes {per_step:.4} s here, so {} steps",
-        training.steps
-    );
-    Ok(())
-}
-
 fn main() -> Result<()> {
     sinmdm_train::memory::keep_freed_memory();
     let args = Args::parse();
@@ -319,29 +283,32 @@ fn resumed(args: &Args, out: &Path, device: Device) -> Result<Trainer> {
     Ok(Trainer::resume(out, args.clip.as_deref(), config, device)?)
 }
 
-/// A new run on the clip, its steps from `--minutes` or the step ladder where the rule asks;
-/// exits with 130 when Ctrl-C stops the ladder.
+/// A new run on the clip, its steps from `--minutes` or the rule (and its step ladder); exits
+/// with 130 when Ctrl-C stops the ladder.
 fn started(args: &Args, out: &Path, device: Device, stop: &Arc<AtomicBool>) -> Result<Trainer> {
     let Some(clip) = &args.clip else {
         bail!("a CLIP to train on is required (or --resume an existing run)");
     };
-    let mut config = new_run_config(args)?;
-    if let Some(minutes) = args.minutes {
-        fit_to_budget(clip, &mut config, &device, minutes)?;
-    }
+    let config = new_run_config(args)?;
+    let ladder = sinmdm_train::choose::step_ladder::Ladder::default();
+    let steps = match args.minutes {
+        Some(minutes) if !(minutes.is_finite() && minutes > 0.0) => {
+            bail!("--minutes must be a positive number, got {minutes}")
+        }
+        Some(minutes) => StepsFrom::Minutes(minutes),
+        None => StepsFrom::Rule(&ladder),
+    };
     let mut on_rung = |rung: &sinmdm_train::choose::step_ladder::RungCheck| {
         eprintln!("step ladder: {}", rung.line());
     };
-    match sinmdm_train::choose::start_run(
-        clip,
-        config,
-        out,
-        device,
-        &sinmdm_train::choose::step_ladder::Ladder::default(),
-        stop,
-        &mut on_rung,
-    )? {
-        Some(trainer) => Ok(trainer),
+    match sinmdm_train::choose::start_run(clip, config, out, device, steps, stop, &mut on_rung)? {
+        Some(trainer) => {
+            if let Some(minutes) = args.minutes {
+                let steps = trainer.state().config.training.steps;
+                eprintln!("--minutes {minutes}: {steps} steps fit, from a timing probe");
+            }
+            Ok(trainer)
+        }
         None => {
             eprintln!(
                 "interrupted while the step ladder chose the steps; the same command starts again and keeps the rungs finished (in {})",

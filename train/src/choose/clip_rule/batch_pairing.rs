@@ -12,16 +12,17 @@ use crate::config::TrainConfig;
 /// pairing it would double a step's frames.
 pub const BATCH_ITEMS_MULTIPLE: usize = 2;
 
-/// The rule's batch; it sets `out.training.frames_per_step` where it pairs the items.
+/// The rule's batch, from the `items` a step of the configuration trains on the clip; it sets
+/// `out.training.frames_per_step` where it pairs them.
 pub(super) fn batch(
     config: &TrainConfig,
     out: &mut TrainConfig,
     reading: ClipReading,
+    items: usize,
     asked: bool,
     calm: bool,
 ) -> Chosen<Batch> {
     let frames = reading.frames;
-    let items = config.training.batch_shape(frames).items;
     let budget = config.training.frames_per_step;
     let theirs = Batch {
         items,
@@ -154,7 +155,7 @@ mod tests {
             Some(budget)
         );
         // A calm clip that no rung covered trains as a varied one, in pairs.
-        let after_all = not_calm_after_all(&config, calm, 80.0, 1000);
+        let after_all = not_calm_after_all(&choose(&config, calm), 80.0, 1000).unwrap();
         assert_eq!(after_all.config.training.frames_per_step, Some(818));
         let mut fixed = config.clone();
         fixed.from_clip.batch = false;

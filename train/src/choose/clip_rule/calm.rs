@@ -1,10 +1,9 @@
 //! A calm clip's part of the rule: its steps are the step ladder's, and a calm clip that no
 //! rung covers trains as a varied one.
 
-use super::{CALM_INTRA_BELOW, ClipReading, RuleChoice, choose_kind};
+use super::{CALM_INTRA_BELOW, RuleChoice};
 use crate::choose::ladder_settings::LADDER_STEPS;
 use crate::chosen::{Chosen, ClipKind, Reason};
-use crate::config::TrainConfig;
 
 /// Warm-up steps of a calm clip's cosine schedule: a third of its steps.
 pub fn calm_warmup_steps(steps: u64) -> u64 {
@@ -16,21 +15,24 @@ pub fn calm_most_steps() -> u64 {
     LADDER_STEPS[LADDER_STEPS.len() - 1]
 }
 
-/// The rule's choice for a calm clip that no rung of the step ladder covered: it trains as a
-/// varied clip. The best rung covered `most_coverage` at `at_steps` steps.
+/// The rule's choice for the `calm` clip once no rung of the step ladder covered it: the clip
+/// trained as a varied one ([`RuleChoice::if_not_calm`]), its reason naming the best rung, which
+/// covered `most_coverage` at `at_steps` steps. `None` for a choice that holds no such fallback
+/// (a varied clip's).
 pub fn not_calm_after_all(
-    config: &TrainConfig,
-    reading: ClipReading,
+    calm: &RuleChoice,
     most_coverage: f64,
     at_steps: u64,
-) -> RuleChoice {
+) -> Option<RuleChoice> {
+    let mut varied = calm.if_not_calm.as_deref()?.clone();
     let reason = Reason::NotCalmAfterAll {
-        intra_diversity: reading.intra_diversity,
+        intra_diversity: calm.reading.intra_diversity,
         below: CALM_INTRA_BELOW,
         most_coverage,
         at_steps,
     };
-    choose_kind(config, reading, Chosen::new(ClipKind::Varied, reason))
+    varied.choices.kind = Chosen::new(ClipKind::Varied, reason);
+    Some(varied)
 }
 
 #[cfg(test)]
@@ -38,6 +40,7 @@ mod tests {
     use super::*;
     use crate::choose::clip_rule::tests::{DEFAULT, reading};
     use crate::choose::clip_rule::{VARIED_WINDOW, choose};
+    use crate::config::TrainConfig;
 
     #[test]
     fn a_calm_clip_leaves_its_steps_to_the_ladder_and_keeps_the_shape() {
@@ -69,7 +72,8 @@ mod tests {
     #[test]
     fn a_calm_clip_no_rung_covers_trains_as_a_varied_one() {
         let config = TrainConfig::parse(DEFAULT).unwrap();
-        let choice = not_calm_after_all(&config, reading(0.6), 80.0, 1000);
+        let calm = choose(&config, reading(0.6));
+        let choice = not_calm_after_all(&calm, 80.0, 1000).expect("a calm clip's fallback");
         assert!(!choice.climb_ladder);
         assert_eq!(choice.config.training.steps, config.training.steps);
         assert_eq!(choice.config.model.window, VARIED_WINDOW);

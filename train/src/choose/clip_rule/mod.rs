@@ -92,6 +92,10 @@ pub struct RuleChoice {
     /// Whether the steps are left to the step ladder ([`crate::choose::step_ladder`]): a calm
     /// clip whose steps the rule was asked for. `config` then holds the ladder's most steps.
     pub climb_ladder: bool,
+    /// For a calm clip, what the rule chooses should the ladder find that no short run covers
+    /// it: the clip trained as a varied one ([`not_calm_after_all`] completes its reason). Decided
+    /// here with the rest, so that the ladder only picks between choices the rule made.
+    pub if_not_calm: Option<Box<RuleChoice>>,
 }
 
 impl RuleChoice {
@@ -128,7 +132,21 @@ pub fn choose(config: &TrainConfig, reading: ClipReading) -> RuleChoice {
         };
         Chosen::new(ClipKind::Varied, reason)
     };
-    choose_kind(config, reading, kind)
+    // A calm clip's choice holds the one it trains should no short run cover it: a varied one.
+    let mut kinds = vec![kind];
+    if kinds[0].value == ClipKind::Calm {
+        let reason = Reason::VariedClip {
+            intra_diversity,
+            below,
+        };
+        kinds.push(Chosen::new(ClipKind::Varied, reason));
+    }
+    let mut choices = kinds
+        .into_iter()
+        .map(|kind| choose_kind(config, reading, kind));
+    let mut choice = choices.next().expect("one kind at least");
+    choice.if_not_calm = choices.next().map(Box::new);
+    choice
 }
 
 /// The rule's choice for a clip of the kind `kind` says.
@@ -160,7 +178,8 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, kind: Chosen<ClipKind
     } else {
         meant
     };
-    let batch = batch_pairing::batch(config, &mut out, reading, asked.batch, calm);
+    let items = config.training.batch_shape(reading.frames).items;
+    let batch = batch_pairing::batch(config, &mut out, reading, items, asked.batch, calm);
     RuleChoice {
         reading,
         config: out,
@@ -174,6 +193,7 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, kind: Chosen<ClipKind
             rungs: Vec::new(),
         },
         climb_ladder: calm && asked.steps,
+        if_not_calm: None,
     }
 }
 

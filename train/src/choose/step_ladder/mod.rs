@@ -32,7 +32,6 @@ pub use crate::choose::ladder_settings::{CHECK_SAMPLES, CHECK_SEED, LADDER_STEPS
 
 use crate::choose::clip_rule::{self, RuleChoice};
 use crate::chosen::{Chosen, Reason};
-use crate::clip::ClipData;
 use crate::config::TrainConfig;
 use crate::error::TrainError;
 use crate::run::{RunEnd, Trainer};
@@ -75,7 +74,7 @@ pub enum Climb {
     Interrupted,
 }
 
-/// The clip a ladder climbs on: its file, and the SHA-256 (hex) of its bytes as [`ClipData`]
+/// The clip a ladder climbs on: its file, and the SHA-256 (hex) of its bytes as [`crate::clip::ClipData`]
 /// holds it, which goes into each rung's fingerprint.
 #[derive(Debug, Clone, Copy)]
 pub struct LadderClip<'a> {
@@ -261,66 +260,10 @@ impl Ladder {
     }
 }
 
-/// Starts a new run of `config` on `clip` in the folder `run`: reads the clip, applies the rule
-/// that reads it where the configuration asks for it ([`clip_rule::apply`]), and for a calm clip
-/// whose steps the rule was asked for, climbs `ladder` ([`Ladder::default`] for the trainer)
-/// first (in [`folder`]`(run)`) and trains the rung it chooses, or trains the clip as a varied
-/// one when no rung covers it. `on_rung` hears each rung's scores; `None` when the stop flag was
-/// raised during the climb (the same command starts again and keeps the finished rungs).
-pub fn start_run(
-    clip: &Path,
-    config: TrainConfig,
-    run: &Path,
-    device: Device,
-    ladder: &Ladder,
-    stop: &AtomicBool,
-    on_rung: &mut dyn FnMut(&RungCheck),
-) -> Result<Option<Trainer>, TrainError> {
-    Trainer::check_new_run(run)?;
-    let data = ClipData::load(clip, &config.data, &config.model)?;
-    let choice = match clip_rule::apply(&config, &data) {
-        Some(choice) if choice.climb_ladder => choice,
-        Some(choice) => return start_chosen(clip, data, choice, run, device).map(Some),
-        None => return Trainer::start_chosen(clip, data, config, None, run, device).map(Some),
-    };
-    let on_clip = LadderClip {
-        path: clip,
-        sha256: &data.facts.sha256,
-    };
-    let rungs = match ladder.climb(
-        on_clip,
-        &choice.config,
-        &folder(run),
-        &device,
-        stop,
-        on_rung,
-    )? {
-        Climb::Done(rungs) => rungs,
-        Climb::Interrupted => return Ok(None),
-    };
-    let mut chosen = climbed(&config, choice, &rungs);
-    chosen.choices.rungs = rungs.iter().map(RungCheck::line).collect();
-    start_chosen(clip, data, chosen, run, device).map(Some)
-}
-
-/// Starts the run the rule chose: its configuration, and the record of what it chose and why.
-fn start_chosen(
-    clip: &Path,
-    data: ClipData,
-    choice: RuleChoice,
-    run: &Path,
-    device: Device,
-) -> Result<Trainer, TrainError> {
-    let RuleChoice {
-        config, choices, ..
-    } = choice;
-    Trainer::start_chosen(clip, data, config, Some(choices), run, device)
-}
-
 /// The rule's choice once the ladder has climbed: `choice` with the steps of the rung it
-/// chooses, or, where no rung covers the clip, the clip trained as a varied one (`config` is the
-/// configuration the rule was applied to).
-fn climbed(config: &TrainConfig, choice: RuleChoice, rungs: &[RungCheck]) -> RuleChoice {
+/// chooses, or, where no rung covers the clip, the clip trained as a varied one (the rule's
+/// [`RuleChoice::if_not_calm`]).
+fn climbed(choice: RuleChoice, rungs: &[RungCheck]) -> RuleChoice {
     match choose(rungs) {
         Some(best) => {
             let mut chosen = choice;
@@ -339,8 +282,36 @@ fn climbed(config: &TrainConfig, choice: RuleChoice, rungs: &[RungCheck]) -> Rul
                 .iter()
                 .max_by(|a, b| a.coverage.total_cmp(&b.coverage))
                 .expect("the ladder has rungs");
-            clip_rule::not_calm_after_all(config, choice.reading, most.coverage, most.steps)
+            clip_rule::not_calm_after_all(&choice, most.coverage, most.steps).unwrap_or(choice)
         }
+    }
+}
+
+impl Ladder {
+    /// The rule's `choice` with its steps settled: as the rule left them, or, where it leaves
+    /// them to the ladder (a calm clip), the ladder climbed in `folder` on `clip` and the rung
+    /// it chooses (or the rule's choice for a clip no rung covers). `on_rung` hears each rung's
+    /// scores; `None` when the stop flag was raised during the climb (the rungs finished so far
+    /// are kept for the next start).
+    pub fn settle(
+        &self,
+        clip: LadderClip<'_>,
+        choice: RuleChoice,
+        folder: &Path,
+        device: &Device,
+        stop: &AtomicBool,
+        on_rung: &mut dyn FnMut(&RungCheck),
+    ) -> Result<Option<RuleChoice>, TrainError> {
+        if !choice.climb_ladder {
+            return Ok(Some(choice));
+        }
+        let rungs = match self.climb(clip, &choice.config, folder, device, stop, on_rung)? {
+            Climb::Done(rungs) => rungs,
+            Climb::Interrupted => return Ok(None),
+        };
+        let mut chosen = climbed(choice, &rungs);
+        chosen.choices.rungs = rungs.iter().map(RungCheck::line).collect();
+        Ok(Some(chosen))
     }
 }
 

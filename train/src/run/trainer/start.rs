@@ -81,7 +81,7 @@ impl Trainer {
     ) -> Result<Trainer, TrainError> {
         Trainer::check_new_run(run)?;
         Trainer::check_final(&config)?;
-        let data = ClipData::load(clip, &config.data, &config.model)?;
+        let data = ClipData::load(clip, &config.data)?;
         Trainer::start_chosen(clip, data, config, None, run, device)
     }
 
@@ -111,6 +111,7 @@ impl Trainer {
         // layout chosen from the clip, resolved.
         let mut config = config.at_fps(data.facts.layout.fps);
         config.data.root_layout = data.facts.root_layout();
+        data.check_length(clip, config.model.receptive_field())?;
         std::fs::create_dir_all(run).map_err(io("create the output folder", run))?;
         let yaml = serde_yaml::to_string(&config).expect("config serialises");
         sinmdm::files::write_atomically(&run.join(CONFIG_COPY), yaml.as_bytes())
@@ -172,7 +173,8 @@ impl Trainer {
                 ),
             })?,
         };
-        let data = ClipData::load(&clip_path, &state.config.data, &state.config.model)?;
+        let data = ClipData::load(&clip_path, &state.config.data)?;
+        data.check_length(&clip_path, state.config.model.receptive_field())?;
         if data.facts.sha256 != state.clip.sha256 {
             return Err(TrainError::Checkpoint {
                 path: clip_path,
