@@ -12,17 +12,16 @@ use crate::config::TrainConfig;
 /// pairing it would double a step's frames.
 pub const BATCH_ITEMS_MULTIPLE: usize = 2;
 
-/// The rule's batch, from the `items` a step of the configuration trains on the clip; it sets
-/// `out.training.frames_per_step` where it pairs them.
+/// The rule's batch; it sets `out.training.frames_per_step` where it pairs the items.
 pub(super) fn batch(
     config: &TrainConfig,
     out: &mut TrainConfig,
     reading: ClipReading,
-    items: usize,
     asked: bool,
     calm: bool,
 ) -> Chosen<Batch> {
     let frames = reading.frames;
+    let items = config.training.batch_shape(frames).items;
     let budget = config.training.frames_per_step;
     let theirs = Batch {
         items,

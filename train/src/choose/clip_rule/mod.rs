@@ -92,8 +92,8 @@ pub struct RuleChoice {
     /// Whether the steps are left to the step ladder ([`crate::choose::step_ladder`]): a calm
     /// clip whose steps the rule was asked for. `config` then holds the ladder's most steps.
     pub climb_ladder: bool,
-    /// For a calm clip, what the rule chooses should the ladder find that no short run covers
-    /// it: the clip trained as a varied one ([`not_calm_after_all`] completes its reason). Decided
+    /// For a clip left to the ladder, what the rule chooses should no short run cover it: the
+    /// clip trained as a varied one ([`not_calm_after_all`] completes its reason). Decided
     /// here with the rest, so that the ladder only picks between choices the rule made.
     pub if_not_calm: Option<Box<RuleChoice>>,
 }
@@ -132,20 +132,16 @@ pub fn choose(config: &TrainConfig, reading: ClipReading) -> RuleChoice {
         };
         Chosen::new(ClipKind::Varied, reason)
     };
-    // A calm clip's choice holds the one it trains should no short run cover it: a varied one.
-    let mut kinds = vec![kind];
-    if kinds[0].value == ClipKind::Calm {
+    let mut choice = choose_kind(config, reading, kind);
+    // A clip left to the ladder holds the choice it trains should no short run cover it.
+    if choice.climb_ladder {
         let reason = Reason::VariedClip {
             intra_diversity,
             below,
         };
-        kinds.push(Chosen::new(ClipKind::Varied, reason));
+        let varied = choose_kind(config, reading, Chosen::new(ClipKind::Varied, reason));
+        choice.if_not_calm = Some(Box::new(varied));
     }
-    let mut choices = kinds
-        .into_iter()
-        .map(|kind| choose_kind(config, reading, kind));
-    let mut choice = choices.next().expect("one kind at least");
-    choice.if_not_calm = choices.next().map(Box::new);
     choice
 }
 
@@ -178,8 +174,7 @@ fn choose_kind(config: &TrainConfig, reading: ClipReading, kind: Chosen<ClipKind
     } else {
         meant
     };
-    let items = config.training.batch_shape(reading.frames).items;
-    let batch = batch_pairing::batch(config, &mut out, reading, items, asked.batch, calm);
+    let batch = batch_pairing::batch(config, &mut out, reading, asked.batch, calm);
     RuleChoice {
         reading,
         config: out,

@@ -74,8 +74,8 @@ pub enum Climb {
     Interrupted,
 }
 
-/// The clip a ladder climbs on: its file, and the SHA-256 (hex) of its bytes as [`crate::clip::ClipData`]
-/// holds it, which goes into each rung's fingerprint.
+/// The clip a ladder climbs on: its file, and the SHA-256 (hex) of its bytes as
+/// [`crate::clip::ClipData`] holds it, which goes into each rung's fingerprint.
 #[derive(Debug, Clone, Copy)]
 pub struct LadderClip<'a> {
     /// The clip's file.
