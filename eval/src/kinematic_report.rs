@@ -3,8 +3,10 @@
 
 use serde::{Deserialize, Serialize};
 use sinmdm::motion::LocalMotion;
+use sinmdm::motion::up::UpAxis;
 
 use crate::kinematics::{ClipKinematics, KinematicScores, Kinematics, goals};
+use crate::turning::{ClipTurning, TurnScores, turn_rates};
 
 /// The kinematic fidelity of a batch of samples, as the network made them and as written
 /// (feet planted), beside the clip's own figures.
@@ -16,26 +18,51 @@ pub struct KinematicReport {
     pub raw: KinematicScores,
     /// The samples with their feet planted (the default output).
     pub planted: KinematicScores,
+    /// How fast the whole body turns: the clip, then the raw and the planted samples.
+    #[serde(default)]
+    pub turning: TurningReport,
+}
+
+/// How fast the root's heading turns in the clip and in the samples ([`crate::turning`]).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TurningReport {
+    /// The clip's turn rates.
+    pub clip: ClipTurning,
+    /// The samples as the network made them.
+    pub raw: TurnScores,
+    /// The samples with their feet planted.
+    pub planted: TurnScores,
 }
 
 impl KinematicReport {
     /// The report of `raw` and `planted` samples against `clip`, all of a skeleton `height`
-    /// tall.
+    /// tall whose file points `up`.
     pub fn new(
         clip: &LocalMotion,
         raw: &[LocalMotion],
         planted: &[LocalMotion],
         height: f64,
+        up: UpAxis,
     ) -> KinematicReport {
         let clip_kinematics = Kinematics::of_motion(clip, height);
         let clip_figures = ClipKinematics::new(&clip_kinematics);
-        let raw = clip_figures.score(&clip_kinematics, &Kinematics::of_motions(raw, height));
-        let planted =
-            clip_figures.score(&clip_kinematics, &Kinematics::of_motions(planted, height));
+        let scores = |motions: &[LocalMotion]| {
+            clip_figures.score(&clip_kinematics, &Kinematics::of_motions(motions, height))
+        };
+        let clip_turning = ClipTurning::new(&turn_rates(clip, up));
+        let turns = |motions: &[LocalMotion]| {
+            let pooled: Vec<f64> = motions.iter().flat_map(|m| turn_rates(m, up)).collect();
+            clip_turning.score(&pooled)
+        };
         KinematicReport {
-            clip: clip_figures,
-            raw,
-            planted,
+            raw: scores(raw),
+            planted: scores(planted),
+            turning: TurningReport {
+                raw: turns(raw),
+                planted: turns(planted),
+                clip: clip_turning.clone(),
+            },
+            clip: clip_figures.clone(),
         }
     }
 
@@ -75,6 +102,16 @@ impl KinematicReport {
             r.acceleration_distance,
             p.acceleration_distance,
             goals::ACCELERATION_DISTANCE
+        ));
+        let t = &self.turning;
+        out.push_str(&format!(
+            "| root turn rate p99 (degrees/s; the clip's most {:.0}) | {:.0} | {:.0} | {:.0} | (reported) |\n",
+            t.clip.most, t.clip.fast, t.raw.fast, t.planted.fast
+        ));
+        out.push_str(&format!(
+            "| frames turning faster than the clip's most (%) | 0 | {:.1} | {:.1} | (reported) |\n",
+            100.0 * t.raw.faster_than_clip,
+            100.0 * t.planted.faster_than_clip
         ));
         out
     }

@@ -39,6 +39,7 @@ mod replay;
 mod report;
 #[cfg(test)]
 mod test_data;
+pub mod turning;
 mod window_match;
 
 use ndarray::{Array2, ArrayView2, Axis};
@@ -62,6 +63,7 @@ pub use patched_nn::patched_nearest_neighbour;
 pub use replay::{
     REPLAY_TOLERANCE, ReplayReport, longest_backwards, longest_hold, longest_replay, rotation_rows,
 };
+pub use turning::{ClipTurning, TurnScores, turn_rates};
 pub use window_match::DiagonalSums;
 
 /// Window of the coverage metric and shortest piece of the global diversity, in frames.

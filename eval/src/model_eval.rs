@@ -198,7 +198,13 @@ pub fn evaluate_generated(
     let planted_report = score_motions(&planted)?;
     let clip_motion = decode(layout, clip)?;
     let feet = FeetReport::new(layout, &clip_motion, &raw, &planted);
-    let kinematics = KinematicReport::new(&clip_motion, &raw, &planted, layout.skeleton_height);
+    let kinematics = KinematicReport::new(
+        &clip_motion,
+        &raw,
+        &planted,
+        layout.skeleton_height,
+        layout.up,
+    );
     Ok(ModelEvaluation {
         generated,
         report,

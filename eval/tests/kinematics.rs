@@ -6,6 +6,7 @@ use std::path::Path;
 
 use sinmdm::bvh::read_bvh;
 use sinmdm::motion::resample::resample;
+use sinmdm::motion::up::UpAxis;
 use sinmdm::motion::{LocalMotion, global_poses, skeleton_height};
 use sinmdm_eval::KinematicReport;
 
@@ -55,6 +56,7 @@ fn the_clip_against_itself_moves_exactly_like_it() {
             std::slice::from_ref(&motion),
             std::slice::from_ref(&motion),
             height,
+            UpAxis::PosY,
         );
         let s = &report.planted;
         assert_eq!(s.speed_ratios, [1.0; 3], "{name}");
@@ -63,6 +65,9 @@ fn the_clip_against_itself_moves_exactly_like_it() {
         assert_eq!(s.still_share, report.clip.still_share, "{name}");
         assert!(s.misses(report.clip.still_share).is_empty(), "{name}");
         assert!(report.clip.speed_percentiles[1] > 0.0, "{name}");
+        let turning = &report.turning;
+        assert_eq!(turning.planted.faster_than_clip, 0.0, "{name}");
+        assert_eq!(turning.planted.fast, turning.clip.fast, "{name}");
     }
 }
 
@@ -77,6 +82,7 @@ fn half_the_pace_halves_every_speed_and_misses_the_goals() {
             std::slice::from_ref(&slow),
             std::slice::from_ref(&slow),
             height,
+            UpAxis::PosY,
         );
         let s = &report.raw;
         // Interpolated frames move half as far per frame; percentiles of a curve sampled twice
@@ -104,6 +110,17 @@ fn half_the_pace_halves_every_speed_and_misses_the_goals() {
             .collect();
         assert!(missed.contains(&"speed p50 / clip's"), "{name}: {missed:?}");
         assert!(missed.contains(&"speed distance"), "{name}: {missed:?}");
+        // A clip that turns turns half as fast, and never faster than it did.
+        let turning = &report.turning;
+        if name.contains("dance") {
+            // The dance turns in place (about 110 degrees/s at its fastest percent).
+            assert!(turning.clip.fast > 50.0, "{name}: {turning:?}");
+        }
+        if turning.clip.fast > 10.0 {
+            let ratio = turning.raw.fast / turning.clip.fast;
+            assert!((ratio - 0.5).abs() < 0.05, "{name}: {turning:?}");
+        }
+        assert_eq!(turning.raw.faster_than_clip, 0.0, "{name}: {turning:?}");
     }
 }
 
@@ -117,6 +134,7 @@ fn one_pose_held_is_still_throughout_and_a_whole_mean_away() {
             std::slice::from_ref(&still),
             std::slice::from_ref(&still),
             height,
+            UpAxis::PosY,
         );
         let s = &report.raw;
         assert_eq!(s.still_share, 1.0, "{name}");
@@ -124,6 +142,7 @@ fn one_pose_held_is_still_throughout_and_a_whole_mean_away() {
         assert!((s.speed_distance - 1.0).abs() < 1e-9, "{name}");
         assert!((s.acceleration_distance - 1.0).abs() < 1e-9, "{name}");
         assert_eq!(s.misses(report.clip.still_share).len(), 6, "{name}");
+        assert_eq!(report.turning.raw.fast, 0.0, "{name}");
     }
 }
 

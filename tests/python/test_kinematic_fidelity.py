@@ -59,6 +59,18 @@ def body_kinematics(path, height, fps, every=1):
     return speeds, accelerations
 
 
+def turn_rates(path, every=1, fps=30.0):
+    """Degrees per second the carrying root's heading turns between frames (+Y up): the root
+    axis that lies flattest on the ground over the motion, projected on it."""
+    joints, _, _, _ = positions(path, every)
+    r = root_rotation(path, carrying_root(path, joints), every)
+    up = np.array([0.0, 1.0, 0.0])
+    flats = [r[:, :, k] - np.outer(r[:, :, k] @ up, up) for k in range(3)]
+    flat = max(flats, key=lambda f: np.linalg.norm(f, axis=1).sum())
+    a, b = flat[:-1], flat[1:]
+    return np.degrees(np.abs(np.arctan2(np.cross(a, b) @ up, (a * b).sum(axis=1)))) * fps
+
+
 def fidelity(clip, samples):
     (cs, ca), (ss, sa) = clip, samples
     still = 0.25 * np.median(cs)
@@ -111,3 +123,15 @@ def test_eval_kinematic_fidelity_matches_the_numpy_definition(tmp_path):
         # A 4-step sample of a tiny model does not move like the walk: the figures are not
         # trivially those of the clip itself.
         assert expected["acceleration_distance"] > 0.1, expected
+
+        # How fast the whole body turns, beside the body's figures.
+        clip_turns = turn_rates(WALK, every=4)
+        turns = np.concatenate([turn_rates(tmp_path / f"{feet_mode}_{i:03d}.bvh") for i in range(3)])
+        turning = scores["kinematics"]["turning"]
+        # The clip is scored as the model encodes it (f32 features), so within 1 %.
+        assert abs(turning["clip"]["most"] - clip_turns.max()) <= 1e-2 * clip_turns.max(), turning
+        assert abs(turning["clip"]["fast"] - np.percentile(clip_turns, 99)) <= 1e-2 * clip_turns.max()
+        mine = turning[feet_mode]
+        assert abs(mine["fast"] - np.percentile(turns, 99)) <= 2e-3 * max(turns.max(), 1.0), (mine, feet_mode)
+        faster = np.mean(turns > turning["clip"]["most"])
+        assert abs(mine["faster_than_clip"] - faster) <= 2.0 / len(turns), (mine, faster)
