@@ -131,6 +131,7 @@ impl ClipTurning {
 mod tests {
     use super::*;
     use sinmdm::motion::math::{IDENTITY, axis_rotation};
+    use sinmdm::motion::up::rotate_motion;
     use sinmdm::motion::{Joint, Skeleton};
 
     /// A two-joint body whose root turns about +Y by `degrees_per_frame[f]` between frames.
@@ -191,6 +192,21 @@ mod tests {
         let rates = turn_rates(&turning(&[1.5; 40], 60.0), UpAxis::PosY);
         assert_eq!(rates.len(), 20);
         assert!(rates.iter().all(|r| (r - 90.0).abs() < 1e-9), "{rates:?}");
+    }
+
+    #[test]
+    fn a_z_up_file_turns_as_its_y_up_twin() {
+        let y_up = turning(&[1.0, 4.0, -2.0, 0.5, 3.0], 30.0);
+        let z_up = rotate_motion(&y_up, &UpAxis::PosZ.file_from_canonical());
+        let (a, b) = (
+            turn_rates(&y_up, UpAxis::PosY),
+            turn_rates(&z_up, UpAxis::PosZ),
+        );
+        assert_eq!(a.len(), 5);
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() < 1e-9, "{a:?} {b:?}");
+        }
+        assert!((a[1] - 120.0).abs() < 1e-9, "{a:?}");
     }
 
     #[test]
