@@ -21,6 +21,10 @@ use crate::kinematics::KINEMATIC_FPS;
 /// shows, without the single fastest frame.
 pub const TURN_PERCENTILE: f64 = 99.0;
 
+/// Turns slower than this, in degrees per second (a whole turn in six minutes), are never
+/// counted as faster than the clip: a clip that never turns would count its samples' rounding.
+pub const LEAST_TURN: f64 = 1.0;
+
 /// The clip's turn rates, which the samples' are measured against.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct ClipTurning {
@@ -37,7 +41,8 @@ pub struct ClipTurning {
 pub struct TurnScores {
     /// The samples' turn rate at [`TURN_PERCENTILE`], degrees per second.
     pub fast: f64,
-    /// Share (0..=1) of the samples' frame pairs turning faster than the clip's fastest.
+    /// Share (0..=1) of the samples' frame pairs turning faster than the clip's fastest (and
+    /// than [`LEAST_TURN`]).
     pub faster_than_clip: f64,
 }
 
@@ -115,7 +120,8 @@ impl ClipTurning {
 
     /// How the pooled turn rates of samples compare with the clip's.
     pub fn score(&self, samples: &[f64]) -> TurnScores {
-        let faster = samples.iter().filter(|&&r| r > self.most).count();
+        let bound = self.most.max(LEAST_TURN);
+        let faster = samples.iter().filter(|&&r| r > bound).count();
         TurnScores {
             fast: percentile(&sorted(samples), TURN_PERCENTILE),
             faster_than_clip: if samples.is_empty() {
@@ -222,5 +228,18 @@ mod tests {
         // The clip against itself: nothing faster.
         let same = clip.score(&turn_rates(&turning(&[2.0; 30], 30.0), UpAxis::PosY));
         assert_eq!(same.faster_than_clip, 0.0);
+        // Against a clip that never turns, a drift under LEAST_TURN is not turning; a turn is.
+        let still = ClipTurning::new(&turn_rates(&turning(&[0.0; 30], 30.0), UpAxis::PosY));
+        assert_eq!(still.most, 0.0);
+        let drift = still.score(&turn_rates(&turning(&[0.01; 30], 30.0), UpAxis::PosY));
+        assert_eq!(drift.faster_than_clip, 0.0);
+        assert!(
+            (still
+                .score(&turn_rates(&turning(&swing, 30.0), UpAxis::PosY))
+                .faster_than_clip
+                - 0.1)
+                .abs()
+                < 1e-9
+        );
     }
 }
