@@ -60,9 +60,9 @@ impl KinematicReport {
             turning: TurningReport {
                 raw: turns(raw),
                 planted: turns(planted),
-                clip: clip_turning.clone(),
+                clip: clip_turning,
             },
-            clip: clip_figures.clone(),
+            clip: clip_figures,
         }
     }
 

@@ -64,6 +64,7 @@ impl Kinematics {
             &root_relative(motion, &global_poses(motion), height),
             motion.fps,
             KINEMATIC_FPS,
+            |a, b, t| lerp_points(a, b, t),
         );
         Kinematics::of_positions(&body, KINEMATIC_FPS)
     }
@@ -137,8 +138,14 @@ fn root_relative(motion: &LocalMotion, poses: &[GlobalPose], height: f64) -> Vec
 }
 
 /// `frames` taken at `from` frames per second, linearly interpolated at `to` frames per second
-/// over the same span (the last frame at or before the source's end).
-fn resampled(frames: &[Vec<Vec3>], from: f64, to: f64) -> Vec<Vec<Vec3>> {
+/// over the same span (the last frame at or before the source's end), `lerp(a, b, t)` giving
+/// the frame a share `t` of the way from `a` to `b`.
+pub(crate) fn resampled<T: Clone>(
+    frames: &[T],
+    from: f64,
+    to: f64,
+    lerp: impl Fn(&T, &T, f64) -> T,
+) -> Vec<T> {
     if frames.len() < 2 || (from - to).abs() < 1e-9 || !(from > 0.0 && to > 0.0) {
         return frames.to_vec();
     }
@@ -149,14 +156,14 @@ fn resampled(frames: &[Vec<Vec3>], from: f64, to: f64) -> Vec<Vec<Vec3>> {
             let at = (k as f64 * from / to).min(last);
             let lo = at.floor() as usize;
             let hi = (lo + 1).min(frames.len() - 1);
-            let t = at - lo as f64;
-            frames[lo]
-                .iter()
-                .zip(&frames[hi])
-                .map(|(&a, &b)| a + (b - a) * t)
-                .collect()
+            lerp(&frames[lo], &frames[hi], at - lo as f64)
         })
         .collect()
+}
+
+/// Points `a` a share `t` of the way to `b`, point by point.
+fn lerp_points(a: &[Vec3], b: &[Vec3], t: f64) -> Vec<Vec3> {
+    a.iter().zip(b).map(|(&a, &b)| a + (b - a) * t).collect()
 }
 
 /// The 1-Wasserstein distance between the empirical distributions of `a` and `b`: the area
@@ -335,7 +342,8 @@ impl KinematicScores {
     }
 }
 
-fn sorted(values: &[f64]) -> Vec<f64> {
+/// `values` in ascending order.
+pub(crate) fn sorted(values: &[f64]) -> Vec<f64> {
     let mut s = values.to_vec();
     s.sort_by(f64::total_cmp);
     s
@@ -405,12 +413,12 @@ mod tests {
     #[test]
     fn resampling_to_half_the_rate_keeps_a_straight_lines_speed() {
         let line: Vec<Vec<Vec3>> = (0..61).map(|i| vec![Vec3([i as f64, 0.0, 0.0])]).collect();
-        let half = resampled(&line, 60.0, 30.0);
+        let half = resampled(&line, 60.0, 30.0, |a, b, t| lerp_points(a, b, t));
         assert_eq!(half.len(), 31);
         let k = Kinematics::of_positions(&half, 30.0);
         assert!(k.speeds.iter().all(|s| (s - 60.0).abs() < 1e-9));
         // 1 frame per 2 at 60 fps, 2 at 30 fps: the other way interpolates.
-        let double = resampled(&half, 30.0, 60.0);
+        let double = resampled(&half, 30.0, 60.0, |a, b, t| lerp_points(a, b, t));
         assert_eq!(double.len(), 61);
         assert!((double[7][0][0] - 7.0).abs() < 1e-12);
     }

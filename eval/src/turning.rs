@@ -15,7 +15,7 @@ use sinmdm::motion::math::Vec3;
 use sinmdm::motion::up::UpAxis;
 use sinmdm::motion::{LocalMotion, global_poses};
 
-use crate::kinematics::KINEMATIC_FPS;
+use crate::kinematics::{KINEMATIC_FPS, resampled, sorted};
 
 /// The percentile of the turn rate compared with the clip's: the fastest turns, where a swing
 /// shows, without the single fastest frame.
@@ -56,16 +56,14 @@ pub fn turn_rates(motion: &LocalMotion, up: UpAxis) -> Vec<f64> {
     let root = travelling_root(&motion.skeleton, &poses);
     let up = up.direction();
     let flat = |v: Vec3| v - up * v.dot(up);
+    let lying: [f64; 3] = std::array::from_fn(|k| {
+        poses
+            .iter()
+            .map(|p| flat(p.rotations[root].column(k)).norm())
+            .sum()
+    });
     let axis = (0..3)
-        .max_by(|&a, &b| {
-            let lying = |k: usize| -> f64 {
-                poses
-                    .iter()
-                    .map(|p| flat(p.rotations[root].column(k)).norm())
-                    .sum()
-            };
-            lying(a).total_cmp(&lying(b))
-        })
+        .max_by(|&a, &b| lying[a].total_cmp(&lying[b]))
         .unwrap_or(0);
     let headings: Vec<Vec3> = poses
         .iter()
@@ -76,35 +74,12 @@ pub fn turn_rates(motion: &LocalMotion, up: UpAxis) -> Vec<f64> {
         let turn = pair[0].cross(pair[1]).dot(up).atan2(pair[0].dot(pair[1]));
         angle.push(angle[angle.len() - 1] + turn);
     }
-    let resampled = resample(&angle, motion.fps, KINEMATIC_FPS);
-    resampled
-        .windows(2)
-        .map(|w| (w[1] - w[0]).abs().to_degrees() * KINEMATIC_FPS)
-        .collect()
-}
-
-/// `values` taken at `from` per second, linearly interpolated at `to` per second over the
-/// same span.
-fn resample(values: &[f64], from: f64, to: f64) -> Vec<f64> {
-    if values.len() < 2 || (from - to).abs() < 1e-9 || !(from > 0.0 && to > 0.0) {
-        return values.to_vec();
-    }
-    let last = (values.len() - 1) as f64;
-    let count = (last * to / from + 1e-9).floor() as usize + 1;
-    (0..count)
-        .map(|k| {
-            let at = (k as f64 * from / to).min(last);
-            let lo = at.floor() as usize;
-            let hi = (lo + 1).min(values.len() - 1);
-            values[lo] + (values[hi] - values[lo]) * (at - lo as f64)
-        })
-        .collect()
-}
-
-fn sorted(values: &[f64]) -> Vec<f64> {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    v
+    resampled(&angle, motion.fps, KINEMATIC_FPS, |&a, &b, t| {
+        a + (b - a) * t
+    })
+    .windows(2)
+    .map(|w| (w[1] - w[0]).abs().to_degrees() * KINEMATIC_FPS)
+    .collect()
 }
 
 impl ClipTurning {

@@ -20,7 +20,7 @@ import onnx
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "python"))
-from test_kinematic_fidelity import carrying_root, positions, root_rotation  # noqa: E402
+from test_kinematic_fidelity import turn_rates  # noqa: E402
 
 
 def model_layout(model):
@@ -30,22 +30,11 @@ def model_layout(model):
     return np.array(up, float), meta["layout"]["fps"]
 
 
-def heading_rate(path, up, fps, every=1):
-    """Degrees per second the root's heading turns between frames (the root axis that lies
-    flattest on the ground, projected on it)."""
-    joints, _, _, _ = positions(path, every)
-    r = root_rotation(path, carrying_root(path, joints), every)
-    flats = [r[:, :, k] - np.outer(r[:, :, k] @ up, up) for k in range(3)]
-    flat = max(flats, key=lambda f: np.linalg.norm(f, axis=1).mean())
-    a, b = flat[:-1], flat[1:]
-    return np.degrees(np.abs(np.arctan2(np.cross(a, b) @ up, (a * b).sum(axis=1)))) * fps
-
-
 def main():
     clip, models = pathlib.Path(sys.argv[1]), sys.argv[2:]
     up, fps = model_layout(models[0])
     frame_time = float(re.search(r"Frame Time:\s*([\d.eE+-]+)", clip.read_text()).group(1))
-    clip_rate = heading_rate(clip, up, fps, every=max(1, round(1 / frame_time / fps)))
+    clip_rate = turn_rates(clip, max(1, round(1 / frame_time / fps)), fps, up)
     print("| motion | heading rate p50 / p99 / most (degrees/s) | frames turning faster than the clip's most |")
     print("|---|---|---|")
     print(f"| clip | {np.median(clip_rate):.0f} / {np.percentile(clip_rate, 99):.0f} / "
@@ -56,7 +45,7 @@ def main():
             subprocess.run([str(ROOT / "target/release/sinmdm"), "generate", "-m", model, "--count", "3",
                             "--seed", "0", "--seconds", "20", "--feet", "raw", "--quiet", "-o", str(out)],
                            check=True, capture_output=True)
-            rate = np.concatenate([heading_rate(out.with_name(f"{out.stem}_{i:03d}.bvh"), up, fps)
+            rate = np.concatenate([turn_rates(out.with_name(f"{out.stem}_{i:03d}.bvh"), 1, fps, up)
                                    for i in range(3)])
             print(f"| {pathlib.Path(model).name} | {np.median(rate):.0f} / {np.percentile(rate, 99):.0f} / "
                   f"{rate.max():.0f} | {np.mean(rate > clip_rate.max()) * 100:.1f} % |")

@@ -59,12 +59,12 @@ def body_kinematics(path, height, fps, every=1):
     return speeds, accelerations
 
 
-def turn_rates(path, every=1, fps=30.0):
-    """Degrees per second the carrying root's heading turns between frames (+Y up): the root
-    axis that lies flattest on the ground over the motion, projected on it."""
+def turn_rates(path, every=1, fps=30.0, up=(0.0, 1.0, 0.0)):
+    """Degrees per second the carrying root's heading turns between frames: the root axis that
+    lies flattest on the ground (normal to `up`) over the motion, projected on it."""
     joints, _, _, _ = positions(path, every)
     r = root_rotation(path, carrying_root(path, joints), every)
-    up = np.array([0.0, 1.0, 0.0])
+    up = np.asarray(up, dtype=float)
     flats = [r[:, :, k] - np.outer(r[:, :, k] @ up, up) for k in range(3)]
     flat = max(flats, key=lambda f: np.linalg.norm(f, axis=1).sum())
     a, b = flat[:-1], flat[1:]
