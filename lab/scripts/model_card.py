@@ -18,6 +18,8 @@ import re
 import subprocess
 import sys
 
+import yaml
+
 
 def eval_text(model: pathlib.Path, clip: str, extra: list[str]) -> str:
     out = subprocess.run(
@@ -149,11 +151,15 @@ def main() -> None:
     contacts = len(layout["contact_joints"])
     joints = len(layout["skeleton"]["joints"])
     fps = "the clip's own rate" if d["fps"] is None else f"{d['fps']:g} fps"
+    # A run's configuration without data.std_floor was trained under the floor before it.
+    floor = d.get("std_floor", 0.001)
+    default_floor = yaml.safe_load(pathlib.Path("configs/default.yaml").read_text())["data"]["std_floor"]
     config_row = (
         f"the default (`configs/default.yaml`: C {m['channels']}, {m['heads']} heads, window "
         f"{m['window']}, dropout {m['dropout']}, cosine learning rate "
         f"from {t['learning_rate']:g} after {t['warmup_steps']} warm-up steps, weight average "
-        f"{t.get('ema_decay')}, {frames_seen(t, state)}, {fps}, seed {t['seed']}; the step count, "
+        f"{t.get('ema_decay')}, {frames_seen(t, state)}, {fps}, feature spread floor {floor:g}, "
+        f"seed {t['seed']}; the step count, "
         "window, dropout and channels as the default's `from_clip` rule chose them from the clip)"
     )
     if d.get("root_layout", "world") != "world":
@@ -162,6 +168,8 @@ def main() -> None:
     extra_args = " --fps clip" if d["fps"] is None else ""
     if d.get("root_layout", "world") != "world":
         extra_args += f" --root-layout {d['root_layout']}"
+    if floor != default_floor:
+        extra_args += f" --std-floor {floor:g}"
     rungs = ladder_rungs(run)
     elapsed = state["elapsed_seconds"]
     ladder_seconds = sum(r["train_seconds"] + r["check_seconds"] for r in rungs)

@@ -6,7 +6,8 @@ mod common;
 use sinmdm::bvh::read_bvh;
 use sinmdm::motion::math::{Vec3, mat_from_quat};
 use sinmdm::motion::{
-    ColumnKind, EncodeOptions, FeatureLayout, Normalizer, decode, encode, global_poses, poses,
+    ColumnKind, EncodeOptions, FeatureLayout, Normalizer, STD_FLOOR_SHARE, decode, encode,
+    global_poses, poses,
 };
 
 #[test]
@@ -38,7 +39,7 @@ fn normalised_features_decode_after_denormalising() {
     let clip =
         read_bvh(common::workspace().join("tests/data/bvh/human_hop_cmu_131_03.bvh")).unwrap();
     let encoded = encode(&clip, &EncodeOptions::default()).unwrap();
-    let stats = Normalizer::fit(encoded.features.view());
+    let stats = Normalizer::fit(encoded.features.view(), STD_FLOOR_SHARE);
     let z = stats.normalize(encoded.features.view());
     // Standardised rows have zero mean; rows whose spread is above the std floor have unit
     // variance, the floored (near-constant) ones less.

@@ -7,8 +7,9 @@ import subprocess
 
 import numpy as np
 import pytest
+import yaml
 
-from conftest import TRAIN, clips, encoded_clip
+from conftest import TRAIN, clips, encoded_clip, tiny_config
 
 # SPEC section 3: the input and output convolutions (k 3) and the two k3 convolutions of each of
 # the three residual blocks reach 8 frames each side; each of the three QnA blocks (k - 1) / 2.
@@ -20,13 +21,13 @@ def receptive_field(window):
     return 2 * (FIXED_HALF_WIDTH + QNA_BLOCKS * (window - 1) // 2) + 1
 
 
-def numpy_span(raw, fps):
+def numpy_span(raw, fps, floor):
     """First lag (frames) at which the mean autocorrelation of the feature rows falls below zero:
-    rows normalised as for training (population std floored at 1e-3 of the mean std), rows that
-    then still vary standardised, lags searched up to half the clip and 10 s."""
+    rows normalised as for training (population std floored at `floor` of the mean std), rows
+    that then still vary standardised, lags searched up to half the clip and 10 s."""
     x = np.asarray(raw, dtype=np.float64)
     std = x.std(axis=1)
-    std = np.maximum(std, max(std.mean() * 1e-3, np.finfo(np.float32).tiny))
+    std = np.maximum(std, max(std.mean() * floor, np.finfo(np.float32).tiny))
     x = (x - x.mean(axis=1, keepdims=True)) / std[:, None]
     var = x.var(axis=1)
     keep = var > 1e-12
@@ -45,7 +46,8 @@ def test_motion_span_and_hint_match_numpy(clip, tmp_path, sinmdm):
     raw = np.asarray(doc["samples"][0], dtype=np.float64)
     assert raw.shape[0] == len(doc["columns"])
     fps = doc["fps"]
-    expected = numpy_span(raw, fps)
+    floor = yaml.safe_load(tiny_config(1))["data"]["std_floor"]
+    expected = numpy_span(raw, fps, floor)
 
     out = subprocess.run([str(TRAIN), str(clip), "--config", str(config), "--dry-run"],
                          check=True, capture_output=True, text=True).stdout

@@ -3,10 +3,14 @@ onnx-models/ has a card and metadata that match its clip, and scripts/demo.sh wr
 that an independent reader (bvhio) parses, with the clip's skeleton and frame rate."""
 
 import json
+import re
 import subprocess
 
 import bvhio
+import numpy as np
+import onnx
 import pytest
+import yaml
 
 from conftest import ROOT, SINMDM
 
@@ -44,6 +48,31 @@ def test_model_has_a_card_and_a_small_file(model):
     assert model.stat().st_size < 8_000_000
     clip = CLIPS / training["clip"]
     assert clip.exists(), f"{training['clip']} is not shipped"
+
+
+@pytest.mark.parametrize("model", MODELS, ids=lambda m: m.stem)
+def test_the_card_names_the_floor_its_statistics_were_fitted_with(model):
+    """The floor is a share of the mean spread before flooring: the smallest spread `v` is that
+    share of it wherever a feature was floored, and the mean before flooring lies between the
+    mean after it less the `k` floored rows' `v` each, and the mean after it. So the card's floor
+    must lie in [v / mean, v / (mean - k v / n)] if any row sits at the minimum because of it, and
+    under v / mean otherwise: a card cannot claim the new floor for a model trained under the
+    old one, or the other way round."""
+    text = model.with_suffix(".md").read_text()
+    found = re.search(r"feature spread floor ([0-9.]+)", text)
+    assert found, f"{model.stem}'s card does not name its feature spread floor"
+    floor = float(found.group(1))
+    props = {p.key: p.value for p in onnx.load(str(model), load_external_data=False).metadata_props}
+    std = np.asarray(json.loads(props["sinmdm.metadata"])["normalizer"]["std"], dtype=np.float64)
+    v, mean, n = std.min(), std.mean(), len(std)
+    k = int(np.sum(std <= v * (1 + 1e-6)))
+    low, high = v / mean, v / (mean - k * v / n)
+    floored = low * (1 - 1e-5) <= floor <= high * (1 + 1e-5)
+    assert floored or floor < low, (floor, low, high)
+    assert high < 0.05 if floor < 0.05 else floored, (floor, low, high)
+    flag = f"--std-floor {found.group(1)}" in text
+    default = yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())["data"]["std_floor"]
+    assert flag == (floor != default), "the card's command must name a floor other than the default"
 
 
 def test_main_command_writes_bvh_files_that_parse(tmp_path):

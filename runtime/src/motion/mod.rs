@@ -30,7 +30,7 @@ pub use features::{
 };
 pub use feet::{Feet, PlantOptions, PlantStats, plant_feet};
 pub use fk::{GlobalPose, global_pose, global_poses, max_position_error, skeleton_height};
-pub use normalize::Normalizer;
+pub use normalize::{Normalizer, STD_FLOOR_SHARE, STD_FLOOR_SHARE_BEFORE};
 pub use pose::{Pose, Quaternion, features_from_poses, motion_from_poses, poses};
 pub use skeleton::{Axis, Channel, Joint, Skeleton};
 pub use up::UpAxis;

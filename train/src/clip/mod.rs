@@ -113,7 +113,7 @@ impl ClipData {
             reason: source,
         })?;
         let frames = encoded.features.ncols();
-        let normalizer = Normalizer::fit(encoded.features.view());
+        let normalizer = Normalizer::fit(encoded.features.view(), data.std_floor as f32);
         let features = normalizer.normalize(encoded.features.view());
         let name = path
             .file_name()

@@ -149,6 +149,11 @@ pub struct DataConfig {
     pub contact_joints: Option<Vec<String>>,
     /// Contact speed threshold in skeleton heights per second.
     pub contact_speed: f64,
+    /// The floor on each feature's standard deviation, as a share of the mean one
+    /// (`sinmdm::motion::STD_FLOOR_SHARE` in the shipped configurations). Absent: the old
+    /// floor `STD_FLOOR_SHARE_BEFORE`, as configurations written before it read.
+    #[serde(default = "std_floor_before")]
+    pub std_floor: f64,
     /// The clip's up axis (`x`, `y`, `z`, `-x`, `-y`, `-z`); absent or `null` reads it from the
     /// motion.
     #[serde(default)]
@@ -168,6 +173,10 @@ pub struct DataConfig {
     /// is never written to or read from a configuration file.
     #[serde(skip)]
     pub allow_outside_folder: bool,
+}
+
+fn std_floor_before() -> f64 {
+    f64::from(sinmdm::motion::STD_FLOOR_SHARE_BEFORE)
 }
 
 fn is_world(layout: &sinmdm::motion::RootLayout) -> bool {

@@ -72,6 +72,12 @@ impl TrainConfig {
                 t.warmup_steps, t.steps
             ));
         }
+        if !(self.data.std_floor.is_finite() && (0.0..1.0).contains(&self.data.std_floor)) {
+            return Err(format!(
+                "data.std_floor must be in [0, 1) (a share of the mean feature spread), got {}",
+                self.data.std_floor
+            ));
+        }
         if !(t.weight_decay.is_finite() && t.weight_decay >= 0.0) {
             return Err(format!(
                 "training.weight_decay must be zero or positive, got {}",

@@ -65,6 +65,10 @@ struct Args {
     /// where the clip has a facing pair and a travelling root, world otherwise).
     #[arg(long, value_name = "world|heading|auto")]
     root_layout: Option<sinmdm::motion::RootLayout>,
+    /// The floor on each feature's standard deviation in a new run, as a share of the mean one,
+    /// replacing the config's data.std_floor (0.05; 0.001 trains as models before it did).
+    #[arg(long, value_name = "SHARE")]
+    std_floor: Option<f64>,
     /// Run folder: checkpoints, loss.csv, loss.png.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -186,6 +190,12 @@ fn new_run_config(args: &Args) -> Result<TrainConfig> {
     if let Some(layout) = args.root_layout {
         config.data.root_layout = layout;
     }
+    if let Some(floor) = args.std_floor {
+        config.data.std_floor = floor;
+        config
+            .validate()
+            .map_err(|e| anyhow::anyhow!("--std-floor {floor}: {e}"))?;
+    }
     if let Some(window) = args.window {
         config.model.window = window;
         config.model.window_follows_fps = false;
@@ -272,6 +282,9 @@ fn resumed(args: &Args, out: &Path, device: Device) -> Result<Trainer> {
     }
     if args.root_layout.is_some() {
         bail!("--root-layout sets the root layout of a new run; a resumed run keeps its own");
+    }
+    if args.std_floor.is_some() {
+        bail!("--std-floor sets how a new run normalises its clip; a resumed run keeps its own");
     }
     if args.clip_anim.is_some() {
         bail!("--clip-anim picks the animation of a new run; a resumed run keeps its own");
