@@ -238,9 +238,16 @@ fn hold_settings() -> Vec<(&'static str, PlantOptions)> {
     let base = PlantOptions::default();
     vec![
         (
-            "legs only (no root travel)",
+            "root carried with the stance (share 1)",
             PlantOptions {
-                root_follows_stance: false,
+                root_stance_share: 1.0,
+                ..base
+            },
+        ),
+        (
+            "root follows half the stance",
+            PlantOptions {
+                root_stance_share: 0.5,
                 ..base
             },
         ),

@@ -143,13 +143,44 @@ fn bone_lengths(pose: &GlobalPose, motion: &LocalMotion) -> Vec<f64> {
 
 #[test]
 fn a_sliding_foot_is_held_still_through_its_span_with_exact_bones() {
-    for root_follows_stance in [true, false] {
+    for root_stance_share in [1.0, 0.5, 0.0] {
         let options = PlantOptions {
-            root_follows_stance,
+            root_stance_share,
             ..options()
         };
         sliding_foot_is_held(&options);
     }
+}
+
+#[test]
+fn the_root_follows_its_share_of_the_stance() {
+    // The stance's travel does not depend on the share, so half a share moves the hips by
+    // exactly half of what a whole one does, frame by frame.
+    let (layout, motion) = sliding_leg();
+    let hips = |share: f64| -> Vec<Vec3> {
+        let options = PlantOptions {
+            root_stance_share: share,
+            ..options()
+        };
+        let (planted, _) =
+            plant_feet(&layout, &motion, &labels(), &Kept::default(), &options).unwrap();
+        global_poses(&planted).iter().map(|p| p.joints[0]).collect()
+    };
+    let (none, half, whole) = (hips(0.0), hips(0.5), hips(1.0));
+    let mut moved = 0.0f64;
+    for f in 0..none.len() {
+        let full = whole[f] - none[f];
+        let part = half[f] - none[f];
+        moved = moved.max(full.norm());
+        assert!(
+            distance(part * 2.0, full) < 1e-9,
+            "frame {f}: {part:?} against half of {full:?}"
+        );
+    }
+    assert!(
+        moved > 0.05 * layout.skeleton_height,
+        "the stance moved the hips {moved}"
+    );
 }
 
 fn sliding_foot_is_held(options: &PlantOptions) {
@@ -182,11 +213,11 @@ fn sliding_foot_is_held(options: &PlantOptions) {
         // ... and the hips keep their height; they move along the ground only to travel with
         // the stance foot, and not at all when told not to.
         assert!((b.joints[0][1] - a.joints[0][1]).abs() < 1e-12);
-        if !options.root_follows_stance {
+        if options.root_stance_share == 0.0 {
             assert!(distance(b.joints[0], a.joints[0]) < 1e-12);
         }
     }
-    if options.root_follows_stance {
+    if options.root_stance_share > 0.0 {
         // The foot slid forward with the hips, so the hips were carried back by the stance,
         // by at most the slide.
         let back = before[SPAN.end - 1].joints[0][2] - after[SPAN.end - 1].joints[0][2];

@@ -45,11 +45,14 @@ pub struct PlantOptions {
     /// past this, it follows the generated point at this distance (a foot the network drags a
     /// long way is let go rather than the leg stretched after it).
     pub max_hold: f64,
-    /// Whether the root travels horizontally with the feet in contact before the legs are
-    /// turned: where planted feet slide together, the body is carried along instead, which
-    /// leaves the legs' rotations (what the model made) as they are. Frames whose root a task
-    /// kept are not moved.
-    pub root_follows_stance: bool,
+    /// How much of the feet in contact's travel the root follows horizontally before the legs
+    /// are turned, from 0 (the root stays where the network put it; the legs alone reach the
+    /// held feet) to 1 (where planted feet slide together, the body is carried along instead,
+    /// which leaves the legs' rotations as the model made them). Frames whose root a task kept
+    /// are not moved. The default, 0, keeps the network's pace: a walk whose strides are
+    /// shorter than its travel was slowed to under half its clip's pace by a root carried with
+    /// its feet (lab/EXPERIMENTS.md, "How fast the planted samples travel").
+    pub root_stance_share: f64,
     /// The root's travel with the stance is averaged over this many seconds on each side of a
     /// frame, with weights falling linearly to the edges (a root that followed every tremor of
     /// a foot would shake the whole body).
@@ -67,7 +70,7 @@ impl Default for PlantOptions {
             grow_below_speed: 2.5,
             soft_reach: 0.2,
             max_hold: 0.4,
-            root_follows_stance: true,
+            root_stance_share: 0.0,
             stance_smoothing_seconds: 0.3,
         }
     }
@@ -119,6 +122,6 @@ pub struct PlantStats {
     /// The mean distance of points from their targets, over every frame with a target.
     pub mean_miss: f64,
     /// The largest horizontal move of the root made so that it travels with the feet in
-    /// contact ([`PlantOptions::root_follows_stance`]).
+    /// contact ([`PlantOptions::root_stance_share`]).
     pub max_root_travel: f64,
 }

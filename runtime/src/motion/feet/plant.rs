@@ -24,7 +24,7 @@ const OVERFLOW_SAFE: f64 = 1e150;
 /// the spans its `labels` (one series per contact joint, as the features carry them) mark, on
 /// or above the ground, easing in and out over [`PlantOptions::blend_seconds`]; and lifts
 /// whatever would go below the ground. Only the root's position (carried along with the feet in
-/// contact, [`PlantOptions::root_follows_stance`], and raised where needed) and rotations of the
+/// contact, [`PlantOptions::root_stance_share`], and raised where needed) and rotations of the
 /// chains above contact joints ([`leg_chain`]) change, so every bone keeps its length. Joints and
 /// root positions in `kept` are left exactly as they are. The ground is the layout's (from the
 /// training clip), or this motion's own ([`ground_level`]) for a model file without one.
@@ -54,7 +54,7 @@ pub fn plant_feet(
     // 2. Contact spans, on the generated motion: the labelled ones, grown over low, slow frames.
     let spans = planting.contact_spans(&chains, labels);
     // 3. The root carried along with the feet in contact.
-    if options.root_follows_stance {
+    if options.root_stance_share > 0.0 {
         planting.carry_root_with_stance(&chains, &spans);
     }
     // 4. Where each contact point should be, frame by frame.
@@ -196,8 +196,8 @@ impl<'a> Planting<'a> {
             .collect()
     }
 
-    /// The root moved horizontally with the feet in contact ([`stance_travel`]), except where a
-    /// task kept it; the poses follow.
+    /// The root moved horizontally with the feet in contact ([`stance_travel`], times
+    /// [`PlantOptions::root_stance_share`]), except where a task kept it; the poses follow.
     fn carry_root_with_stance(&mut self, chains: &[Option<LegChain>], spans: &[Vec<Range<usize>>]) {
         let (mut points, mut weights) = (Vec::new(), Vec::new());
         for (chain, spans) in chains.iter().zip(spans) {
@@ -219,9 +219,11 @@ impl<'a> Planting<'a> {
             .max(0.0) as usize;
         let travel = stance_travel(&points, &weights, &kept_root, radius);
         let joints = self.motion.skeleton.len();
+        let share = self.options.root_stance_share.clamp(0.0, 1.0);
         for (f, t) in travel.iter().enumerate() {
+            let t = *t * share;
             let root = &mut self.motion.translations[f * joints + self.top];
-            *root += *t;
+            *root += t;
             self.stats.max_root_travel = self.stats.max_root_travel.max(t.norm() / self.height);
         }
         self.poses = global_poses(&self.motion);
