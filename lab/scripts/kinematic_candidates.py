@@ -3,9 +3,11 @@
 rung (`step_ladder/steps-N/check.json`, seed 1, the ladder's own scores), with the kinematic
 goals beside the others, and the bounds each row misses.
 
-Usage: python3 lab/scripts/kinematic_candidates.py OUT_DIR [--rungs]
+Usage: python3 lab/scripts/kinematic_candidates.py OUT_DIR [--rungs] [--planted]
   OUT_DIR   the runs' folder (out/variants by default in the lab's drivers)
   --rungs   also list every ladder rung of every *.ladder* run
+  --planted score the samples with their feet planted (the default output: kinematics, coverage,
+            diversity and jitter of the planted motion) instead of as the network made them
 """
 import json
 import pathlib
@@ -14,9 +16,12 @@ import sys
 # The goals (SPEC section 9; eval/src/kinematics.rs and train/src/choose/step_ladder/ hold them).
 STILL_MARGIN, LOW, HIGH, SPEED_DISTANCE, ACCELERATION_DISTANCE = 0.05, 0.8, 1.25, 0.2, 0.5
 COVERAGE, JITTER = 95.0, 1.5
+# Global diversity at least DIVERSITY where the clip's own intra diversity is at least VARIED.
+DIVERSITY, VARIED = 1.2, 0.7
 
 
-def misses(still, clip_still, ratios, speed_d, accel_d, coverage, replay, replay_goal, jitter):
+def misses(still, clip_still, ratios, speed_d, accel_d, coverage, replay, replay_goal, jitter,
+           diversity=None, clip_intra=0.0):
     out = []
     if still > clip_still + STILL_MARGIN:
         out.append("still")
@@ -29,6 +34,8 @@ def misses(still, clip_still, ratios, speed_d, accel_d, coverage, replay, replay
         out.append("accel. d.")
     if coverage < COVERAGE:
         out.append("coverage")
+    if diversity is not None and clip_intra >= VARIED and diversity < DIVERSITY:
+        out.append("diversity")
     if replay > replay_goal:
         out.append("replay")
     if jitter > JITTER:
@@ -37,22 +44,27 @@ def misses(still, clip_still, ratios, speed_d, accel_d, coverage, replay, replay
 
 
 def row(name, still, clip_still, ratios, speed_d, accel_d, coverage, diversity, replay, floor,
-        jitter):
+        jitter, clip_intra=0.0):
     goal = max(1.0, floor)
+    missed = misses(still, clip_still, ratios, speed_d, accel_d, coverage, replay, goal, jitter,
+                    diversity, clip_intra)
     return (f"| {name} | {100 * still:.1f} ({100 * clip_still:.1f}) | "
             f"{' / '.join(f'{r:.2f}' for r in ratios)} | {speed_d:.2f} / {accel_d:.2f} | "
             f"{coverage:.1f} | {diversity:.3f} | {replay:.2f} ({floor:.2f}) | {jitter:.2f} | "
-            f"{misses(still, clip_still, ratios, speed_d, accel_d, coverage, replay, goal, jitter)} |")
+            f"{missed} |")
 
 
-def eval_row(path):
+def eval_row(path, planted=False):
     d = json.loads(path.read_text())
-    k, c = d["kinematics"]["raw"], d["kinematics"]["clip"]
+    kind = "planted" if planted else "raw"
+    k, c = d["kinematics"][kind], d["kinematics"]["clip"]
+    report = d["planted_report"] if planted else d["report"]
     r = d["replay"]
     return row(path.stem, k["still_share"], c["still_share"], k["speed_ratios"],
-               k["speed_distance"], k["acceleration_distance"], d["report"]["coverage"]["mean"],
-               d["report"]["global_diversity"]["mean"], r["mean_seconds"],
-               r.get("clip_backwards_seconds", 0.0), d["feet"]["raw"]["jitter_ratio"])
+               k["speed_distance"], k["acceleration_distance"], report["coverage"]["mean"],
+               report["global_diversity"]["mean"], r["mean_seconds"],
+               r.get("clip_backwards_seconds", 0.0), d["feet"][kind]["jitter_ratio"],
+               d["report"]["clip_intra_diversity"])
 
 
 def rung_row(run, path):
@@ -64,12 +76,12 @@ def rung_row(run, path):
                d["jitter_ratio"])
 
 
-def main(out, rungs):
+def main(out, rungs, planted):
     print("| run | still % (clip) | speed p25 / p50 / p90 x clip | speed / accel. distance "
           "| coverage | global div. | replay s (backwards) | jitter x clip | misses |")
     print("|---|---|---|---|---|---|---|---|---|")
     for path in sorted(out.glob("*.json")):
-        print(eval_row(path))
+        print(eval_row(path, planted))
     if rungs:
         for ladder in sorted(out.glob("*/step_ladder")):
             checks = sorted(ladder.glob("steps-*/check.json"),
@@ -81,4 +93,4 @@ def main(out, rungs):
 if __name__ == "__main__":
     if len(sys.argv) < 2:
         sys.exit(__doc__)
-    main(pathlib.Path(sys.argv[1]), "--rungs" in sys.argv[2:])
+    main(pathlib.Path(sys.argv[1]), "--rungs" in sys.argv[2:], "--planted" in sys.argv[2:])
