@@ -2,6 +2,7 @@
 //! the model learns (SPEC section 2).
 
 pub mod beats;
+pub mod bind_pose;
 pub mod clip;
 pub mod contacts;
 pub mod features;

@@ -48,6 +48,10 @@ pub struct ClipFacts {
     /// The root layout the features use and why (absent in runs made before it was recorded).
     #[serde(default)]
     pub root: String,
+    /// What was left out of the file before encoding (a converter's bind pose in its first
+    /// frame), and why; `None` when every frame was learned.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dropped: Option<String>,
 }
 
 impl ClipFacts {
@@ -124,9 +128,11 @@ impl ClipData {
             None => format!("{} (data.up in the config)", encoded.layout.up),
         };
         let root = describe_root(&encoded);
+        let dropped = encoded.bind_pose.as_ref().map(|found| found.describe());
         Ok(ClipData {
             facts: ClipFacts {
                 root,
+                dropped,
                 up,
                 in_place: encoded.in_place,
                 name,

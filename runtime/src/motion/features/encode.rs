@@ -9,6 +9,7 @@ use super::heading::{
 };
 use super::layout::{FeatureLayout, RootFeatures};
 use crate::limits::MAX_ENCODED_FRAMES;
+use crate::motion::bind_pose::{LeadingBindPose, without_bind_pose};
 use crate::motion::clip::{ChannelClip, LocalMotion};
 use crate::motion::contacts::{ContactConfig, choose_contact_joints};
 use crate::motion::fk::{global_pose, global_poses, skeleton_height};
@@ -63,6 +64,9 @@ pub struct EncodedClip {
     /// The root layout the options asked for ([`RootLayout::Auto`] where the clip chose), so
     /// that a description of the root can say who chose it.
     pub root_asked: RootLayout,
+    /// The clip's first frame, dropped as a converter's bind pose
+    /// ([`crate::motion::bind_pose::leading_bind_pose`]); `None` when every frame was kept.
+    pub bind_pose: Option<LeadingBindPose>,
 }
 
 /// Relative change under which a channel counts as constant.
@@ -113,8 +117,14 @@ fn check_resampled_length(clip: &ChannelClip, fps: f64) -> Result<(), MotionErro
 }
 
 /// Turns a clip into features: resampled to `options.fps`, root displacement and height, 6D
-/// rotations, varying positions and contact labels.
+/// rotations, varying positions and contact labels; a first frame that is a converter's bind
+/// pose is dropped first ([`EncodedClip::bind_pose`]).
 pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip, MotionError> {
+    let trimmed = without_bind_pose(clip);
+    let (clip, bind_pose) = match &trimmed {
+        Some((rest, found)) => (rest, Some(found.clone())),
+        None => (clip, None),
+    };
     let fps = checked_fps(clip, options)?;
     let skeleton = &clip.skeleton;
     let varies = varying_channels(clip);
@@ -195,6 +205,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         in_place: filled.in_place,
         world_root_reason,
         root_asked: options.root,
+        bind_pose,
     })
 }
 

@@ -73,6 +73,9 @@ fn print_clip(clip: &std::path::Path, data: &ClipData, config: &TrainConfig) {
             source.animations
         );
     }
+    if let Some(dropped) = &data.facts.dropped {
+        println!("left out        {dropped}");
+    }
     println!("up axis         {}", data.facts.up);
     if data.facts.in_place {
         println!("cycle           in place: contacts measured against the treadmill");

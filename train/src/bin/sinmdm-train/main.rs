@@ -345,6 +345,9 @@ fn print_start(trainer: &Trainer, out: &Path) {
         state.step,
         state.config.training.steps
     );
+    if let Some(dropped) = &state.clip.dropped {
+        eprintln!("left out {dropped}");
+    }
     eprintln!("up axis {}", state.clip.up);
     if !state.clip.root.is_empty() {
         eprintln!("root {}", state.clip.root);
