@@ -6,7 +6,7 @@ mod common;
 
 use sinmdm::bvh::{parse_bvh, read_bvh};
 use sinmdm::motion::bind_pose::{BIND_POSE_MIN_DEGREES, leading_bind_pose, typical_turn};
-use sinmdm::motion::{EncodeOptions, encode};
+use sinmdm::motion::{EncodeOptions, encode, encode_for_model};
 
 /// The BVH text with its first frame's line removed and the frame count lowered by one.
 fn without_first_frame_line(text: &str) -> String {
@@ -49,6 +49,10 @@ fn the_cmu_release_t_pose_is_dropped_as_if_the_file_lacked_it() {
     assert!(without.bind_pose.is_none(), "{:?}", without.bind_pose);
     assert_eq!(with.features, without.features);
     assert_eq!(with.layout, without.layout);
+    // Read as a reference for a model of this skeleton (eval's --clip, the tasks'), the file
+    // lines up with the clip the model learned, not with one a frame longer.
+    let reference = encode_for_model(&clip, &with.layout, None).unwrap();
+    assert_eq!(reference.features, without.features);
 }
 
 #[test]

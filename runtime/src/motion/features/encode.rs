@@ -449,7 +449,8 @@ fn choose_heading(
 
 /// Encodes a clip of the same skeleton in an existing layout (a model's): resampled to the
 /// layout's frame rate, read with the layout's up axis, with the layout's columns, contact joints
-/// and contact threshold, so the result lines up with the features the model was trained on.
+/// and contact threshold, so the result lines up with the features the model was trained on; a
+/// first frame that is a bind pose is left out, as [`encode`] leaves it out of a training clip.
 pub fn encode_for(
     clip: &ChannelClip,
     layout: &FeatureLayout,
@@ -457,6 +458,8 @@ pub fn encode_for(
     if clip.frame_count() == 0 {
         return Err(MotionError::NoFrames);
     }
+    let trimmed = without_bind_pose(clip);
+    let clip = trimmed.as_ref().map_or(clip, |(rest, _)| rest);
     if let Some(problem) = layout.skeleton.difference(&clip.skeleton) {
         return Err(MotionError::SkeletonMismatch(problem));
     }
