@@ -51,6 +51,13 @@ def rust_constant(name):
     raise AssertionError(f"train/src/choose/clip_rule/ defines no {name}")
 
 
+def floored_std(x, floor):
+    """Each row's population std over frames, floored at `floor` times their mean (never under
+    f32's smallest normal), as training normalises a clip (SPEC section 2)."""
+    std = np.asarray(x, dtype=np.float64).std(axis=1)
+    return np.maximum(std, max(std.mean() * floor, np.finfo(np.float32).tiny))
+
+
 def default_config(section, key):
     """A value of configs/default.yaml (read, not restated)."""
     return yaml.safe_load((ROOT / "configs" / "default.yaml").read_text())[section][key]

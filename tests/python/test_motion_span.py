@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
-from conftest import TRAIN, clips, encoded_clip, tiny_config
+from conftest import TRAIN, clips, encoded_clip, floored_std, tiny_config
 
 # SPEC section 3: the input and output convolutions (k 3) and the two k3 convolutions of each of
 # the three residual blocks reach 8 frames each side; each of the three QnA blocks (k - 1) / 2.
@@ -26,9 +26,7 @@ def numpy_span(raw, fps, floor):
     rows normalised as for training (population std floored at `floor` of the mean std), rows
     that then still vary standardised, lags searched up to half the clip and 10 s."""
     x = np.asarray(raw, dtype=np.float64)
-    std = x.std(axis=1)
-    std = np.maximum(std, max(std.mean() * floor, np.finfo(np.float32).tiny))
-    x = (x - x.mean(axis=1, keepdims=True)) / std[:, None]
+    x = (x - x.mean(axis=1, keepdims=True)) / floored_std(x, floor)[:, None]
     var = x.var(axis=1)
     keep = var > 1e-12
     z = (x[keep] - x[keep].mean(axis=1, keepdims=True)) / np.sqrt(var[keep])[:, None]

@@ -9,7 +9,7 @@ import numpy as np
 import onnx
 import yaml
 
-from conftest import ROOT, TRAIN, default_config, encoded_clip, tiny_config
+from conftest import ROOT, TRAIN, default_config, encoded_clip, floored_std, tiny_config
 
 FOX = ROOT / "tests" / "data" / "bvh" / "fox_survey_khronos.bvh"
 
@@ -22,8 +22,7 @@ def model_statistics(path):
 
 def numpy_statistics(raw, floor):
     x = np.asarray(raw, dtype=np.float64)
-    std = x.std(axis=1)
-    return x.mean(axis=1), np.maximum(std, max(std.mean() * floor, np.finfo(np.float32).tiny))
+    return x.mean(axis=1), floored_std(x, floor)
 
 
 def test_statistics_follow_the_configured_floor_and_the_flag(tmp_path, sinmdm):

@@ -2,6 +2,8 @@
 //! releases of the CMU database, among others, put one before the captured motion, and a model
 //! trained on it learns a jump into a T-pose as part of the motion.
 
+use std::borrow::Cow;
+
 use super::clip::{ChannelClip, LocalMotion};
 use super::math::Mat3;
 
@@ -116,15 +118,38 @@ pub fn leading_bind_pose(motion: &LocalMotion) -> Option<LeadingBindPose> {
     })
 }
 
-/// `clip` without its first frame when that frame is a bind pose ([`leading_bind_pose`]), and
-/// what was found; `None` for a clip that keeps every frame.
-pub fn without_bind_pose(clip: &ChannelClip) -> Option<(ChannelClip, LeadingBindPose)> {
-    let found = leading_bind_pose(&clip.to_local())?;
-    let width = clip.skeleton.channel_count();
-    let trimmed = ChannelClip {
-        skeleton: clip.skeleton.clone(),
-        fps: clip.fps,
-        values: clip.values[width..].to_vec(),
+/// A clip ready to encode: its channels and its local motion (computed once, for the search and
+/// for the encoder), without the first frame when that frame is a bind pose.
+pub struct PastBindPose<'a> {
+    /// The channels, trimmed where a bind pose was found.
+    pub clip: Cow<'a, ChannelClip>,
+    /// The same frames as local transforms.
+    pub local: LocalMotion,
+    /// What was left out ([`leading_bind_pose`]); `None` when every frame is kept.
+    pub bind_pose: Option<LeadingBindPose>,
+}
+
+/// `clip` and its local motion, the first frame left out when it is a bind pose
+/// ([`leading_bind_pose`]).
+pub fn past_bind_pose(clip: &ChannelClip) -> PastBindPose<'_> {
+    let mut local = clip.to_local();
+    let Some(found) = leading_bind_pose(&local) else {
+        return PastBindPose {
+            clip: Cow::Borrowed(clip),
+            local,
+            bind_pose: None,
+        };
     };
-    Some((trimmed, found))
+    let (width, joints) = (clip.skeleton.channel_count(), clip.skeleton.len());
+    local.rotations.drain(..joints);
+    local.translations.drain(..joints);
+    PastBindPose {
+        clip: Cow::Owned(ChannelClip {
+            skeleton: clip.skeleton.clone(),
+            fps: clip.fps,
+            values: clip.values[width..].to_vec(),
+        }),
+        local,
+        bind_pose: Some(found),
+    }
 }

@@ -9,7 +9,7 @@ use super::heading::{
 };
 use super::layout::{FeatureLayout, RootFeatures};
 use crate::limits::MAX_ENCODED_FRAMES;
-use crate::motion::bind_pose::{LeadingBindPose, without_bind_pose};
+use crate::motion::bind_pose::{LeadingBindPose, PastBindPose, past_bind_pose};
 use crate::motion::clip::{ChannelClip, LocalMotion};
 use crate::motion::contacts::{ContactConfig, choose_contact_joints};
 use crate::motion::fk::{global_pose, global_poses, skeleton_height};
@@ -120,11 +120,12 @@ fn check_resampled_length(clip: &ChannelClip, fps: f64) -> Result<(), MotionErro
 /// rotations, varying positions and contact labels; a first frame that is a converter's bind
 /// pose is dropped first ([`EncodedClip::bind_pose`]).
 pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip, MotionError> {
-    let trimmed = without_bind_pose(clip);
-    let (clip, bind_pose) = match &trimmed {
-        Some((rest, found)) => (rest, Some(found.clone())),
-        None => (clip, None),
-    };
+    let PastBindPose {
+        clip,
+        local: file_local,
+        bind_pose,
+    } = past_bind_pose(clip);
+    let clip = clip.as_ref();
     let fps = checked_fps(clip, options)?;
     let skeleton = &clip.skeleton;
     let varies = varying_channels(clip);
@@ -145,7 +146,6 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         .collect();
     let root_joint = motion_root(skeleton, &any_position_varies);
 
-    let file_local = clip.to_local();
     let (up, up_detection) = choose_up(&file_local, options.up);
     let canonical_from_file = up.canonical_from_file();
     let local = to_canonical(&resample(&file_local, fps), up);
@@ -458,13 +458,12 @@ pub fn encode_for(
     if clip.frame_count() == 0 {
         return Err(MotionError::NoFrames);
     }
-    let trimmed = without_bind_pose(clip);
-    let clip = trimmed.as_ref().map_or(clip, |(rest, _)| rest);
-    if let Some(problem) = layout.skeleton.difference(&clip.skeleton) {
+    let trimmed = past_bind_pose(clip);
+    if let Some(problem) = layout.skeleton.difference(&trimmed.clip.skeleton) {
         return Err(MotionError::SkeletonMismatch(problem));
     }
-    check_resampled_length(clip, layout.fps)?;
-    let local = to_canonical(&resample(&clip.to_local(), layout.fps), layout.up);
+    check_resampled_length(&trimmed.clip, layout.fps)?;
+    let local = to_canonical(&resample(&trimmed.local, layout.fps), layout.up);
     let poses = global_poses(&local);
     Ok(fill_features(layout, &local, &poses).features)
 }
