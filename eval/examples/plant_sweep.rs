@@ -1,6 +1,7 @@
 //! Foot planting under several settings on saved samples, to choose the defaults: for each
-//! setting, the feet figures of SPEC section 9 and the coverage and global diversity of the
-//! planted motion (re-encoded, the model's contact labels kept), beside the raw samples'. It
+//! setting, the feet figures of SPEC section 9, how the body moves against the clip (its speed
+//! ratios and acceleration distance) and the coverage and global diversity of the planted
+//! motion (re-encoded, the model's contact labels kept), beside the raw samples'. It
 //! also plants the clip itself with its own labels: a pass that changes the clip much is
 //! holding feet that the clip lets move. Usage:
 //! `cargo run --release -p sinmdm-eval --example plant_sweep -- MODEL.onnx CLIP.bvh SAMPLES.json`
@@ -15,7 +16,8 @@ use sinmdm::motion::feet::{Anchor, Kept, PlantOptions, plant_feet};
 use sinmdm::motion::{FeatureLayout, LocalMotion, decode, encode_for_model};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_eval::{
-    FeetReference, FeetScores, evaluate, mean_scores, metric_features, motion_metric_features,
+    ClipKinematics, FeetReference, FeetScores, Kinematics, evaluate, mean_scores, metric_features,
+    motion_metric_features,
 };
 
 /// The table's coverage / global diversity column of planted (or raw) samples' motions.
@@ -35,6 +37,36 @@ fn mean_frame_distance(a: &Array2<f64>, b: &Array2<f64>) -> f64 {
         })
         .sum();
     total / a.nrows().max(1) as f64
+}
+
+/// How motions' bodies move against the clip's (the kinematic fidelity figures).
+struct BodyMoves {
+    clip: Kinematics,
+    scores: ClipKinematics,
+    height: f64,
+}
+
+impl BodyMoves {
+    fn new(clip: &LocalMotion, height: f64) -> BodyMoves {
+        let clip = Kinematics::of_motion(clip, height);
+        BodyMoves {
+            scores: ClipKinematics::new(&clip),
+            clip,
+            height,
+        }
+    }
+
+    /// The speed ratios and acceleration distance of `motions`, pooled, as text.
+    fn of(&self, motions: &[LocalMotion]) -> String {
+        let moves = self
+            .scores
+            .score(&self.clip, &Kinematics::of_motions(motions, self.height));
+        let [p25, p50, p90] = moves.speed_ratios;
+        format!(
+            "body speed p25 / p50 / p90 {p25:.2} / {p50:.2} / {p90:.2} x the clip's, acceleration distance {:.2}",
+            moves.acceleration_distance
+        )
+    }
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -72,10 +104,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let settings = settings();
     let clip_labels = labels_of(clip.features.view());
+    let body = BodyMoves::new(&clip_motion, layout.skeleton_height);
     println!(
         "the clip planted with its own labels (how much a setting changes motion that is right):"
     );
-    for (name, options) in &settings[..5] {
+    for (name, options) in &settings[..span_settings().len()] {
         let (planted, _) = plant_feet(
             layout,
             &clip_motion,
@@ -88,12 +121,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &clip_metric,
         );
         println!(
-            "  {name}: mean per-frame distance to the clip {moved:.3}, skating {:.1} %",
-            100.0 * reference.scores(&planted).skating_ratio
+            "  {name}: mean per-frame distance to the clip {moved:.3}, skating {:.1} %, {}",
+            100.0 * reference.scores(&planted).skating_ratio,
+            body.of(std::slice::from_ref(&planted))
         );
     }
 
     let raw = print_reference_rows(layout, &reference, &clip_motion, &samples, &benchmark)?;
+    let raw_motions: Vec<LocalMotion> = samples.iter().map(|(m, _)| m.clone()).collect();
+    println!("raw: {}", body.of(&raw_motions));
     for (name, options) in settings {
         let started = std::time::Instant::now();
         let planted = samples
@@ -114,12 +150,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             planted.iter().map(|(_, s)| s.max_miss).fold(0.0, f64::max)
         );
         let scores = benchmark(&planted.iter().map(|(m, _)| m).collect::<Vec<_>>())?;
+        let moves = body.of(&planted.iter().map(|(m, _)| m.clone()).collect::<Vec<_>>());
         println!(
-            "{name} | {:.1} | {:.4} | {:.1} | {:.3} | {scores} | {lifted} | {miss} | {ms:.1}",
+            "{name} | {:.1} | {:.4} | {:.1} | {:.3} | {scores} | {lifted} | {miss} | {ms:.1} | {moves}",
             100.0 * s.skating_ratio,
             s.max_penetration,
             100.0 * s.penetrating_frames,
-            s.jitter / raw.jitter
+            s.jitter / raw.jitter,
         );
     }
     Ok(())
@@ -147,7 +184,7 @@ fn print_reference_rows(
         layout.ground
     );
     println!(
-        "setting | skating % | deepest H | floor frames % | jitter ratio to raw | coverage / global diversity | lifted | miss mean/max H | ms/sample"
+        "setting | skating % | deepest H | floor frames % | jitter ratio to raw | coverage / global diversity | lifted | miss mean/max H | ms/sample | how the body moves"
     );
     println!(
         "clip | {:.1} | {:.4} | {:.1} | {:.3} | | | |",
@@ -205,6 +242,20 @@ fn span_settings() -> Vec<(&'static str, PlantOptions)> {
             "spans grown by height alone",
             PlantOptions {
                 grow_below_speed: f64::INFINITY,
+                ..base
+            },
+        ),
+        (
+            "spans grown only below 0.3 H/s",
+            PlantOptions {
+                grow_below_speed: 0.3,
+                ..base
+            },
+        ),
+        (
+            "spans grown only below 0.6 H/s",
+            PlantOptions {
+                grow_below_speed: 0.6,
                 ..base
             },
         ),

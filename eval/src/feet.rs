@@ -5,6 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 use sinmdm::motion::feet::ground_level;
+use sinmdm::motion::ground::Body;
 use sinmdm::motion::math::Vec3;
 use sinmdm::motion::up::{height_of, horizontal, to_canonical};
 use sinmdm::motion::{FeatureLayout, GlobalPose, LocalMotion, global_poses};
@@ -35,6 +36,7 @@ pub struct FeetScores {
 #[derive(Debug, Clone)]
 pub struct FeetReference {
     layout: FeatureLayout,
+    body: Body,
     ground: f64,
 }
 
@@ -44,9 +46,11 @@ impl FeetReference {
     /// layout has no contact joints).
     pub fn new(layout: &FeatureLayout, clip: &LocalMotion) -> FeetReference {
         let poses = canonical_poses(layout, clip);
+        let body = layout.body();
         FeetReference {
             layout: layout.clone(),
-            ground: ground_level(&layout.contact_joints, &poses),
+            ground: ground_level(&layout.contact_joints, &body, &poses),
+            body,
         }
     }
 
@@ -64,12 +68,12 @@ impl FeetReference {
             skating_ratio: self.skating_ratio(&poses, h, fps),
             max_penetration: poses
                 .iter()
-                .flat_map(|p| p.points())
+                .flat_map(|p| self.body.points(p))
                 .map(|p| (self.ground - height_of(p)).max(0.0) / h)
                 .fold(0.0, f64::max),
             penetrating_frames: share(poses.len(), |i| {
-                poses[i]
-                    .points()
+                self.body
+                    .points(&poses[i])
                     .any(|p| height_of(p) < self.ground - PENETRATION_TOLERANCE * h)
             }),
             jitter: jitter(&poses, h, fps),

@@ -10,13 +10,29 @@ const FRAMES: usize = 60;
 
 /// A clip whose hip is at `hip(i)` (x, y) in frame `i`, the leg hanging straight down.
 fn clip(hip: impl Fn(usize) -> (f64, f64)) -> (sinmdm::motion::FeatureLayout, LocalMotion) {
-    let mut text = String::from(
-        "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n JOINT Foot\n {\n  OFFSET 0 -1 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n  End Site\n  {\n   OFFSET 0 -0.1 0\n  }\n }\n}\nMOTION\n",
-    );
+    figure(None, hip)
+}
+
+/// [`clip`], its hips inside a static container joint at the height `container` when given
+/// (the hips' channels then relative to it, so the body moves the same).
+fn figure(
+    container: Option<f64>,
+    hip: impl Fn(usize) -> (f64, f64),
+) -> (sinmdm::motion::FeatureLayout, LocalMotion) {
+    let body = "Hips\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n JOINT Foot\n {\n  OFFSET 0 -1 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n  End Site\n  {\n   OFFSET 0 -0.1 0\n  }\n }\n}\n";
+    let mut text = match container {
+        None => format!("HIERARCHY\nROOT {body}MOTION\n"),
+        Some(_) => format!(
+            "HIERARCHY\nROOT Container\n{{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\nJOINT {body}}}\nMOTION\n"
+        ),
+    };
     text.push_str(&format!("Frames: {FRAMES}\nFrame Time: {}\n", 1.0 / FPS));
     for i in 0..FRAMES {
         let (x, y) = hip(i);
-        text.push_str(&format!("{x} {y} 0 0 0 0 0 0 0\n"));
+        match container {
+            None => text.push_str(&format!("{x} {y} 0 0 0 0 0 0 0\n")),
+            Some(c) => text.push_str(&format!("0 {c} 0 0 0 0 {x} {} 0 0 0 0 0 0 0\n", y - c)),
+        }
     }
     let channels = parse_bvh(&text, "synthetic.bvh").unwrap();
     let encoded = encode(
@@ -92,4 +108,21 @@ fn jitter_of_a_constant_acceleration_is_that_acceleration_in_heights() {
     });
     let s = scores(&accelerating);
     assert!((s.jitter - a / 1.1).abs() < 1e-3 * a, "{}", s.jitter);
+}
+
+#[test]
+fn a_container_under_the_floor_is_no_part_of_the_body() {
+    // A rig's root bone 5 units under a figure that walks: it neither sinks through the floor
+    // nor stretches the skeleton's height.
+    let (layout, walking) = figure(Some(-5.0), |i| (0.01 * i as f64, 1.1));
+    assert!(
+        (layout.skeleton_height - 1.1).abs() < 1e-6,
+        "{}",
+        layout.skeleton_height
+    );
+    let reference = FeetReference::new(&layout, &walking);
+    assert!(reference.ground().abs() < 1e-6, "{}", reference.ground());
+    let s = reference.scores(&walking);
+    assert!(s.max_penetration < 1e-6, "{}", s.max_penetration);
+    assert_eq!(s.penetrating_frames, 0.0);
 }

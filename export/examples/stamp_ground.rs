@@ -27,7 +27,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let layout = &metadata.layout;
     let clip = encode_for_model(&read_bvh(Path::new(clip_path))?, layout, None)?;
     let motion = to_canonical(&decode(layout, clip.features.view())?, layout.up);
-    let ground = ground_level(&layout.contact_joints, &global_poses(&motion));
+    let ground = ground_level(
+        &layout.contact_joints,
+        &layout.body(),
+        &global_poses(&motion),
+    );
     println!(
         "{model_path}: ground {ground:.5} (was {:?})",
         metadata.layout.ground

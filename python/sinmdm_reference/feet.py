@@ -3,7 +3,8 @@
 Written from the definitions, independently of the runtime's `sinmdm-eval` crate, so the two
 check each other. Positions are arrays [frames, points, 3] in a Y-up frame; `contacts` are the
 contact points (a contact joint's End Site when it has one), `joints` the joints only, `points`
-the joints and End Sites.
+the body's joints and End Sites (a static container above the motion root, such as a root bone
+left at the world origin, is no part of the body: SPEC section 2).
 """
 
 import numpy as np

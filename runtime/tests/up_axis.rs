@@ -217,11 +217,12 @@ fn a_z_up_copy_round_trips_in_its_own_frame() {
             "{}: {worst} > 1e-4 x {height}",
             name(&path)
         );
-        // And it is Z-up: the figure's vertical extent is along Z.
+        // And it is Z-up: the body's vertical extent is along Z.
+        let body = encoded.layout.body();
         let z_extent: f64 = after
             .iter()
             .map(|p| {
-                let zs: Vec<f64> = p.points().map(|q| q[2]).collect();
+                let zs: Vec<f64> = body.points(p).map(|q| q[2]).collect();
                 zs.iter().copied().fold(f64::NEG_INFINITY, f64::max)
                     - zs.iter().copied().fold(f64::INFINITY, f64::min)
             })

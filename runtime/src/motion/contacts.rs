@@ -13,7 +13,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::fk::GlobalPose;
-use super::ground::lowest_point;
+use super::ground::Body;
 use super::math::Vec3;
 use super::skeleton::Skeleton;
 use super::up::{height_of, horizontal};
@@ -59,7 +59,7 @@ pub const GROUND_SHARE: f64 = 0.25;
 pub const STANDING_ROOT_SHARE: f64 = 0.35;
 
 /// The chain-end joints whose contact point comes within `ground_fraction * height` of the
-/// frame's lowest point (every joint and End Site) in at least [`GROUND_SHARE`] of the frames in
+/// frame's lowest point of the body ([`Body`]: every joint and End Site but a static container's) in at least [`GROUND_SHARE`] of the frames in
 /// which the figure stands ([`standing_frames`]). Each frame is measured against its own lowest
 /// point, so a clip on uneven ground still finds its feet, and one that lies down for most of
 /// the clip finds the feet it gets up on, not the tail it lies on.
@@ -71,9 +71,10 @@ pub fn choose_contact_joints(
 ) -> Vec<usize> {
     let leaves = skeleton.leaves();
     let standing = standing_frames(skeleton, poses, height, ground_fraction);
+    let body = Body::carried_by(skeleton, travelling_root(skeleton, poses));
     let mut grounded = vec![0usize; leaves.len()];
     for (pose, _) in poses.iter().zip(&standing).filter(|(_, up)| **up) {
-        let ground = lowest_point(pose);
+        let ground = body.lowest_point(pose);
         for (count, &leaf) in grounded.iter_mut().zip(&leaves) {
             if height_of(pose.contact_point(leaf)) - ground <= ground_fraction * height {
                 *count += 1;
@@ -99,9 +100,10 @@ pub fn standing_frames(
     ground_fraction: f64,
 ) -> Vec<bool> {
     let root = travelling_root(skeleton, poses);
+    let body = Body::carried_by(skeleton, root);
     let lift: Vec<f64> = poses
         .iter()
-        .map(|pose| height_of(pose.joints[root]) - lowest_point(pose))
+        .map(|pose| height_of(pose.joints[root]) - body.lowest_point(pose))
         .collect();
     // `f64::max` passes over a NaN lift, so no lift at all leaves the fold at minus infinity.
     let highest = lift.iter().copied().fold(f64::NEG_INFINITY, f64::max);

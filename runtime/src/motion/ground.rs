@@ -1,26 +1,83 @@
 //! The ground level of a motion: where its contact points rest.
 
 use crate::motion::fk::GlobalPose;
+use crate::motion::math::Vec3;
+use crate::motion::skeleton::Skeleton;
 use crate::motion::up::height_of;
 
 /// The ground is this percentile of the per-frame lowest contact point (SPEC section 9): low
 /// enough to be the floor, robust to a few frames of a foot through it.
 pub const GROUND_PERCENTILE: f64 = 5.0;
 
-/// The height of a canonical-frame pose's lowest point (every joint and End Site).
-pub fn lowest_point(pose: &GlobalPose) -> f64 {
-    pose.points().map(height_of).fold(f64::INFINITY, f64::min)
+/// The points of a skeleton that belong to the body: every joint and End Site but the static
+/// containers above the joint that carries the motion. A rig's root bone left at the world
+/// origin while the hips walk away (Bandai's `joint_Root`) is no part of what stands on the floor.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Body {
+    /// Per joint, whether it is a container above the body.
+    container: Vec<bool>,
+}
+
+impl Body {
+    /// The body of `skeleton` whose motion `carrier` carries: that joint and all but its
+    /// ancestors.
+    pub fn carried_by(skeleton: &Skeleton, carrier: usize) -> Body {
+        let mut container = vec![false; skeleton.len()];
+        for above in skeleton.ancestors(carrier) {
+            container[above] = true;
+        }
+        Body { container }
+    }
+
+    /// Whether `joint` (and an End Site it carries) is part of the body.
+    pub fn has(&self, joint: usize) -> bool {
+        !self.container.get(joint).copied().unwrap_or(false)
+    }
+
+    /// The height of a canonical-frame pose's lowest point of the body (every joint and End Site
+    /// but the containers'); infinity for none.
+    pub fn lowest_point(&self, pose: &GlobalPose) -> f64 {
+        self.points(pose)
+            .map(height_of)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The body's height: the mean over frames of the vertical extent of its points (as
+    /// [`skeleton_height`](crate::motion::fk::skeleton_height) over the whole skeleton); 0 for
+    /// no frames.
+    pub fn height(&self, poses: &[GlobalPose]) -> f64 {
+        let extent = |pose: &GlobalPose| {
+            let heights = self.points(pose).map(height_of);
+            let (lo, hi) = heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
+                (lo.min(y), hi.max(y))
+            });
+            hi - lo
+        };
+        if poses.is_empty() {
+            return 0.0;
+        }
+        poses.iter().map(extent).sum::<f64>() / poses.len() as f64
+    }
+
+    /// The body's points of a canonical-frame pose, joints first, then End Sites.
+    pub fn points<'a>(&'a self, pose: &'a GlobalPose) -> impl Iterator<Item = Vec3> + 'a {
+        let joints = pose.joints.iter().enumerate();
+        joints
+            .chain(pose.end_sites.iter().map(|(j, p)| (*j, p)))
+            .filter(|&(j, _)| self.has(j))
+            .map(|(_, p)| *p)
+    }
 }
 
 /// The ground level of canonical-frame `poses`: the [`GROUND_PERCENTILE`]th percentile of each
-/// frame's lowest contact point of `contact_joints`, or of its lowest point of all when there
+/// frame's lowest contact point of `contact_joints`, or of the body's lowest point when there
 /// are no contact joints. 0 for no frames.
-pub fn ground_level(contact_joints: &[usize], poses: &[GlobalPose]) -> f64 {
+pub fn ground_level(contact_joints: &[usize], body: &Body, poses: &[GlobalPose]) -> f64 {
     let mut lowest: Vec<f64> = poses
         .iter()
         .map(|pose| {
             if contact_joints.is_empty() {
-                lowest_point(pose)
+                body.lowest_point(pose)
             } else {
                 contact_joints
                     .iter()

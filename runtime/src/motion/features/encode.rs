@@ -12,8 +12,8 @@ use crate::limits::MAX_ENCODED_FRAMES;
 use crate::motion::bind_pose::{LeadingBindPose, PastBindPose, past_bind_pose};
 use crate::motion::clip::{ChannelClip, LocalMotion};
 use crate::motion::contacts::{ContactConfig, choose_contact_joints};
-use crate::motion::fk::{global_pose, global_poses, skeleton_height};
-use crate::motion::ground::ground_level;
+use crate::motion::fk::{global_pose, global_poses};
+use crate::motion::ground::{Body, ground_level};
 use crate::motion::math::{IDENTITY, Mat3, Vec3};
 use crate::motion::resample::resample;
 use crate::motion::skeleton::{Axis, Channel, Skeleton};
@@ -168,7 +168,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         .collect();
 
     let poses = global_poses(&local);
-    let height = skeleton_height(&poses);
+    let height = Body::carried_by(skeleton, root_joint).height(&poses);
     let contact_joints = contact_joints(skeleton, &options.contacts, &poses, height)?;
 
     let layout = FeatureLayout {
@@ -185,7 +185,7 @@ pub fn encode(clip: &ChannelClip, options: &EncodeOptions) -> Result<EncodedClip
         ground: None,
     };
     let mut layout = FeatureLayout {
-        ground: Some(ground_level(&layout.contact_joints, &poses)),
+        ground: Some(ground_level(&layout.contact_joints, &layout.body(), &poses)),
         ..layout
     };
     let (heading, world_root_reason) = root_heading(options.root, &layout, &local, &poses)?;

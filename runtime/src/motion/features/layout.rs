@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::heading::{Heading, RootLayout};
+use crate::motion::ground::Body;
 use crate::motion::math::{IDENTITY, Mat3, Vec3};
 use crate::motion::skeleton::{Axis, Skeleton};
 use crate::motion::up::{UP, UpAxis};
@@ -153,6 +154,26 @@ pub struct FeatureLayout {
 }
 
 impl FeatureLayout {
+    /// The joint that carries the motion: the root's joint, or the top joint for a layout
+    /// without root features.
+    pub fn carrier(&self) -> usize {
+        self.root.as_ref().map_or_else(
+            || {
+                self.skeleton
+                    .joints
+                    .iter()
+                    .position(|j| j.parent.is_none())
+                    .unwrap_or(0)
+            },
+            |r| r.joint,
+        )
+    }
+
+    /// The skeleton's body: every joint but the static containers above the [`carrier`](Self::carrier).
+    pub fn body(&self) -> Body {
+        Body::carried_by(&self.skeleton, self.carrier())
+    }
+
     /// Number of feature columns (F).
     pub fn width(&self) -> usize {
         self.root.as_ref().map_or(0, RootFeatures::width)

@@ -13,7 +13,7 @@ use super::targets::{ChainTrack, chain_targets, grow_spans};
 use crate::motion::clip::LocalMotion;
 use crate::motion::features::{FeatureLayout, MotionError};
 use crate::motion::fk::{GlobalPose, global_pose, global_poses};
-use crate::motion::ground::{ground_level, lowest_point};
+use crate::motion::ground::{Body, ground_level};
 use crate::motion::math::Vec3;
 use crate::motion::up::{UP, height_of, horizontal, to_canonical, to_file};
 
@@ -75,8 +75,11 @@ struct Planting<'a> {
     frames: usize,
     /// The skeleton's height (never 0).
     height: f64,
-    /// The joint without a parent.
-    top: usize,
+    /// The joint that carries the motion ([`FeatureLayout::carrier`]): what the pass moves
+    /// when it moves the root. Containers above it stay where the file put them.
+    carrier: usize,
+    /// The points that must stay above the ground: all but the containers above the carrier.
+    body: Body,
     motion: LocalMotion,
     poses: Vec<GlobalPose>,
     stats: PlantStats,
@@ -90,22 +93,18 @@ impl<'a> Planting<'a> {
         options: &'a PlantOptions,
     ) -> Planting<'a> {
         let poses = global_poses(canonical);
+        let body = layout.body();
         let ground = layout
             .ground
-            .unwrap_or_else(|| ground_level(&layout.contact_joints, &poses));
-        let top = canonical
-            .skeleton
-            .joints
-            .iter()
-            .position(|j| j.parent.is_none())
-            .unwrap_or(0);
+            .unwrap_or_else(|| ground_level(&layout.contact_joints, &body, &poses));
         Planting {
             layout,
             kept,
             options,
             frames: canonical.frame_count(),
             height: layout.skeleton_height.max(f64::MIN_POSITIVE),
-            top,
+            carrier: layout.carrier(),
+            body,
             motion: canonical.clone(),
             poses,
             stats: PlantStats {
@@ -125,9 +124,18 @@ impl<'a> Planting<'a> {
                 .all(|pose| pose.points().all(|p| p.iter().all(|&v| tame(v))))
     }
 
-    /// Whether a task kept the root (its position, or the top joint) at frame `f`.
+    /// Whether a task kept the root (its position, or the carrier joint) at frame `f`.
     fn root_kept(&self, f: usize) -> bool {
-        self.kept.root(f) || self.kept.joint(f, self.top)
+        self.kept.root(f) || self.kept.joint(f, self.carrier)
+    }
+
+    /// A move of the carrier by `world` (canonical frame) at frame `f`, in its parent's frame:
+    /// the carrier's translation is local to the container above it, which may be turned.
+    fn in_carrier_frame(&self, f: usize, world: Vec3) -> Vec3 {
+        match self.motion.skeleton.joints[self.carrier].parent {
+            Some(p) => self.poses[f].rotations[p].transpose() * world,
+            None => world,
+        }
     }
 
     /// One chain per contact joint; a chain that shares joints with an earlier one is skipped
@@ -222,8 +230,11 @@ impl<'a> Planting<'a> {
         let share = self.options.root_stance_share.clamp(0.0, 1.0);
         for (f, t) in travel.iter().enumerate() {
             let t = *t * share;
-            let root = &mut self.motion.translations[f * joints + self.top];
-            *root += t;
+            let step = self.in_carrier_frame(f, t);
+            add_nonzero(
+                &mut self.motion.translations[f * joints + self.carrier],
+                step,
+            );
             self.stats.max_root_travel = self.stats.max_root_travel.max(t.norm() / self.height);
         }
         self.poses = global_poses(&self.motion);
@@ -281,7 +292,16 @@ impl<'a> Planting<'a> {
                 })
                 .collect()
         };
-        let (ground, top) = (self.stats.ground, self.top);
+        let ground = self.stats.ground;
+        let lifts: Vec<Vec3> = (0..self.frames)
+            .map(|f| {
+                let mut world = Vec3([0.0; 3]);
+                world[UP] = 1.0;
+                self.in_carrier_frame(f, world)
+            })
+            .collect();
+        let up = |f: usize, by: f64| lifts[f] * by;
+        let carrier = self.carrier;
         let mut out = self.motion.clone();
         let mut deficit = vec![0.0; self.frames];
         for (f, need) in deficit.iter_mut().enumerate() {
@@ -291,11 +311,11 @@ impl<'a> Planting<'a> {
             let solved = solve_frame(
                 &self.motion,
                 &mut out,
-                (f, top, 0.0),
+                (f, carrier, up(f, 0.0)),
                 &frame_targets(f),
                 self.options,
             );
-            *need = (ground - lowest_point(&solved)).max(0.0);
+            *need = (ground - self.body.lowest_point(&solved)).max(0.0);
         }
         let lift = smooth_upper_envelope(&deficit, self.blend_frames());
         let (mut miss_sum, mut miss_count) = (0.0, 0usize);
@@ -306,15 +326,18 @@ impl<'a> Planting<'a> {
             let mut solved = solve_frame(
                 &self.motion,
                 &mut out,
-                (f, top, shift),
+                (f, carrier, up(f, shift)),
                 &wanted,
                 self.options,
             );
             let mut total_lift = shift;
-            let rest = ground - lowest_point(&solved);
+            let rest = ground - self.body.lowest_point(&solved);
             if rest > 0.0 && free {
                 // What the smooth lift and the legs could not fix: lift the root the rest.
-                out.translations[f * out.skeleton.len() + top][UP] += rest;
+                add_nonzero(
+                    &mut out.translations[f * out.skeleton.len() + carrier],
+                    up(f, rest),
+                );
                 total_lift += rest;
                 solved = global_pose(&out, f);
             }
@@ -367,4 +390,14 @@ fn restore_kept(
         }
     }
     planted
+}
+
+/// Adds `by` to `to` where a component of `by` is not zero, leaving the others' bits as they
+/// are (a `-0.0` stays `-0.0`, so a pass that moves nothing writes the input back exactly).
+pub(super) fn add_nonzero(to: &mut Vec3, by: Vec3) {
+    for (t, d) in to.0.iter_mut().zip(by.0) {
+        if d != 0.0 {
+            *t += d;
+        }
+    }
 }

@@ -8,7 +8,6 @@ use crate::motion::fk::{GlobalPose, global_pose};
 use crate::motion::ik::{TurnChain, least_turn};
 use crate::motion::math::{self, Mat3, Vec3};
 use crate::motion::skeleton::Skeleton;
-use crate::motion::up::UP;
 
 use super::options::PlantOptions;
 
@@ -27,12 +26,13 @@ const LEAST_TURN_DAMPING: f64 = 0.05;
 /// Least-turn steps per [`PlantOptions::iterations`]: each is a small first-order turn.
 const LEAST_TURN_STEPS_PER_ITERATION: usize = 4;
 
-/// Frame `f` of `original`, with the top joint raised by `shift` and each chain turned so that
-/// its contact point reaches its target, written into `out`; returns its global pose.
+/// Frame `f` of `original`, with the carrier joint's translation moved by `shift` (in its
+/// parent's frame) and each chain turned so that its contact point reaches its target, written
+/// into `out`; returns its global pose.
 pub(super) fn solve_frame(
     original: &LocalMotion,
     out: &mut LocalMotion,
-    (f, top, shift): (usize, usize, f64),
+    (f, carrier, shift): (usize, usize, Vec3),
     wanted: &[Wanted<'_>],
     options: &PlantOptions,
 ) -> GlobalPose {
@@ -40,8 +40,8 @@ pub(super) fn solve_frame(
     let range = f * joints..(f + 1) * joints;
     out.rotations[range.clone()].copy_from_slice(&original.rotations[range.clone()]);
     out.translations[range.clone()].copy_from_slice(&original.translations[range]);
-    out.translations[f * joints + top][UP] += shift;
-    if wanted.is_empty() && shift == 0.0 {
+    super::plant::add_nonzero(&mut out.translations[f * joints + carrier], shift);
+    if wanted.is_empty() && shift.iter().all(|&v| v == 0.0) {
         return global_pose(out, f);
     }
     let pose = global_pose(out, f);
