@@ -298,7 +298,12 @@ mod tests {
             include_str!("../../../configs/paper.yaml"),
             include_str!("../../../configs/default.yaml"),
         ] {
-            TrainConfig::parse(text).unwrap();
+            // Each floors the feature spreads at the runtime's share, so the number lives once.
+            let config = TrainConfig::parse(text).unwrap();
+            assert_eq!(
+                config.data.std_floor as f32,
+                sinmdm::motion::STD_FLOOR_SHARE
+            );
         }
         let paper = TrainConfig::parse(include_str!("../../../configs/paper.yaml")).unwrap();
         assert_eq!(paper.model.channels, 256);
