@@ -64,10 +64,16 @@ def frames_seen(t: dict, state: dict) -> str:
 
 
 def ladder_rungs(run: pathlib.Path) -> list[dict]:
-    """The step ladder's rungs of a calm clip's run (step_ladder/steps-N/check.json), fewest
-    steps first; none for a varied clip's run."""
+    """The step ladder's rungs of a calm clip's run (step_ladder/steps-N*/check.json), those at
+    the configuration's learning rate first, fewest steps first; none for a varied clip's run."""
     checks = [json.loads(p.read_text()) for p in (run / "step_ladder").glob("steps-*/check.json")]
-    return sorted(checks, key=lambda c: c["steps"])
+    return sorted(checks, key=lambda c: (c.get("learning_rate") is not None, c["steps"]))
+
+
+def rung_label(rung: dict) -> str:
+    """A rung as the card names it: its steps, and its learning rate where it has its own."""
+    rate = rung.get("learning_rate")
+    return f"{rung['steps']}" if rate is None else f"{rung['steps']} at learning rate {rate:g}"
 
 
 def kinematic_cells(rung: dict) -> str:
@@ -84,25 +90,29 @@ def kinematic_cells(rung: dict) -> str:
     )
 
 
-def ladder_section(rungs: list[dict], chosen: int) -> list[str]:
-    """The card's table of the step ladder: each rung's samples as the trainer scored them."""
+def ladder_section(rungs: list[dict], chosen: int, chosen_rate: float, default_rate: float) -> list[str]:
+    """The card's table of the step ladder: each rung's samples as the trainer scored them; the
+    chosen one trained `chosen` steps at `chosen_rate` (a rung without its own rate has the
+    configuration's, `default_rate`)."""
     if not rungs:
         return []
+    picked = [r for r in rungs if r["steps"] == chosen and (r.get("learning_rate") or default_rate) == chosen_rate]
+    label = rung_label(picked[0]) if picked else f"{chosen}-step"
     text = [
         "## Step ladder",
         "",
         "The clip is calm, so the trainer chose its steps by the samples of short runs (the step "
         "ladder: lab/EXPERIMENTS.md, *The step ladder*; 20 samples of twice the clip, "
-        f"seed 1, default sampling). It trained the {chosen}-step rung:",
+        f"seed 1, default sampling). It trained the {label} rung:",
         "",
         "| rung | coverage | replay (s) | jitter x clip | global diversity | still % (clip) "
         "| speed p25 / p50 / p90 x clip | speed / acc. distance | train + check (s) |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rungs:
-        mark = " (chosen)" if r["steps"] == chosen else ""
+        mark = " (chosen)" if any(r is p for p in picked) else ""
         text.append(
-            f"| {r['steps']}{mark} | {r['coverage']:.1f} | {r['replay_seconds']:.2f} | "
+            f"| {rung_label(r)}{mark} | {r['coverage']:.1f} | {r['replay_seconds']:.2f} | "
             f"{r['jitter_ratio']:.2f} | {r['global_diversity']:.3f} | {kinematic_cells(r)} | "
             f"{r['train_seconds']:.0f} + {r['check_seconds']:.0f} |"
         )
@@ -153,14 +163,17 @@ def main() -> None:
     fps = "the clip's own rate" if d["fps"] is None else f"{d['fps']:g} fps"
     # A run's configuration without data.std_floor was trained under the floor before it.
     floor = d.get("std_floor", 0.001)
-    default_floor = yaml.safe_load(pathlib.Path("configs/default.yaml").read_text())["data"]["std_floor"]
+    default_config = yaml.safe_load(pathlib.Path("configs/default.yaml").read_text())
+    default_floor = default_config["data"]["std_floor"]
+    default_rate = default_config["training"]["learning_rate"]
     config_row = (
         f"the default (`configs/default.yaml`: C {m['channels']}, {m['heads']} heads, window "
         f"{m['window']}, dropout {m['dropout']}, cosine learning rate "
         f"from {t['learning_rate']:g} after {t['warmup_steps']} warm-up steps, weight average "
         f"{t.get('ema_decay')}, {frames_seen(t, state)}, {fps}, feature spread floor {floor:g}, "
-        f"seed {t['seed']}; the step count, "
-        "window, dropout and channels as the default's `from_clip` rule chose them from the clip)"
+        f"seed {t['seed']}; the step count (and, for a rung of the step ladder's faster arm, the "
+        "learning rate), window, dropout and channels as the default's `from_clip` rule chose "
+        "them from the clip)"
     )
     if d.get("root_layout", "world") != "world":
         config_row += f", with the {d['root_layout']} root layout"
@@ -202,7 +215,7 @@ def main() -> None:
         "",
         f"Made with `sinmdm-train {clip} --out runs/{name}{extra_args} --export onnx-models/{name}.onnx`.",
         "",
-        *ladder_section(rungs, state["step"]),
+        *ladder_section(rungs, state["step"], t["learning_rate"], default_rate),
         *([about.rstrip(), ""] if about.strip() else []),
         *evaluation(name, clip, model),
     ]

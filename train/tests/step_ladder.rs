@@ -10,7 +10,9 @@ use std::sync::atomic::AtomicBool;
 
 use burn::tensor::Device;
 use sinmdm_train::TrainConfig;
-use sinmdm_train::choose::step_ladder::{Ladder, RungCheck, choose, folder};
+use sinmdm_train::choose::step_ladder::{
+    FASTER_LEARNING_RATE, Ladder, RungCheck, choose, folder, rung_folder,
+};
 use sinmdm_train::choose::{StepsFrom, start_run};
 
 mod common;
@@ -74,10 +76,11 @@ fn start_fox(
     .unwrap()
 }
 
-/// A ladder of three short rungs, scored on two samples.
+/// A ladder of three short rungs and a faster one, scored on two samples.
 fn three_rungs() -> Ladder {
     Ladder {
         steps: vec![4, 8, 12],
+        faster: vec![5],
         samples: 2,
         seed: 1,
     }
@@ -89,6 +92,7 @@ fn each_rung_is_scored_as_sinmdm_eval_scores_it_and_the_chosen_one_trains() {
     let run = common::scratch("ladder", "climb");
     let ladder = Ladder {
         steps: vec![3, 6],
+        faster: Vec::new(),
         samples: 2,
         seed: 1,
     };
@@ -172,6 +176,7 @@ fn each_rung_is_scored_as_sinmdm_eval_scores_it_and_the_chosen_one_trains() {
 fn scored(steps: u64, coverage: f64, replay_seconds: f64, jitter_ratio: f64) -> RungCheck {
     RungCheck {
         steps,
+        learning_rate: None,
         coverage,
         global_diversity: 0.5,
         replay_seconds,
@@ -191,7 +196,7 @@ fn scored(steps: u64, coverage: f64, replay_seconds: f64, jitter_ratio: f64) -> 
 /// What a rung of `steps` on the fox is made from, when `ladder` climbs it for `config`.
 fn fox_rung_fingerprint(ladder: &Ladder, config: &TrainConfig, steps: u64) -> String {
     let clip = sinmdm_train::clip::sha256_hex(&std::fs::read(fox()).unwrap());
-    ladder.rung_fingerprint(&clip, config, steps)
+    ladder.rung_fingerprint(&clip, &Ladder::rung_config(config, steps, None))
 }
 
 /// Writes `rungs` into the ladder folder of `run`, as a climb of `ladder` with `config` on the
@@ -247,11 +252,13 @@ fn scored_rungs_are_kept_and_the_widest_margin_trains() {
         heard.push(r.clone())
     })
     .unwrap();
-    // The most-trained first (it covers the clip), then the others, fewest steps first.
+    // The most-trained first (it covers the clip), then the others, fewest steps first; rung 4
+    // meets every goal, so the faster rung is not climbed.
     assert_eq!(
         heard.iter().map(|r| r.steps).collect::<Vec<_>>(),
         [12, 4, 8]
     );
+    assert!(!folder(&run).join("steps-5-lr0.001").exists());
     assert_eq!((&heard[0], &heard[1]), (&kept[1], &kept[0]));
     assert!(folder(&run).join("steps-8/model.onnx").is_file());
     assert_eq!(
@@ -281,8 +288,9 @@ fn a_clip_the_most_steps_do_not_cover_trains_as_a_varied_one() {
     config.from_clip.window = true;
     leave_scored(&run, &three_rungs(), &config, &[scored(12, 90.0, 0.5, 1.0)]);
     let trainer = start_fox(&run, config, &three_rungs(), false, &mut |_| {}).unwrap();
-    // Nothing under the most-trained rung is climbed.
+    // Nothing under the most-trained rung is climbed, nor the faster rung.
     assert!(!folder(&run).join("steps-4").exists() && !folder(&run).join("steps-8").exists());
+    assert!(!folder(&run).join("steps-5-lr0.001").exists());
     let trained = &trainer.state().config;
     assert_eq!(trained.training.steps, 300, "the configuration's");
     // The fox stands on four feet: a varied clip on as many trains the wide window.
@@ -338,5 +346,56 @@ fn a_run_started_without_the_policy_refuses_a_configuration_that_asks_for_the_ru
     written.from_clip.steps = false;
     let trainer = sinmdm_train::Trainer::start(&fox(), written, &run, device()).unwrap();
     assert!(trainer.chosen().is_none());
+    let _ = std::fs::remove_dir_all(&run);
+}
+
+#[test]
+fn where_no_rung_meets_every_goal_the_faster_rungs_climb_at_their_rate() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let run = common::scratch("ladder", "faster");
+    let config = tiny_asking_for_steps();
+    let ladder = three_rungs();
+    // Every rung at the configuration's rate covers the clip and replays it for 3 s.
+    leave_scored(
+        &run,
+        &ladder,
+        &config,
+        &[
+            scored(4, 100.0, 3.0, 1.0),
+            scored(8, 100.0, 3.0, 1.0),
+            scored(12, 100.0, 3.0, 1.0),
+        ],
+    );
+    let mut heard: Vec<RungCheck> = Vec::new();
+    let trainer = start_fox(&run, config.clone(), &ladder, false, &mut |r| {
+        heard.push(r.clone())
+    })
+    .unwrap();
+    let climbed: Vec<(u64, Option<f64>)> =
+        heard.iter().map(|r| (r.steps, r.learning_rate)).collect();
+    assert_eq!(
+        climbed,
+        [
+            (12, None),
+            (4, None),
+            (8, None),
+            (5, Some(FASTER_LEARNING_RATE))
+        ]
+    );
+    let dir = folder(&run).join(rung_folder(5, Some(FASTER_LEARNING_RATE)));
+    assert!(dir.join("model.onnx").is_file(), "{}", dir.display());
+    // The rung was trained at its rate: its fingerprint is that of the faster configuration.
+    let clip = sinmdm_train::clip::sha256_hex(&std::fs::read(fox()).unwrap());
+    let faster = Ladder::rung_config(&config, 5, Some(FASTER_LEARNING_RATE));
+    assert_eq!(faster.training.learning_rate, FASTER_LEARNING_RATE);
+    assert_eq!(heard[3].made_from, ladder.rung_fingerprint(&clip, &faster));
+    // The main run trains the chosen rung with its rate.
+    let best = choose(&heard).expect("the rungs cover the clip");
+    let trained = &trainer.state().config.training;
+    assert_eq!(trained.steps, best.steps);
+    assert_eq!(
+        trained.learning_rate,
+        best.learning_rate.unwrap_or(config.training.learning_rate)
+    );
     let _ = std::fs::remove_dir_all(&run);
 }

@@ -111,6 +111,11 @@ pub enum Reason {
     LadderWillChoose {
         /// The rungs' steps.
         rungs: Vec<u64>,
+        /// The steps of the rungs at a faster learning rate, climbed where no other rung
+        /// meets every goal.
+        faster: Vec<u64>,
+        /// Their learning rate.
+        faster_learning_rate: f64,
         /// Samples a rung is scored on.
         samples: usize,
         /// The coverage goal.
@@ -126,6 +131,8 @@ pub enum Reason {
         warmup: u64,
         /// Whether it meets every goal (else it misses them by least, moving like the clip first).
         meets_goals: bool,
+        /// Its learning rate where it is not the configuration's.
+        learning_rate: Option<f64>,
     },
     /// A varied clip's steps: the configuration's, since it covers more the longer it trains.
     VariedTrainsLonger,

@@ -60,24 +60,29 @@ fn steps_text(steps: &Chosen<u64>) -> String {
         Reason::NotAsked => format!("{value} ({NOT_ASKED})"),
         Reason::LadderWillChoose {
             rungs,
+            faster,
+            faster_learning_rate,
             samples,
             coverage,
             replay_seconds,
             jitter_ratio,
         } => format!(
-            "chosen by the step ladder when training starts: short runs of {} steps (warm-up a third), each sampled {samples} times and scored, and the one that meets coverage >= {coverage}, replay <= {replay_seconds} s (or the clip's own backwards score), jitter within {jitter_ratio}x of the clip's either way and moves like the clip (still frames, speeds) with the widest margin (where none meets them all, the one that moves most like the clip, then misses the rest by least in all) trains the model (a calm clip is covered within a few hundred steps, and replays the longer it trains)",
-            in_words(rungs)
+            "chosen by the step ladder when training starts: short runs of {} steps (warm-up a third), and of {} steps at learning rate {faster_learning_rate} where none of those meets every goal, each sampled {samples} times and scored, and the one that meets coverage >= {coverage}, replay <= {replay_seconds} s (or the clip's own backwards score), jitter within {jitter_ratio}x of the clip's either way and moves like the clip (still frames, speeds) with the widest margin (where none meets them all, the one that moves most like the clip, then misses the rest by least in all) trains the model (a calm clip is covered within a few hundred steps, and replays the longer it trains)",
+            in_words(rungs),
+            in_words(faster)
         ),
         Reason::LadderRung {
             warmup,
             meets_goals,
+            learning_rate,
         } => {
             let why = if *meets_goals {
                 "the rung of the step ladder that meets every goal with the widest margin"
             } else {
                 "no rung of the step ladder meets every goal; this one moves most like the clip, then misses the rest by least in all"
             };
-            format!("{value} (warm-up {warmup}): {why}")
+            let rate = learning_rate.map_or(String::new(), |r| format!(", learning rate {r}"));
+            format!("{value} (warm-up {warmup}{rate}): {why}")
         }
         Reason::TimeBudget {
             minutes,

@@ -2,7 +2,7 @@
 //! rung covers trains as a varied one.
 
 use super::{CALM_INTRA_BELOW, RuleChoice};
-use crate::choose::ladder_settings::LADDER_STEPS;
+use crate::choose::ladder_settings::{FASTER_STEPS, LADDER_STEPS};
 use crate::chosen::{Chosen, ClipKind, Reason};
 
 /// Warm-up steps of a calm clip's cosine schedule: a third of its steps.
@@ -10,9 +10,13 @@ pub fn calm_warmup_steps(steps: u64) -> u64 {
     (steps as f64 / 3.0).round() as u64
 }
 
-/// The most steps a calm clip trains: the step ladder's top rung.
+/// The most steps a calm clip trains: the step ladder's most-trained rung.
 pub fn calm_most_steps() -> u64 {
-    LADDER_STEPS[LADDER_STEPS.len() - 1]
+    LADDER_STEPS
+        .into_iter()
+        .chain(FASTER_STEPS)
+        .max()
+        .unwrap_or(0)
 }
 
 /// The rule's choice for the `calm` clip once no rung of the step ladder covered it: the clip
@@ -48,16 +52,16 @@ mod tests {
         let choice = choose(&config, reading(0.5));
         let out = &choice.config;
         assert!(choice.climb_ladder);
-        // Until the ladder chooses, the most it may train.
-        assert_eq!(out.training.steps, 1000);
-        assert_eq!(out.training.warmup_steps, 333);
+        // Until the ladder chooses, the most it may train: the faster arm's top rung.
+        assert_eq!(out.training.steps, 3000);
+        assert_eq!(out.training.warmup_steps, 1000);
         assert_eq!(out.model.window, config.model.window);
         assert_eq!(out.model.dropout, config.model.dropout);
         assert!(out.from_clip.is_off());
         assert!(choice.lines()[0].contains("calm: its own intra diversity 0.500 is under 0.7"));
         assert!(
             choice.lines()[1]
-                .contains("short runs of 50, 75, 100, 150, 200, 250, 300, 400, 600 and 1000 steps"),
+                .contains("short runs of 50, 75, 100, 150, 200, 250, 300, 400, 600 and 1000 steps (warm-up a third), and of 1000 and 3000 steps at learning rate 0.001 where none of those meets every goal"),
             "{:?}",
             choice.lines()
         );

@@ -6,7 +6,9 @@ use super::{
     ClipReading, MANY_FEET_CHANNELS, MANY_FEET_DROPOUT, MANY_FEET_STEPS, MANY_FEET_WINDOW,
     VARIED_WINDOW, steps_at_window, window_step_cost,
 };
-use crate::choose::ladder_settings::{CHECK_SAMPLES, LADDER_STEPS, goals};
+use crate::choose::ladder_settings::{
+    CHECK_SAMPLES, FASTER_LEARNING_RATE, FASTER_STEPS, LADDER_STEPS, goals,
+};
 use crate::chosen::{Chosen, FieldNeed, Reason};
 use crate::config::TrainConfig;
 
@@ -41,6 +43,8 @@ impl Choosing<'_> {
                 out.training.warmup_steps = calm_warmup_steps(steps);
                 let reason = Reason::LadderWillChoose {
                     rungs: LADDER_STEPS.to_vec(),
+                    faster: FASTER_STEPS.to_vec(),
+                    faster_learning_rate: FASTER_LEARNING_RATE,
                     samples: CHECK_SAMPLES,
                     coverage: goals::COVERAGE,
                     replay_seconds: goals::REPLAY_SECONDS,

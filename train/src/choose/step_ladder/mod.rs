@@ -28,7 +28,9 @@ use burn::tensor::Device;
 use sinmdm::motion::encode_for_model;
 use sinmdm_formats::{AnimationChoice, FileAccess, ReadOptions, read_clip_with_access};
 
-pub use crate::choose::ladder_settings::{CHECK_SAMPLES, CHECK_SEED, LADDER_STEPS, goals};
+pub use crate::choose::ladder_settings::{
+    CHECK_SAMPLES, CHECK_SEED, FASTER_LEARNING_RATE, FASTER_STEPS, LADDER_STEPS, goals,
+};
 
 use crate::choose::clip_rule::{self, RuleChoice};
 use crate::chosen::{Chosen, Reason};
@@ -49,6 +51,9 @@ pub const LADDER_FOLDER: &str = "step_ladder";
 pub struct Ladder {
     /// The steps of each rung.
     pub steps: Vec<u64>,
+    /// The steps of the rungs at [`FASTER_LEARNING_RATE`], climbed only where no rung of
+    /// `steps` meets every goal.
+    pub faster: Vec<u64>,
     /// Samples a rung is scored on.
     pub samples: usize,
     /// Their seed.
@@ -59,6 +64,7 @@ impl Default for Ladder {
     fn default() -> Self {
         Ladder {
             steps: LADDER_STEPS.to_vec(),
+            faster: FASTER_STEPS.to_vec(),
             samples: CHECK_SAMPLES,
             seed: CHECK_SEED,
         }
@@ -88,9 +94,10 @@ impl Ladder {
     /// Trains and scores the rungs of the ladder on `clip` with `config` (its steps and warm-up
     /// replaced by each rung's), in `folder`: the most-trained rung first, and the others, fewest
     /// steps first, only when it covers the clip (a calm clip covers more the longer it trains:
-    /// when the most steps do not cover it, fewer will not). A rung whose scores are already
-    /// there is not trained again. `on_rung` hears each rung's scores as they come; the rungs
-    /// come back sorted by their steps.
+    /// when the most steps do not cover it, fewer will not); then, where none of those meets
+    /// every goal, the [`faster`](Ladder::faster) rungs, fewest steps first. A rung whose scores
+    /// are already there is not trained again. `on_rung` hears each rung's scores as they come;
+    /// the rungs come back sorted by their steps, those at the configuration's rate first.
     pub fn climb(
         &self,
         clip: LadderClip<'_>,
@@ -106,49 +113,92 @@ impl Ladder {
         if let Some(most) = order.pop() {
             order.insert(0, most);
         }
-        let mut rungs: Vec<RungCheck> = Vec::with_capacity(order.len());
+        let mut rungs: Vec<RungCheck> = Vec::with_capacity(order.len() + self.faster.len());
         for steps in order {
             if rungs.first().is_some_and(|most| !most.covers()) {
                 break;
             }
-            let dir = folder.join(format!("steps-{steps}"));
-            let made_from = self.rung_fingerprint(clip.sha256, config, steps);
-            let check = match read_check(&dir, steps, &made_from) {
-                Some(check) => check,
-                None => match self.train_rung(clip.path, config, steps, &dir, device, stop)? {
-                    Some(check) => {
-                        let check = RungCheck { made_from, ..check };
-                        write_check(&dir, &check)?;
-                        check
-                    }
-                    None => return Ok(Climb::Interrupted),
-                },
+            let Some(check) = self.rung(clip, config, (steps, None), folder, device, stop)? else {
+                return Ok(Climb::Interrupted);
             };
             on_rung(&check);
             rungs.push(check);
         }
-        rungs.sort_by_key(|r| r.steps);
+        let covered = rungs.first().is_some_and(RungCheck::covers);
+        if covered && !rungs.iter().any(RungCheck::meets_goals) {
+            let mut faster = self.faster.clone();
+            faster.sort_unstable();
+            faster.dedup();
+            for steps in faster {
+                let rung = (steps, Some(FASTER_LEARNING_RATE));
+                let Some(check) = self.rung(clip, config, rung, folder, device, stop)? else {
+                    return Ok(Climb::Interrupted);
+                };
+                on_rung(&check);
+                rungs.push(check);
+            }
+        }
+        rungs.sort_by(|a, b| {
+            (a.learning_rate.is_some(), a.steps).cmp(&(b.learning_rate.is_some(), b.steps))
+        });
         Ok(Climb::Done(rungs))
     }
 
+    /// The scores of the rung of `steps` at `learning_rate` (the configuration's where `None`):
+    /// read from its folder where it finished before, else trained, scored and written there;
+    /// `None` when the stop flag was raised.
+    fn rung(
+        &self,
+        clip: LadderClip<'_>,
+        config: &TrainConfig,
+        (steps, learning_rate): (u64, Option<f64>),
+        folder: &Path,
+        device: &Device,
+        stop: &AtomicBool,
+    ) -> Result<Option<RungCheck>, TrainError> {
+        let dir = folder.join(rung_folder(steps, learning_rate));
+        let rung_config = Self::rung_config(config, steps, learning_rate);
+        let made_from = self.rung_fingerprint(clip.sha256, &rung_config);
+        if let Some(check) = read_check(&dir, steps, &made_from) {
+            return Ok(Some(check));
+        }
+        let Some(check) = self.train_rung(clip.path, rung_config, &dir, device, stop)? else {
+            return Ok(None);
+        };
+        let check = RungCheck {
+            made_from,
+            learning_rate,
+            ..check
+        };
+        write_check(&dir, &check)?;
+        Ok(Some(check))
+    }
+
     /// The configuration a rung of `steps` trains: `config` with the rung's steps and warm-up,
-    /// one checkpoint at its end, and no rule (its numbers are the rule's already).
-    pub fn rung_config(config: &TrainConfig, steps: u64) -> TrainConfig {
+    /// its `learning_rate` where given, one checkpoint at its end, and no rule (its numbers are
+    /// the rule's already).
+    pub fn rung_config(
+        config: &TrainConfig,
+        steps: u64,
+        learning_rate: Option<f64>,
+    ) -> TrainConfig {
         let mut rung = config.clone();
         rung.from_clip = Default::default();
+        if let Some(rate) = learning_rate {
+            rung.training.learning_rate = rate;
+        }
         rung.training.steps = steps;
         rung.training.warmup_steps = clip_rule::calm_warmup_steps(steps);
         rung.training.checkpoint_every = steps;
         rung
     }
 
-    /// What a rung of `steps` on the clip whose bytes hash to `clip_sha256` (SHA-256, hex) is
-    /// made from, hashed: the trainer's version, the clip, the rung's configuration
-    /// ([`Ladder::rung_config`] of `config`) and this ladder's check (samples and seed). A
-    /// finished rung is reused only when its scores record the same.
-    pub fn rung_fingerprint(&self, clip_sha256: &str, config: &TrainConfig, steps: u64) -> String {
-        let rung = serde_json::to_string(&Self::rung_config(config, steps))
-            .expect("a configuration serialises");
+    /// What a rung on the clip whose bytes hash to `clip_sha256` (SHA-256, hex) is made from,
+    /// hashed: the trainer's version, the clip, the rung's configuration `rung_config`
+    /// ([`Ladder::rung_config`]) and this ladder's check (samples and seed). A finished rung is
+    /// reused only when its scores record the same.
+    pub fn rung_fingerprint(&self, clip_sha256: &str, rung_config: &TrainConfig) -> String {
+        let rung = serde_json::to_string(rung_config).expect("a configuration serialises");
         // The check's version names what a rung's scores hold: version 2 added the backwards
         // floor and the kinematic figures, which a rung scored before does not have; version 3
         // measures the body from the joint that carries it.
@@ -161,13 +211,13 @@ impl Ladder {
         ])
     }
 
-    /// Trains one rung into `dir` (anything a killed rung left there is replaced), exports it
-    /// and scores its samples; `None` when stopped.
+    /// Trains one rung, its configuration `rung` ([`Ladder::rung_config`]), into `dir` (anything
+    /// a killed rung left there is replaced), exports it and scores its samples; `None` when
+    /// stopped.
     fn train_rung(
         &self,
         clip: &Path,
-        config: &TrainConfig,
-        steps: u64,
+        rung: TrainConfig,
         dir: &Path,
         device: &Device,
         stop: &AtomicBool,
@@ -179,7 +229,7 @@ impl Ladder {
                 reason: source,
             })?;
         }
-        let rung = Self::rung_config(config, steps);
+        let steps = rung.training.steps;
         let started = Instant::now();
         let mut trainer = Trainer::start(clip, rung, dir, device.clone())?;
         let checkpoint = match trainer.run(stop, |_| {})? {
@@ -246,6 +296,7 @@ impl Ladder {
             .map_err(|e| failed(e.to_string()))?;
         Ok(RungCheck {
             steps: 0,
+            learning_rate: None,
             coverage: scores.report.coverage.mean,
             global_diversity: scores.report.global_diversity.mean,
             replay_seconds: scores.replay.mean_seconds,
@@ -270,9 +321,13 @@ fn climbed(choice: RuleChoice, rungs: &[RungCheck]) -> RuleChoice {
             let warmup = clip_rule::calm_warmup_steps(best.steps);
             chosen.config.training.steps = best.steps;
             chosen.config.training.warmup_steps = warmup;
+            if let Some(rate) = best.learning_rate {
+                chosen.config.training.learning_rate = rate;
+            }
             let reason = Reason::LadderRung {
                 warmup,
                 meets_goals: best.meets_goals(),
+                learning_rate: best.learning_rate,
             };
             chosen.choices.steps = Chosen::new(best.steps, reason);
             chosen
@@ -312,6 +367,15 @@ impl Ladder {
         let mut chosen = climbed(choice, &rungs);
         chosen.choices.rungs = rungs.iter().map(RungCheck::line).collect();
         Ok(Some(chosen))
+    }
+}
+
+/// The folder, inside the ladder's, of the rung of `steps` at `learning_rate` (the
+/// configuration's where `None`).
+pub fn rung_folder(steps: u64, learning_rate: Option<f64>) -> String {
+    match learning_rate {
+        None => format!("steps-{steps}"),
+        Some(rate) => format!("steps-{steps}-lr{rate}"),
     }
 }
 

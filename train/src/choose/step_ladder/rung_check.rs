@@ -18,6 +18,9 @@ const CHECK_FILE: &str = "check.json";
 pub struct RungCheck {
     /// The rung's optimiser steps.
     pub steps: u64,
+    /// Its learning rate where it is not the configuration's (a rung of the faster arm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub learning_rate: Option<f64>,
     /// Coverage of the clip's windows, percent.
     pub coverage: f64,
     /// Global diversity.
@@ -128,8 +131,10 @@ impl RungCheck {
     /// One line of the ladder's table.
     pub fn line(&self) -> String {
         format!(
-            "{:>4} steps: coverage {:.1}, replay {:.2} s, jitter {:.2}x the clip's, global diversity {:.3}, still {:.0}% (clip {:.0}%), speed p25/p50/p90 {:.2}/{:.2}/{:.2}x, distances {:.2}/{:.2}{} ({:.0} s + {:.0} s check)",
+            "{:>4} steps{}: coverage {:.1}, replay {:.2} s, jitter {:.2}x the clip's, global diversity {:.3}, still {:.0}% (clip {:.0}%), speed p25/p50/p90 {:.2}/{:.2}/{:.2}x, distances {:.2}/{:.2}{} ({:.0} s + {:.0} s check)",
             self.steps,
+            self.learning_rate
+                .map_or(String::new(), |r| format!(" at learning rate {r}")),
             self.coverage,
             self.replay_seconds,
             self.jitter_ratio,
@@ -209,6 +214,7 @@ mod tests {
     fn rung(steps: u64, coverage: f64, replay_seconds: f64, jitter_ratio: f64) -> RungCheck {
         RungCheck {
             steps,
+            learning_rate: None,
             coverage,
             global_diversity: 1.0,
             replay_seconds,
