@@ -6,9 +6,10 @@
 
 use super::canvas::{Canvas, Rgb};
 use sinmdm::motion::contacts::{choose_contact_joints, label_contacts, travelling_root};
+use sinmdm::motion::ground::Body;
 use sinmdm::motion::math::Vec3;
-use sinmdm::motion::up::{GROUND_PLANE, UpAxis, height_of, on_ground, to_canonical};
-use sinmdm::motion::{GlobalPose, LocalMotion, global_poses, skeleton_height};
+use sinmdm::motion::up::{GROUND_PLANE, UpAxis, on_ground, to_canonical};
+use sinmdm::motion::{GlobalPose, LocalMotion, global_poses};
 
 /// Background colour.
 pub const BACKGROUND: Rgb = [250, 250, 246];
@@ -71,14 +72,14 @@ impl Figure {
         contact_speed: f64,
     ) -> Figure {
         let poses = global_poses(&to_canonical(motion, up));
-        let height = skeleton_height(&poses).max(1e-9);
+        let root = travelling_root(&motion.skeleton, &poses);
+        let body = Body::carried_by(&motion.skeleton, root);
+        let height = body.height(&poses).max(1e-9);
         let ground = poses
             .iter()
-            .flat_map(|p| p.points())
-            .map(height_of)
+            .map(|p| body.lowest_point(p))
             .fold(f64::INFINITY, f64::min);
         let joints = choose_contact_joints(&motion.skeleton, &poses, height, 0.25);
-        let root = travelling_root(&motion.skeleton, &poses);
         let labelled = label_contacts(&poses, root, &joints, motion.fps, height, contact_speed);
         let contacts = joints
             .into_iter()

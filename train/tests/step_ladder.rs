@@ -195,8 +195,18 @@ fn scored(steps: u64, coverage: f64, replay_seconds: f64, jitter_ratio: f64) -> 
 
 /// What a rung of `steps` on the fox is made from, when `ladder` climbs it for `config`.
 fn fox_rung_fingerprint(ladder: &Ladder, config: &TrainConfig, steps: u64) -> String {
+    fox_rung_fingerprint_at(ladder, config, steps, None)
+}
+
+/// [`fox_rung_fingerprint`] of a rung at `learning_rate` (the configuration's where `None`).
+fn fox_rung_fingerprint_at(
+    ladder: &Ladder,
+    config: &TrainConfig,
+    steps: u64,
+    learning_rate: Option<f64>,
+) -> String {
     let clip = sinmdm_train::clip::sha256_hex(&std::fs::read(fox()).unwrap());
-    ladder.rung_fingerprint(&clip, &Ladder::rung_config(config, steps, None))
+    ladder.rung_fingerprint(&clip, &Ladder::rung_config(config, steps, learning_rate))
 }
 
 /// Writes `rungs` into the ladder folder of `run`, as a climb of `ladder` with `config` on the
@@ -210,10 +220,10 @@ fn leave_scored(
     let mut written = Vec::new();
     for rung in rungs {
         let rung = RungCheck {
-            made_from: fox_rung_fingerprint(ladder, config, rung.steps),
+            made_from: fox_rung_fingerprint_at(ladder, config, rung.steps, rung.learning_rate),
             ..rung.clone()
         };
-        let dir = folder(run).join(format!("steps-{}", rung.steps));
+        let dir = folder(run).join(rung_folder(rung.steps, rung.learning_rate));
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(
             dir.join("check.json"),
@@ -353,7 +363,9 @@ fn a_run_started_without_the_policy_refuses_a_configuration_that_asks_for_the_ru
 fn where_no_rung_meets_every_goal_the_faster_rungs_climb_at_their_rate() {
     let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
     let run = common::scratch("ladder", "faster");
-    let config = tiny_asking_for_steps();
+    // The tiny configuration's rate (2e-3) is faster than the arm's: the default's is not.
+    let mut config = tiny_asking_for_steps();
+    config.training.learning_rate = 3e-4;
     let ladder = three_rungs();
     // Every rung at the configuration's rate covers the clip and replays it for 3 s.
     leave_scored(
@@ -397,5 +409,46 @@ fn where_no_rung_meets_every_goal_the_faster_rungs_climb_at_their_rate() {
         trained.learning_rate,
         best.learning_rate.unwrap_or(config.training.learning_rate)
     );
+    let _ = std::fs::remove_dir_all(&run);
+}
+
+#[test]
+fn the_main_run_trains_a_faster_rung_at_its_rate_and_a_fast_configuration_climbs_none() {
+    let _turn = RNG.lock().unwrap_or_else(|e| e.into_inner());
+    let run = common::scratch("ladder", "faster-chosen");
+    let mut config = tiny_asking_for_steps();
+    config.training.learning_rate = 3e-4;
+    // Every rung at the configuration's rate replays the clip for 3 s; the faster rung meets
+    // every goal, so the main run trains it, at its rate.
+    let replaying = [4, 8, 12].map(|steps| scored(steps, 100.0, 3.0, 1.0));
+    leave_scored(&run, &three_rungs(), &config, &replaying);
+    let faster = RungCheck {
+        learning_rate: Some(FASTER_LEARNING_RATE),
+        ..scored(5, 100.0, 0.0, 1.0)
+    };
+    leave_scored(&run, &three_rungs(), &config, &[faster]);
+    let trainer = start_fox(&run, config, &three_rungs(), false, &mut |_| {}).unwrap();
+    let trained = &trainer.state().config.training;
+    assert_eq!(
+        (trained.steps, trained.learning_rate),
+        (5, FASTER_LEARNING_RATE)
+    );
+    let lines = trainer.chosen().unwrap().lines().join("\n");
+    assert!(
+        lines.contains("(warm-up 2, learning rate 0.001)"),
+        "{lines}"
+    );
+    let _ = std::fs::remove_dir_all(&run);
+
+    // A configuration already at a faster rate (the tiny one's 2e-3) climbs no faster rung.
+    let run = common::scratch("ladder", "faster-none");
+    let config = tiny_asking_for_steps();
+    leave_scored(&run, &three_rungs(), &config, &replaying);
+    let mut heard = Vec::new();
+    start_fox(&run, config, &three_rungs(), false, &mut |r| {
+        heard.push(r.steps)
+    })
+    .unwrap();
+    assert_eq!(heard, [12, 4, 8]);
     let _ = std::fs::remove_dir_all(&run);
 }

@@ -4,7 +4,7 @@
 /// The steps of each rung, fewest first.
 pub const LADDER_STEPS: [u64; 10] = [50, 75, 100, 150, 200, 250, 300, 400, 600, 1000];
 /// The steps of the rungs trained at [`FASTER_LEARNING_RATE`], climbed only when no rung of
-/// [`LADDER_STEPS`] meets every goal: calm clips still damped at the top rung move more with
+/// [`LADDER_STEPS`] meets every goal and the configuration's rate is slower: calm clips still damped at the top rung move more with
 /// training that goes further, and a faster rate goes there in a third of the time
 /// (lab/EXPERIMENTS.md, "A faster arm of the step ladder").
 pub const FASTER_STEPS: [u64; 2] = [1000, 3000];

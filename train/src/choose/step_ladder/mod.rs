@@ -52,7 +52,7 @@ pub struct Ladder {
     /// The steps of each rung.
     pub steps: Vec<u64>,
     /// The steps of the rungs at [`FASTER_LEARNING_RATE`], climbed only where no rung of
-    /// `steps` meets every goal.
+    /// `steps` meets every goal and that rate is above the configuration's.
     pub faster: Vec<u64>,
     /// Samples a rung is scored on.
     pub samples: usize,
@@ -95,7 +95,8 @@ impl Ladder {
     /// replaced by each rung's), in `folder`: the most-trained rung first, and the others, fewest
     /// steps first, only when it covers the clip (a calm clip covers more the longer it trains:
     /// when the most steps do not cover it, fewer will not); then, where none of those meets
-    /// every goal, the [`faster`](Ladder::faster) rungs, fewest steps first. A rung whose scores
+    /// every goal and [`FASTER_LEARNING_RATE`] is above the configuration's rate, the
+    /// [`faster`](Ladder::faster) rungs, fewest steps first. A rung whose scores
     /// are already there is not trained again. `on_rung` hears each rung's scores as they come;
     /// the rungs come back sorted by their steps, those at the configuration's rate first.
     pub fn climb(
@@ -125,7 +126,8 @@ impl Ladder {
             rungs.push(check);
         }
         let covered = rungs.first().is_some_and(RungCheck::covers);
-        if covered && !rungs.iter().any(RungCheck::meets_goals) {
+        let faster_than_configured = FASTER_LEARNING_RATE > config.training.learning_rate;
+        if covered && faster_than_configured && !rungs.iter().any(RungCheck::meets_goals) {
             let mut faster = self.faster.clone();
             faster.sort_unstable();
             faster.dedup();
@@ -201,8 +203,9 @@ impl Ladder {
         let rung = serde_json::to_string(rung_config).expect("a configuration serialises");
         // The check's version names what a rung's scores hold: version 2 added the backwards
         // floor and the kinematic figures, which a rung scored before does not have; version 3
-        // measures the body from the joint that carries it.
-        let check = format!("{} samples, seed {}, check 3", self.samples, self.seed);
+        // measures the body from the joint that carries it; version 4 leaves a static container
+        // out of the body (the clip's height and contacts, the planted samples' scores).
+        let check = format!("{} samples, seed {}, check 4", self.samples, self.seed);
         sinmdm_library::fingerprint::sha256_of_parts(&[
             env!("CARGO_PKG_VERSION").as_bytes(),
             clip_sha256.as_bytes(),
