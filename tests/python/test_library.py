@@ -115,4 +115,5 @@ def test_a_task_killed_during_its_step_ladder_keeps_the_rungs_it_finished(tmp_pa
     assert all((ladder / name / "check.json").exists() for name in finished)
     status = json.loads((tmp_path / "library" / "fox" / "status.json").read_text())
     assert status["state"] == "done"
-    assert status["steps"] in (50, 75, 100, 150, 200, 250, 300, 400, 600, 1000), status
+    # A rung of the ladder, or of its faster arm (1 000 or 3 000 steps at learning rate 1e-3).
+    assert status["steps"] in (50, 75, 100, 150, 200, 250, 300, 400, 600, 1000, 3000), status

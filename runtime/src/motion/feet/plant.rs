@@ -6,7 +6,7 @@ use std::ops::Range;
 
 use super::chain::{LegChain, leg_chain};
 use super::options::{Kept, PlantOptions, PlantStats};
-use super::solve::{Wanted, smooth_upper_envelope, solve_frame};
+use super::solve::{Wanted, add_nonzero, smooth_upper_envelope, solve_frame};
 use super::spans::contact_spans;
 use super::stance::stance_travel;
 use super::targets::{ChainTrack, chain_targets, grow_spans};
@@ -390,14 +390,4 @@ fn restore_kept(
         }
     }
     planted
-}
-
-/// Adds `by` to `to` where a component of `by` is not zero, leaving the others' bits as they
-/// are (a `-0.0` stays `-0.0`, so a pass that moves nothing writes the input back exactly).
-pub(super) fn add_nonzero(to: &mut Vec3, by: Vec3) {
-    for (t, d) in to.0.iter_mut().zip(by.0) {
-        if d != 0.0 {
-            *t += d;
-        }
-    }
 }

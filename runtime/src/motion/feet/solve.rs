@@ -40,7 +40,7 @@ pub(super) fn solve_frame(
     let range = f * joints..(f + 1) * joints;
     out.rotations[range.clone()].copy_from_slice(&original.rotations[range.clone()]);
     out.translations[range.clone()].copy_from_slice(&original.translations[range]);
-    super::plant::add_nonzero(&mut out.translations[f * joints + carrier], shift);
+    add_nonzero(&mut out.translations[f * joints + carrier], shift);
     if wanted.is_empty() && shift.iter().all(|&v| v == 0.0) {
         return global_pose(out, f);
     }
@@ -143,6 +143,16 @@ pub(super) fn smooth_upper_envelope(values: &[f64], radius: usize) -> Vec<f64> {
             mean.max(values[i])
         })
         .collect()
+}
+
+/// Adds `by` to `to` where a component of `by` is not zero, leaving the others' bits as they
+/// are (a `-0.0` stays `-0.0`, so a pass that moves nothing writes the input back exactly).
+pub(super) fn add_nonzero(to: &mut Vec3, by: Vec3) {
+    for (t, d) in to.0.iter_mut().zip(by.0) {
+        if d != 0.0 {
+            *t += d;
+        }
+    }
 }
 
 #[cfg(test)]
