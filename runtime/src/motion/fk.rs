@@ -75,17 +75,24 @@ pub fn global_poses(motion: &LocalMotion) -> Vec<GlobalPose> {
 /// Sites, from canonical-frame poses ([`super::up`]). Measured on the posed clip rather than the
 /// rest pose, because some rigs (the MANN dog) lie along +X at rest.
 pub fn skeleton_height(poses: &[GlobalPose]) -> f64 {
+    mean_vertical_extent(poses, GlobalPose::points)
+}
+
+/// The mean over `poses` of the vertical extent of the points `points` gives of each (the
+/// body's alone, as the ground module's `Body` measures it); 0 for no poses.
+pub fn mean_vertical_extent<'a, I: Iterator<Item = Vec3>>(
+    poses: &'a [GlobalPose],
+    points: impl Fn(&'a GlobalPose) -> I,
+) -> f64 {
     if poses.is_empty() {
         return 0.0;
     }
     let total: f64 = poses
         .iter()
         .map(|pose| {
-            let (lo, hi) = pose
-                .points()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                    (lo.min(height_of(p)), hi.max(height_of(p)))
-                });
+            let (lo, hi) = points(pose).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(height_of(p)), hi.max(height_of(p)))
+            });
             hi - lo
         })
         .sum();

@@ -1,6 +1,6 @@
 //! The ground level of a motion: where its contact points rest.
 
-use crate::motion::fk::GlobalPose;
+use crate::motion::fk::{GlobalPose, mean_vertical_extent};
 use crate::motion::math::Vec3;
 use crate::motion::skeleton::Skeleton;
 use crate::motion::up::height_of;
@@ -46,17 +46,7 @@ impl Body {
     /// [`skeleton_height`](crate::motion::fk::skeleton_height) over the whole skeleton); 0 for
     /// no frames.
     pub fn height(&self, poses: &[GlobalPose]) -> f64 {
-        let extent = |pose: &GlobalPose| {
-            let heights = self.points(pose).map(height_of);
-            let (lo, hi) = heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
-                (lo.min(y), hi.max(y))
-            });
-            hi - lo
-        };
-        if poses.is_empty() {
-            return 0.0;
-        }
-        poses.iter().map(extent).sum::<f64>() / poses.len() as f64
+        mean_vertical_extent(poses, |pose| self.points(pose))
     }
 
     /// The body's points of a canonical-frame pose, joints first, then End Sites.
