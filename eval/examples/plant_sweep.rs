@@ -104,6 +104,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let settings = settings();
     let clip_labels = labels_of(clip.features.view());
+    print_contact_heights(
+        layout,
+        reference.ground(),
+        "the clip",
+        &[(clip_motion.clone(), clip_labels.clone())],
+    );
+    print_contact_heights(layout, reference.ground(), "the samples", &samples);
     let body = BodyMoves::new(&clip_motion, layout.skeleton_height);
     println!(
         "the clip planted with its own labels (how much a setting changes motion that is right):"
@@ -162,6 +169,49 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// Per contact joint, how high its point is above the ground (in skeleton heights) in the
+/// frames its labels call contact and in the others (p10 / p50 / p90), and the share of the
+/// others within 0.05 H: how low the feet swing against how they stand.
+fn print_contact_heights(
+    layout: &FeatureLayout,
+    ground: f64,
+    what: &str,
+    motions: &[(LocalMotion, Vec<Vec<f32>>)],
+) {
+    use sinmdm::motion::up::{height_of, to_canonical};
+    let quantiles = |mut v: Vec<f64>| -> String {
+        if v.is_empty() {
+            return "-".into();
+        }
+        v.sort_by(f64::total_cmp);
+        let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+        format!("{:.3} / {:.3} / {:.3}", q(0.1), q(0.5), q(0.9))
+    };
+    println!("contact heights of {what} (H above the ground, p10 / p50 / p90):");
+    for (c, &joint) in layout.contact_joints.iter().enumerate() {
+        let (mut on, mut off) = (Vec::new(), Vec::new());
+        for (motion, labels) in motions {
+            let poses = sinmdm::motion::global_poses(&to_canonical(motion, layout.up));
+            for (f, pose) in poses.iter().enumerate() {
+                let h = (height_of(pose.contact_point(joint)) - ground) / layout.skeleton_height;
+                if labels[c][f] >= 0.5 {
+                    on.push(h)
+                } else {
+                    off.push(h)
+                }
+            }
+        }
+        let low = off.iter().filter(|&&h| h < 0.05).count() as f64 / off.len().max(1) as f64;
+        println!(
+            "  {}: contact {} | swing {} | swing within 0.05 H {:.0} %",
+            layout.skeleton.joints[joint].name,
+            quantiles(on),
+            quantiles(off),
+            100.0 * low
+        );
+    }
+}
+
 /// Prints the ground and the table's header, clip and raw rows; returns the raw samples' mean
 /// scores, against which the settings' jitter is given.
 fn print_reference_rows(
@@ -210,8 +260,8 @@ fn settings() -> Vec<(&'static str, PlantOptions)> {
     settings
 }
 
-/// The default and the settings that change which frames are planted (the first five also plant
-/// the clip).
+/// The default and the settings that change which frames are planted (each also plants the
+/// clip).
 fn span_settings() -> Vec<(&'static str, PlantOptions)> {
     let base = PlantOptions::default();
     vec![
@@ -231,8 +281,9 @@ fn span_settings() -> Vec<(&'static str, PlantOptions)> {
             },
         ),
         (
-            "spans grown by height alone, max hold 0.3 H (the previous default)",
+            "spans grown by height alone, max hold 0.3 H, band 0.05 H (an earlier default)",
             PlantOptions {
+                grow_stance_quantile: None,
                 grow_below_speed: f64::INFINITY,
                 max_hold: 0.3,
                 ..base
@@ -242,6 +293,28 @@ fn span_settings() -> Vec<(&'static str, PlantOptions)> {
             "spans grown by height alone",
             PlantOptions {
                 grow_below_speed: f64::INFINITY,
+                ..base
+            },
+        ),
+        (
+            "band 0.05 H, not read from the stance (the previous default)",
+            PlantOptions {
+                grow_stance_quantile: None,
+                ..base
+            },
+        ),
+        (
+            "band: stance p50",
+            PlantOptions {
+                grow_stance_quantile: Some(0.5),
+                ..base
+            },
+        ),
+        (
+            "band: stance p90, below 1 H/s",
+            PlantOptions {
+                grow_stance_quantile: Some(0.9),
+                grow_below_speed: 1.0,
                 ..base
             },
         ),

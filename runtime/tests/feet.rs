@@ -272,6 +272,7 @@ fn spans_grow_over_low_frames_only_where_the_foot_is_slow() {
     let planted_frames = |grow_below_speed: f64| {
         let options = PlantOptions {
             grow_within: 0.05,
+            grow_stance_quantile: None,
             grow_below_speed,
             ..options()
         };
@@ -284,6 +285,65 @@ fn spans_grow_over_low_frames_only_where_the_foot_is_slow() {
     assert_eq!(planted_frames(f64::INFINITY), (1, FRAMES));
     // Faster than the gate everywhere: only the labelled span is held.
     assert_eq!(planted_frames(0.5 * fastest), (1, SPAN.len()));
+}
+
+#[test]
+fn a_foot_that_swings_lower_than_the_fixed_band_is_held_only_where_it_stands() {
+    // A shuffle: outside the labelled span the whole figure is 0.02 H higher, so the toe swings
+    // within the fixed 0.05 H band but above every height it has while it stands.
+    let (layout, mut motion) = sliding_leg();
+    let h = layout.skeleton_height;
+    let ground = layout.ground.unwrap();
+    let joints = motion.skeleton.len();
+    for f in (0..FRAMES).filter(|f| !SPAN.contains(f)) {
+        motion.translations[f * joints].0[1] += 0.02 * h;
+    }
+    let poses = global_poses(&motion);
+    let height = |f: usize| (poses[f].contact_point(3)[1] - ground) / h;
+    let highest_stance = SPAN.map(height).fold(f64::MIN, f64::max);
+    let lowest_swing = (0..FRAMES)
+        .filter(|f| !SPAN.contains(f))
+        .map(height)
+        .fold(f64::MAX, f64::min);
+    let highest_swing = (0..FRAMES).map(height).fold(f64::MIN, f64::max);
+    assert!(
+        highest_stance < lowest_swing && highest_swing < 0.05,
+        "not a shuffle"
+    );
+    let planted_frames = |grow_stance_quantile: Option<f64>| {
+        let options = PlantOptions {
+            grow_within: 0.05,
+            grow_stance_quantile,
+            grow_below_speed: f64::INFINITY,
+            ..options()
+        };
+        let (_, stats) =
+            plant_feet(&layout, &motion, &labels(), &Kept::default(), &options).expect("planting");
+        (stats.spans, stats.planted_frames)
+    };
+    // The fixed band holds the swing, the whole clip; the band read from the stance does not.
+    assert_eq!(planted_frames(None), (1, FRAMES));
+    assert_eq!(planted_frames(Some(0.9)), (1, SPAN.len()));
+    assert_eq!(
+        PlantOptions::default().grow_stance_quantile,
+        Some(0.9),
+        "the default reads the band from the stance"
+    );
+    // Where the swing is as low as the stance (the figure not lifted), the stance's band lets
+    // the span grow over the frames at its heights again.
+    let (layout, motion) = sliding_leg();
+    let options = PlantOptions {
+        grow_within: 0.05,
+        grow_stance_quantile: Some(1.0),
+        grow_below_speed: f64::INFINITY,
+        ..options()
+    };
+    let (_, stats) = plant_feet(&layout, &motion, &labels(), &Kept::default(), &options).unwrap();
+    assert!(
+        stats.planted_frames > SPAN.len(),
+        "{}",
+        stats.planted_frames
+    );
 }
 
 #[test]

@@ -30,6 +30,13 @@ pub struct PlantOptions {
     /// a point as on the ground: growing further holds feet that swing low, which costs the
     /// motion more than it fixes.
     pub grow_within: f64,
+    /// Where set, each contact point's band is at most this quantile of its own heights over
+    /// the ground in the frames its labels mark as contact: a foot is held where it is as low as
+    /// it stands, and a shuffling foot that swings lower than 0.05 H is not held over its swing.
+    /// `None` uses `grow_within` alone. The default, 0.9, leaves a clip planted with its own
+    /// labels as it is where the fixed band changed it (lab/EXPERIMENTS.md, "The ground band
+    /// read from the stance").
+    pub grow_stance_quantile: Option<f64>,
     /// A span grows only over frames where its contact point also moves slower than this, in
     /// skeleton heights per second along the ground: a foot that sweeps low and fast (a swing
     /// that grazes the floor, a hop's take-off) is motion the network meant, not a slide, and
@@ -67,6 +74,7 @@ impl Default for PlantOptions {
             anchor: Anchor::Mean,
             iterations: 20,
             grow_within: 0.05,
+            grow_stance_quantile: Some(0.9),
             grow_below_speed: 2.5,
             soft_reach: 0.2,
             max_hold: 0.4,

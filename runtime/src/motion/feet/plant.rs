@@ -7,7 +7,7 @@ use std::ops::Range;
 use super::chain::{LegChain, leg_chain};
 use super::options::{Kept, PlantOptions, PlantStats};
 use super::solve::{Wanted, add_nonzero, smooth_upper_envelope, solve_frame};
-use super::spans::contact_spans;
+use super::spans::{CONTACT_ON, contact_spans};
 use super::stance::stance_travel;
 use super::targets::{ChainTrack, chain_targets, grow_spans};
 use crate::motion::clip::LocalMotion;
@@ -195,13 +195,36 @@ impl<'a> Planting<'a> {
                     };
                     horizontal(points[next] - points[f]).norm() * fps / height
                 };
+                let band = self.grow_band(&points, labels);
                 let low = |f: usize| {
-                    height_of(points[f]) - self.stats.ground < options.grow_within * height
+                    height_of(points[f]) - self.stats.ground < band
                         && speed(f) < options.grow_below_speed
                 };
                 grow_spans(contact_spans(labels, min_frames), frames, low)
             })
             .collect()
+    }
+
+    /// How far over the ground a contact point may be for its spans to grow over it:
+    /// [`PlantOptions::grow_within`], or less where
+    /// [`PlantOptions::grow_stance_quantile`] reads a lower band from the point's own stance.
+    fn grow_band(&self, points: &[Vec3], labels: &[f32]) -> f64 {
+        let fixed = self.options.grow_within * self.height;
+        let Some(q) = self.options.grow_stance_quantile else {
+            return fixed;
+        };
+        let mut stance: Vec<f64> = points
+            .iter()
+            .zip(labels)
+            .filter(|(_, l)| **l >= CONTACT_ON)
+            .map(|(p, _)| height_of(*p) - self.stats.ground)
+            .collect();
+        if stance.is_empty() {
+            return fixed;
+        }
+        stance.sort_by(f64::total_cmp);
+        let at = ((stance.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
+        fixed.min(stance[at].max(0.0))
     }
 
     /// The root moved horizontally with the feet in contact ([`stance_travel`], times
