@@ -20,8 +20,8 @@
 
 use serde::{Deserialize, Serialize};
 use sinmdm::motion::LocalMotion;
-use sinmdm::motion::contacts::travelling_root;
 use sinmdm::motion::ground::percentile;
+use sinmdm::motion::ground::travelling_root;
 use sinmdm::motion::math::Vec3;
 use sinmdm::motion::{GlobalPose, global_poses};
 

@@ -9,8 +9,8 @@
 //! [`KINEMATIC_FPS`] (the unwrapped heading resampled linearly to it), in degrees per second.
 
 use serde::{Deserialize, Serialize};
-use sinmdm::motion::contacts::travelling_root;
 use sinmdm::motion::ground::percentile;
+use sinmdm::motion::ground::travelling_root;
 use sinmdm::motion::math::Vec3;
 use sinmdm::motion::up::UpAxis;
 use sinmdm::motion::{LocalMotion, global_poses};

@@ -5,7 +5,7 @@
 //! upright first, so the camera and the grid never depend on the file's convention.
 
 use super::canvas::{Canvas, Rgb};
-use sinmdm::motion::contacts::{choose_contact_joints, label_contacts, travelling_root};
+use sinmdm::motion::contacts::{choose_contact_joints, label_contacts};
 use sinmdm::motion::ground::Body;
 use sinmdm::motion::math::Vec3;
 use sinmdm::motion::up::{GROUND_PLANE, UpAxis, on_ground, to_canonical};
@@ -72,8 +72,8 @@ impl Figure {
         contact_speed: f64,
     ) -> Figure {
         let poses = global_poses(&to_canonical(motion, up));
-        let root = travelling_root(&motion.skeleton, &poses);
-        let body = Body::carried_by(&motion.skeleton, root);
+        let body = Body::travelling(&motion.skeleton, &poses);
+        let root = body.carrier();
         let height = body.height(&poses).max(1e-9);
         let ground = poses
             .iter()

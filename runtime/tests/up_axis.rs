@@ -5,7 +5,7 @@
 mod common;
 
 use sinmdm::bvh::{parse_bvh, read_bvh, to_bvh_string};
-use sinmdm::motion::contacts::travelling_root;
+use sinmdm::motion::ground::travelling_root;
 use sinmdm::motion::math::{self, Mat3, Vec3};
 use sinmdm::motion::up::{UP, UpAxis, reorient};
 use sinmdm::motion::{

@@ -5,7 +5,7 @@
 //! knee and turns at the hip so its ankle is where the clip's ankle is, scaled as the travel is,
 //! the foot keeping its turn; a leg that is the clip's scaled alike is left exactly as it was.
 
-use sinmdm::motion::contacts::{ContactConfig, choose_contact_joints, travelling_root};
+use sinmdm::motion::contacts::{ContactConfig, choose_contact_joints};
 use sinmdm::motion::feet::leg_chain;
 use sinmdm::motion::ground::Body;
 use sinmdm::motion::math::{Mat3, Vec3};
@@ -192,7 +192,7 @@ fn legs(
     skeleton: &Skeleton,
 ) -> Vec<Leg> {
     let config = ContactConfig::default();
-    let height = Body::carried_by(source, travelling_root(source, poses)).height(poses);
+    let height = Body::travelling(source, poses).height(poses);
     let contacts = choose_contact_joints(source, poses, height, config.ground_fraction);
     let offsets: Vec<Vec3> = skeleton.joints.iter().map(|j| j.offset).collect();
     let joint_of = |k: usize| {

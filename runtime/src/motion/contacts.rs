@@ -51,8 +51,8 @@ impl Default for ContactConfig {
 pub const GROUND_SHARE: f64 = 0.25;
 
 /// A frame counts toward [`GROUND_SHARE`] only while the figure stands: its travelling root
-/// ([`travelling_root`]) at least this share as high above the frame's lowest point as in the
-/// frame where it stands highest. Feet are what a figure stands on; while it lies, its belly
+/// ([`travelling_root`](super::ground::travelling_root)) at least this share as high above the
+/// frame's lowest point as in the frame where it stands highest. Feet are what a figure stands on; while it lies, its belly
 /// and tail carry it. Measured (root over the frame's lowest point, against the clip's highest):
 /// MANN dogs lying 0.21 and 0.27; every standing frame of the project's clips 0.43 or more (a
 /// dog crouching to jump 0.43, the CMU walk 0.51, the dog run 0.54, the rest 0.64-0.97).
@@ -71,7 +71,7 @@ pub fn choose_contact_joints(
 ) -> Vec<usize> {
     let leaves = skeleton.leaves();
     let standing = standing_frames(skeleton, poses, height, ground_fraction);
-    let body = Body::carried_by(skeleton, travelling_root(skeleton, poses));
+    let body = Body::travelling(skeleton, poses);
     let mut grounded = vec![0usize; leaves.len()];
     for (pose, _) in poses.iter().zip(&standing).filter(|(_, up)| **up) {
         let ground = body.lowest_point(pose);
@@ -99,8 +99,8 @@ pub fn standing_frames(
     height: f64,
     ground_fraction: f64,
 ) -> Vec<bool> {
-    let root = travelling_root(skeleton, poses);
-    let body = Body::carried_by(skeleton, root);
+    let body = Body::travelling(skeleton, poses);
+    let root = body.carrier();
     let lift: Vec<f64> = poses
         .iter()
         .map(|pose| height_of(pose.joints[root]) - body.lowest_point(pose))
@@ -163,25 +163,6 @@ pub const IN_PLACE_MIN_BELT_RATIO: f64 = 0.3;
 /// Frames in one second at `fps`, at least 1.
 fn one_second(fps: f64) -> usize {
     (fps.round() as usize).max(1)
-}
-
-/// The joint that carries a clip's travel, from poses alone: the top joint, or, while it stays
-/// put and has exactly one child, that child (some rigs have a static container above the hips).
-/// Works in any frame: staying put is judged in all three dimensions.
-pub fn travelling_root(skeleton: &Skeleton, poses: &[GlobalPose]) -> usize {
-    let mut joint = 0;
-    loop {
-        let Some(first) = poses.first().map(|p| p.joints[joint]) else {
-            return joint;
-        };
-        let still = poses
-            .iter()
-            .all(|p| (p.joints[joint] - first).norm() <= 1e-9 * (1.0 + first.norm()));
-        match skeleton.children(joint).as_slice() {
-            [only] if still => joint = *only,
-            _ => return joint,
-        }
-    }
 }
 
 /// Whether the clip is an in-place cycle: its feet (the contact joints) move relative to the

@@ -1,4 +1,5 @@
-//! The ground level of a motion: where its contact points rest.
+//! The ground a motion stands on: the joint that carries its travel, the body that joint carries
+//! (every point but the static containers above it), and the level where its contact points rest.
 
 use crate::motion::fk::{GlobalPose, mean_vertical_extent};
 use crate::motion::math::Vec3;
@@ -14,6 +15,8 @@ pub const GROUND_PERCENTILE: f64 = 5.0;
 /// origin while the hips walk away (Bandai's `joint_Root`) is no part of what stands on the floor.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Body {
+    /// The joint that carries the body's motion.
+    carrier: usize,
     /// Per joint, whether it is a container above the body.
     container: Vec<bool>,
 }
@@ -26,7 +29,17 @@ impl Body {
         for above in skeleton.ancestors(carrier) {
             container[above] = true;
         }
-        Body { container }
+        Body { carrier, container }
+    }
+
+    /// The body of a motion's canonical-frame `poses`: the one its [`travelling_root`] carries.
+    pub fn travelling(skeleton: &Skeleton, poses: &[GlobalPose]) -> Body {
+        Body::carried_by(skeleton, travelling_root(skeleton, poses))
+    }
+
+    /// The joint that carries the body's motion.
+    pub fn carrier(&self) -> usize {
+        self.carrier
     }
 
     /// Whether `joint` (and an End Site it carries) is part of the body.
@@ -56,6 +69,25 @@ impl Body {
             .chain(pose.end_sites.iter().map(|(j, p)| (*j, p)))
             .filter(|&(j, _)| self.has(j))
             .map(|(_, p)| *p)
+    }
+}
+
+/// The joint that carries a clip's travel, from poses alone: the top joint, or, while it stays
+/// put and has exactly one child, that child (some rigs have a static container above the hips).
+/// Works in any frame: staying put is judged in all three dimensions.
+pub fn travelling_root(skeleton: &Skeleton, poses: &[GlobalPose]) -> usize {
+    let mut joint = 0;
+    loop {
+        let Some(first) = poses.first().map(|p| p.joints[joint]) else {
+            return joint;
+        };
+        let still = poses
+            .iter()
+            .all(|p| (p.joints[joint] - first).norm() <= 1e-9 * (1.0 + first.norm()));
+        match skeleton.children(joint).as_slice() {
+            [only] if still => joint = *only,
+            _ => return joint,
+        }
     }
 }
 

@@ -4,8 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::motion::clip::LocalMotion;
-use crate::motion::contacts::travelling_root;
 use crate::motion::fk::{GlobalPose, global_poses};
+use crate::motion::ground::travelling_root;
 use crate::motion::math::Vec3;
 use crate::motion::skeleton::Skeleton;
 use crate::motion::up::UpAxis;
