@@ -59,15 +59,23 @@ impl BodyMoves {
         }
     }
 
-    /// The speed ratios and acceleration distance of `motions`, pooled, as text.
+    /// The speed ratios, acceleration distance and acceleration p99 (against the clip's: the
+    /// snaps a pass may add) of `motions`, pooled, as text.
     fn of(&self, motions: &[LocalMotion]) -> String {
-        let moves = self
-            .scores
-            .score(&self.clip, &Kinematics::of_motions(motions, self.height));
+        let kinematics = Kinematics::of_motions(motions, self.height);
+        let moves = self.scores.score(&self.clip, &kinematics);
         let [p25, p50, p90] = moves.speed_ratios;
+        let p99 = |values: &[f64]| {
+            let mut v = values.to_vec();
+            v.sort_by(f64::total_cmp);
+            v.get(((v.len().max(1) - 1) as f64 * 0.99).round() as usize)
+                .copied()
+                .unwrap_or(0.0)
+        };
         format!(
-            "body speed p25 / p50 / p90 {p25:.2} / {p50:.2} / {p90:.2} x the clip's, acceleration distance {:.2}",
-            moves.acceleration_distance
+            "body speed p25 / p50 / p90 {p25:.2} / {p50:.2} / {p90:.2} x the clip's, acceleration distance {:.2}, acceleration p99 {:.2} x the clip's",
+            moves.acceleration_distance,
+            p99(&kinematics.accelerations) / p99(&self.clip.accelerations).max(f64::MIN_POSITIVE)
         )
     }
 }
@@ -455,6 +463,20 @@ fn hold_settings() -> Vec<(&'static str, PlantOptions)> {
             "stance smoothed over 0.4 s",
             PlantOptions {
                 stance_smoothing_seconds: 0.4,
+                ..base
+            },
+        ),
+        (
+            "iterations 80",
+            PlantOptions {
+                iterations: 80,
+                ..base
+            },
+        ),
+        (
+            "max hold 0.2 H",
+            PlantOptions {
+                max_hold: 0.2,
                 ..base
             },
         ),
