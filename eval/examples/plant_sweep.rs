@@ -306,6 +306,7 @@ fn print_reference_rows(
 fn settings() -> Vec<(&'static str, PlantOptions)> {
     let mut settings = span_settings();
     settings.extend(hold_settings());
+    settings.extend(release_and_solver_settings());
     settings
 }
 
@@ -467,13 +468,6 @@ fn hold_settings() -> Vec<(&'static str, PlantOptions)> {
             },
         ),
         (
-            "iterations 80",
-            PlantOptions {
-                iterations: 80,
-                ..base
-            },
-        ),
-        (
             "max hold 0.2 H",
             PlantOptions {
                 max_hold: 0.2,
@@ -484,6 +478,41 @@ fn hold_settings() -> Vec<(&'static str, PlantOptions)> {
             "soft reach 0",
             PlantOptions {
                 soft_reach: 0.0,
+                ..base
+            },
+        ),
+    ]
+}
+
+/// The settings that let a stepping foot go inside its span, and the solver's iterations.
+fn release_and_solver_settings() -> Vec<(&'static str, PlantOptions)> {
+    let base = PlantOptions::default();
+    vec![
+        (
+            "spans kept whole (released above no speed, the previous default)",
+            PlantOptions {
+                release_above_speed: f64::INFINITY,
+                ..base
+            },
+        ),
+        (
+            "released above 1.5 H/s",
+            PlantOptions {
+                release_above_speed: 1.5,
+                ..base
+            },
+        ),
+        (
+            "released above 1 H/s",
+            PlantOptions {
+                release_above_speed: 1.0,
+                ..base
+            },
+        ),
+        (
+            "iterations 80",
+            PlantOptions {
+                iterations: 80,
                 ..base
             },
         ),

@@ -347,6 +347,40 @@ fn a_foot_that_swings_lower_than_the_fixed_band_is_held_only_where_it_stands() {
 }
 
 #[test]
+fn a_foot_the_network_flicks_inside_its_span_is_let_go_there() {
+    // The hips jump 0.15 sideways for frames 19 and 20 of the span 10..30: the toe moves
+    // 0.15 in a frame (4.5 units/s, 3.5 H/s) from 18 to 19 and from 20 to 21, a step the
+    // labels missed.
+    let (layout, mut motion) = sliding_leg();
+    let joints = motion.skeleton.len();
+    for f in [19, 20] {
+        motion.translations[f * joints].0[0] += 0.15;
+    }
+    let h = layout.skeleton_height;
+    let poses = global_poses(&motion);
+    let speed = |f: usize| {
+        let (a, b) = (poses[f].contact_point(3), poses[f + 1].contact_point(3));
+        (b[0] - a[0]).hypot(b[2] - a[2]) * 30.0 / h
+    };
+    let fast: Vec<usize> = SPAN.filter(|&f| speed(f) >= 2.5).collect();
+    assert_eq!(fast, vec![18, 20]);
+    let planted = |release_above_speed: f64| {
+        let options = PlantOptions {
+            release_above_speed,
+            ..options()
+        };
+        let (_, stats) =
+            plant_feet(&layout, &motion, &labels(), &Kept::default(), &options).expect("planting");
+        (stats.spans, stats.planted_frames)
+    };
+    // 10..18 and 21..30 are held; 19..20, one frame, is shorter than the 0.1 s a span needs.
+    assert_eq!(planted(2.5), (2, 8 + 9));
+    assert_eq!(PlantOptions::default().release_above_speed, 2.5);
+    // Kept whole, the span holds the toe through the flick.
+    assert_eq!(planted(f64::INFINITY), (1, SPAN.len()));
+}
+
+#[test]
 fn nothing_goes_below_the_ground() {
     let (mut layout, motion) = sliding_leg();
     // A ground above the toes' lowest point: the pass must lift them to it.

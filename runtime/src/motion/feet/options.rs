@@ -44,6 +44,13 @@ pub struct PlantOptions {
     /// alone. The default, 2.5 H/s, is well above a sliding stance (SPEC section 9 counts a
     /// slide from 0.3 H/s) and below a swinging foot.
     pub grow_below_speed: f64,
+    /// Frames of a labelled span where the contact point moves faster than this, in skeleton
+    /// heights per second along the ground, are taken out of it: the network is stepping the
+    /// foot there, and holding it turns the leg against that step (the legs' accelerations
+    /// snap). `f64::INFINITY` keeps the labelled spans whole. The default, 2.5 H/s, is the
+    /// speed above which a span does not grow either (lab/EXPERIMENTS.md, "The ground band read
+    /// from the stance").
+    pub release_above_speed: f64,
     /// Soft reach: over the last share of a chain's length the distance it reaches eases in
     /// exponentially instead of snapping straight (a knee that straightens smoothly); 0 for a
     /// hard limit.
@@ -76,6 +83,7 @@ impl Default for PlantOptions {
             grow_within: 0.05,
             grow_stance_quantile: Some(0.9),
             grow_below_speed: 2.5,
+            release_above_speed: 2.5,
             soft_reach: 0.2,
             max_hold: 0.4,
             root_stance_share: 0.0,

@@ -9,7 +9,7 @@ use super::options::{Kept, PlantOptions, PlantStats};
 use super::solve::{Wanted, add_nonzero, smooth_upper_envelope, solve_frame};
 use super::spans::{CONTACT_ON, contact_spans};
 use super::stance::stance_travel;
-use super::targets::{ChainTrack, chain_targets, grow_spans};
+use super::targets::{ChainTrack, chain_targets, grow_spans, split_spans};
 use crate::motion::clip::LocalMotion;
 use crate::motion::features::{FeatureLayout, MotionError};
 use crate::motion::fk::{GlobalPose, global_pose, global_poses};
@@ -200,7 +200,10 @@ impl<'a> Planting<'a> {
                     height_of(points[f]) - self.stats.ground < band
                         && speed(f) < options.grow_below_speed
                 };
-                grow_spans(contact_spans(labels, min_frames), frames, low)
+                let labelled = split_spans(contact_spans(labels, min_frames), min_frames, |f| {
+                    speed(f) >= options.release_above_speed
+                });
+                grow_spans(labelled, frames, low)
             })
             .collect()
     }

@@ -32,6 +32,32 @@ pub(super) fn grow_spans(
     grown
 }
 
+/// Spans with the frames where `fast` holds taken out, each piece kept if it is at least
+/// `min_frames` long: a foot the network moves fast within a labelled span is stepping, not
+/// standing.
+pub(super) fn split_spans(
+    spans: Vec<Range<usize>>,
+    min_frames: usize,
+    fast: impl Fn(usize) -> bool,
+) -> Vec<Range<usize>> {
+    let mut pieces = Vec::with_capacity(spans.len());
+    for span in spans {
+        let mut start = span.start;
+        for f in span.clone() {
+            if fast(f) {
+                if f - start >= min_frames.max(1) {
+                    pieces.push(start..f);
+                }
+                start = f + 1;
+            }
+        }
+        if span.end.saturating_sub(start) >= min_frames.max(1) {
+            pieces.push(start..span.end);
+        }
+    }
+    pieces
+}
+
 /// The point a span holds its contact point at, on or above the ground.
 fn anchor(points: &[Vec3], span: Range<usize>, kind: Anchor, ground: f64) -> Vec3 {
     let mut at = match kind {
@@ -120,6 +146,25 @@ mod tests {
         let low = |f: usize| (3..=6).contains(&f) || f == 9;
         let grown = grow_spans(vec![4..5, 6..7, 10..12], 14, low);
         assert_eq!(grown, vec![3..7, 9..12]);
+    }
+
+    #[test]
+    fn fast_frames_split_a_span_and_short_pieces_go() {
+        let fast = |f: usize| f == 5 || f == 6 || f == 12;
+        // 2..12: 2..5 kept (3 frames), 7..12 kept; 10..14: 10..12 is 2 frames, dropped at 3,
+        // and 13..14 too; 20..22, shorter than 3 frames, goes too, and stays whole at 2.
+        assert_eq!(
+            split_spans(vec![2..12, 10..14, 20..22], 3, fast),
+            vec![2..5, 7..12]
+        );
+        assert_eq!(
+            split_spans(vec![2..12, 10..14, 20..22], 2, fast),
+            vec![2..5, 7..12, 10..12, 20..22]
+        );
+        assert_eq!(
+            split_spans(vec![0..4, 6..9], 1, |_| false),
+            vec![0..4, 6..9]
+        );
     }
 
     #[test]
