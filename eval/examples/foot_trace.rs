@@ -1,6 +1,7 @@
 //! One contact joint of one saved sample, frame by frame, as the network made it and as
 //! planting writes it: its label, its contact point, the distance from the chain's top to it,
-//! and the knee (the chain's middle joint), in skeleton heights in the canonical frame. What
+//! and the chain's middle joint (the knee of a hip-knee-ankle chain; named in the header), in
+//! skeleton heights in the canonical frame. What
 //! the sweep's acceleration figures count, to look at. Usage:
 //! `cargo run --release -p sinmdm-eval --example foot_trace -- MODEL.onnx SAMPLES.json CONTACT FROM TO`
 //! (SAMPLES.json from `sinmdm generate --feet raw --features-json`; CONTACT indexes the model's
@@ -44,8 +45,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let raw = global_poses(&to_canonical(&motion, layout.up));
     let out = global_poses(&to_canonical(&planted, layout.up));
     let at = |v: Vec3| format!("{:7.3} {:7.3} {:7.3}", v[0] / h, v[1] / h, v[2] / h);
+    let middle = &layout.skeleton.joints[knee].name;
     println!(
-        "frame | label | point raw | point planted | top to point, planted | knee raw | knee planted"
+        "frame | label | point raw | point planted | top to point, planted | {middle} raw | {middle} planted"
     );
     for f in from..to.min(raw.len()) {
         println!(

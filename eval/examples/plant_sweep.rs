@@ -12,7 +12,7 @@ use std::path::Path;
 use ndarray::{Array2, ArrayView2};
 use sinmdm::bvh::read_bvh;
 use sinmdm::features_file::read_features;
-use sinmdm::motion::feet::{Anchor, Kept, PlantOptions, plant_feet};
+use sinmdm::motion::feet::{Anchor, CONTACT_ON, Kept, PlantOptions, plant_feet};
 use sinmdm::motion::{FeatureLayout, LocalMotion, decode, encode_for_model};
 use sinmdm::{Model, ModelOptions};
 use sinmdm_eval::{
@@ -20,7 +20,9 @@ use sinmdm_eval::{
     motion_metric_features,
 };
 
-/// The row of the default planted over a ground 0.03 H lower.
+/// The row of the default planted over a ground 0.03 H lower (every height then reads 0.03 H
+/// higher, so the stance band shifts with it; a model file without a ground plants as the
+/// default).
 const LOWERED_GROUND: &str = "default, the ground 0.03 H lower (almost nothing lifted)";
 
 /// The table's coverage / global diversity column of planted (or raw) samples' motions.
@@ -219,7 +221,8 @@ impl Planting<'_> {
 }
 
 /// Per contact joint, how high its point is above the ground (in skeleton heights) in the
-/// frames its labels call contact and in the others (p10 / p50 / p90), and the share of the
+/// frames whose label is at least [`CONTACT_ON`] (those the stance band is read from) and in the
+/// others (p10 / p50 / p90), and the share of the
 /// others within 0.05 H: how low the feet swing against how they stand.
 fn print_contact_heights(
     layout: &FeatureLayout,
@@ -243,7 +246,7 @@ fn print_contact_heights(
             let poses = sinmdm::motion::global_poses(&to_canonical(motion, layout.up));
             for (f, pose) in poses.iter().enumerate() {
                 let h = (height_of(pose.contact_point(joint)) - ground) / layout.skeleton_height;
-                if labels[c][f] >= 0.5 {
+                if labels[c][f] >= CONTACT_ON {
                     on.push(h)
                 } else {
                     off.push(h)
@@ -317,16 +320,17 @@ fn span_settings() -> Vec<(&'static str, PlantOptions)> {
     vec![
         ("default", base),
         (
-            "labelled spans only",
+            "labelled spans only (no growth)",
             PlantOptions {
                 grow_within: 0.0,
                 ..base
             },
         ),
         (
-            "spans grown within 0.08 H",
+            "spans grown within 0.08 H, not read from the stance",
             PlantOptions {
                 grow_within: 0.08,
+                grow_stance_quantile: None,
                 ..base
             },
         ),
@@ -335,6 +339,7 @@ fn span_settings() -> Vec<(&'static str, PlantOptions)> {
             PlantOptions {
                 grow_stance_quantile: None,
                 grow_below_speed: f64::INFINITY,
+                release_above_speed: f64::INFINITY,
                 max_hold: 0.3,
                 ..base
             },
@@ -343,13 +348,15 @@ fn span_settings() -> Vec<(&'static str, PlantOptions)> {
             "spans grown by height alone",
             PlantOptions {
                 grow_below_speed: f64::INFINITY,
+                release_above_speed: f64::INFINITY,
                 ..base
             },
         ),
         (
-            "band 0.05 H, not read from the stance (the previous default)",
+            "band 0.05 H, spans kept whole (the default before the stance band)",
             PlantOptions {
                 grow_stance_quantile: None,
+                release_above_speed: f64::INFINITY,
                 ..base
             },
         ),
@@ -397,9 +404,10 @@ fn span_settings() -> Vec<(&'static str, PlantOptions)> {
             },
         ),
         (
-            "spans grown only below 3 H/s",
+            "spans grown only below 3 H/s, kept whole",
             PlantOptions {
                 grow_below_speed: 3.0,
+                release_above_speed: f64::INFINITY,
                 ..base
             },
         ),

@@ -14,6 +14,8 @@ use serde::{Deserialize, Serialize};
 
 use super::fk::GlobalPose;
 use super::ground::Body;
+/// Kept here for callers from before it moved to [`super::ground`], beside the body it carries.
+pub use super::ground::travelling_root;
 use super::math::Vec3;
 use super::skeleton::Skeleton;
 use super::up::{height_of, horizontal};
@@ -51,7 +53,7 @@ impl Default for ContactConfig {
 pub const GROUND_SHARE: f64 = 0.25;
 
 /// A frame counts toward [`GROUND_SHARE`] only while the figure stands: its travelling root
-/// ([`travelling_root`](super::ground::travelling_root)) at least this share as high above the
+/// ([`travelling_root`]) at least this share as high above the
 /// frame's lowest point as in the frame where it stands highest. Feet are what a figure stands on; while it lies, its belly
 /// and tail carry it. Measured (root over the frame's lowest point, against the clip's highest):
 /// MANN dogs lying 0.21 and 0.27; every standing frame of the project's clips 0.43 or more (a

@@ -30,10 +30,11 @@ pub struct PlantOptions {
     /// a point as on the ground: growing further holds feet that swing low, which costs the
     /// motion more than it fixes.
     pub grow_within: f64,
-    /// Where set, each contact point's band is at most this quantile of its own heights over
-    /// the ground in the frames its labels mark as contact: a foot is held where it is as low as
-    /// it stands, and a shuffling foot that swings lower than 0.05 H is not held over its swing.
-    /// `None` uses `grow_within` alone. The default, 0.9, leaves a clip planted with its own
+    /// Where set, each contact point's band is at most this quantile (clamped to 0..=1) of its
+    /// own heights over the ground in the frames whose label is at least
+    /// [`CONTACT_ON`](super::spans::CONTACT_ON), and never below 0: a foot is held where it is
+    /// as low as it stands, and a shuffling foot that swings within `grow_within` is not held
+    /// over its swing. `None` uses `grow_within` alone. The default, 0.9, leaves a clip planted with its own
     /// labels as it is where the fixed band changed it (lab/EXPERIMENTS.md, "The ground band
     /// read from the stance").
     pub grow_stance_quantile: Option<f64>,
@@ -44,8 +45,9 @@ pub struct PlantOptions {
     /// alone. The default, 2.5 H/s, is well above a sliding stance (SPEC section 9 counts a
     /// slide from 0.3 H/s) and below a swinging foot.
     pub grow_below_speed: f64,
-    /// Frames of a labelled span where the contact point moves faster than this, in skeleton
-    /// heights per second along the ground, are taken out of it: the network is stepping the
+    /// Frames of a labelled span where the contact point moves at least this fast, in skeleton
+    /// heights per second along the ground, are taken out of it (and growth does not take them
+    /// back; the pieces ease in and out as any span does): the network is stepping the
     /// foot there, and holding it turns the leg against that step (the legs' accelerations
     /// snap). `f64::INFINITY` keeps the labelled spans whole. The default, 2.5 H/s, is the
     /// speed above which a span does not grow either (lab/EXPERIMENTS.md, "The ground band read

@@ -51,7 +51,8 @@ pub fn plant_feet(
     }
     // 1. One leg chain per contact joint.
     let chains = planting.leg_chains();
-    // 2. Contact spans, on the generated motion: the labelled ones, grown over low, slow frames.
+    // 2. Contact spans, on the generated motion: the labelled ones less the frames where the
+    //    foot steps fast, grown over low, slow frames.
     let spans = planting.contact_spans(&chains, labels);
     // 3. The root carried along with the feet in contact.
     if options.root_stance_share > 0.0 {
@@ -168,9 +169,12 @@ impl<'a> Planting<'a> {
     }
 
     /// Each chain's contact spans: those its labels mark (at least
-    /// [`PlantOptions::min_span_seconds`]), grown on both sides over frames where the point is
-    /// within [`PlantOptions::grow_within`] of the ground and slower than
-    /// [`PlantOptions::grow_below_speed`].
+    /// [`PlantOptions::min_span_seconds`]), less the frames where the point moves at least
+    /// [`PlantOptions::release_above_speed`] (the step to the next frame; the last frame's from
+    /// the one before), then grown on both sides over frames where the point is within its band
+    /// of the ground ([`Planting::grow_band`]) and slower than both
+    /// [`PlantOptions::grow_below_speed`] and the release speed (growth never takes back a
+    /// released frame).
     fn contact_spans(
         &self,
         chains: &[Option<LegChain>],
@@ -199,6 +203,7 @@ impl<'a> Planting<'a> {
                 let low = |f: usize| {
                     height_of(points[f]) - self.stats.ground < band
                         && speed(f) < options.grow_below_speed
+                        && speed(f) < options.release_above_speed
                 };
                 let labelled = split_spans(contact_spans(labels, min_frames), min_frames, |f| {
                     speed(f) >= options.release_above_speed
@@ -209,8 +214,10 @@ impl<'a> Planting<'a> {
     }
 
     /// How far over the ground a contact point may be for its spans to grow over it:
-    /// [`PlantOptions::grow_within`], or less where
-    /// [`PlantOptions::grow_stance_quantile`] reads a lower band from the point's own stance.
+    /// [`PlantOptions::grow_within`] skeleton heights, or less where
+    /// [`PlantOptions::grow_stance_quantile`] reads a lower band from the point's own heights
+    /// in the frames whose label is at least [`CONTACT_ON`] (never below 0: a foot that stands
+    /// under the ground grows only over frames still further under it).
     fn grow_band(&self, points: &[Vec3], labels: &[f32]) -> f64 {
         let fixed = self.options.grow_within * self.height;
         let Some(q) = self.options.grow_stance_quantile else {

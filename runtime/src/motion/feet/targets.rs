@@ -150,20 +150,25 @@ mod tests {
 
     #[test]
     fn fast_frames_split_a_span_and_short_pieces_go() {
-        let fast = |f: usize| f == 5 || f == 6 || f == 12;
-        // 2..12: 2..5 kept (3 frames), 7..12 kept; 10..14: 10..12 is 2 frames, dropped at 3,
-        // and 13..14 too; 20..22, shorter than 3 frames, goes too, and stays whole at 2.
+        let fast = |f: usize| [5, 6, 12, 20, 29].contains(&f);
+        // 2..10: frames 5 and 6 go, 2..5 (3 frames) and 7..10 (3) stay at a minimum of 3.
+        // 12..16: its fast first frame goes, 13..16 stays. 18..21: 18..20 (2 frames) and
+        // nothing after the fast 20 are under 3. 25..30: its fast last frame goes, 25..29 stays.
+        // 31..34 has no fast frame and stays whole.
+        let spans = vec![2..10, 12..16, 18..21, 25..30, 31..34];
         assert_eq!(
-            split_spans(vec![2..12, 10..14, 20..22], 3, fast),
-            vec![2..5, 7..12]
+            split_spans(spans.clone(), 3, fast),
+            vec![2..5, 7..10, 13..16, 25..29, 31..34]
         );
+        // At a minimum of 2 the piece 18..20 stays too.
         assert_eq!(
-            split_spans(vec![2..12, 10..14, 20..22], 2, fast),
-            vec![2..5, 7..12, 10..12, 20..22]
+            split_spans(spans, 2, fast),
+            vec![2..5, 7..10, 13..16, 18..20, 25..29, 31..34]
         );
+        // A span ending at the clip's last frame (here 40) splits the same way.
         assert_eq!(
-            split_spans(vec![0..4, 6..9], 1, |_| false),
-            vec![0..4, 6..9]
+            split_spans(vec![30..33, 35..40], 1, |f| f == 39),
+            vec![30..33, 35..39]
         );
     }
 
