@@ -1,8 +1,8 @@
 //! One contact joint of one saved sample, frame by frame, as the network made it and as
 //! planting writes it: its label, its contact point, the distance from the chain's top to it,
 //! and the chain's middle joint (the knee of a hip-knee-ankle chain; named in the header), in
-//! skeleton heights in the canonical frame. What
-//! the sweep's acceleration figures count, to look at. Usage:
+//! skeleton heights in the canonical frame: what the sweep's acceleration figures count, to
+//! look at. Usage:
 //! `cargo run --release -p sinmdm-eval --example foot_trace -- MODEL.onnx SAMPLES.json CONTACT FROM TO`
 //! (SAMPLES.json from `sinmdm generate --feet raw --features-json`; CONTACT indexes the model's
 //! contact joints; the first sample is traced).
@@ -28,11 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (args[3].parse()?, args[4].parse()?, args[5].parse()?);
     let sample = features.outer_iter().next().ok_or("no sample")?;
     let motion = decode(layout, sample)?;
-    let labels: Vec<Vec<f32>> = layout
-        .contact_rows()
-        .iter()
-        .map(|&r| sample.row(r).to_vec())
-        .collect();
+    let labels = layout.contact_labels(sample);
     let options = PlantOptions::default();
     let (planted, _) = plant_feet(layout, &motion, &labels, &Kept::default(), &options)?;
     let joint = *layout

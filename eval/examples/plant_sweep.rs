@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use ndarray::{Array2, ArrayView2};
+use ndarray::Array2;
 use sinmdm::bvh::read_bvh;
 use sinmdm::features_file::read_features;
 use sinmdm::motion::feet::{Anchor, CONTACT_ON, Kept, PlantOptions, plant_feet};
@@ -94,13 +94,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let clip_metric = metric_features(layout, clip.features.view());
     let reference = FeetReference::new(layout, &clip_motion);
     let (features, _) = read_features(Path::new(&args[3]))?;
-    let contact_rows = layout.contact_rows();
-    let labels_of = |f: ArrayView2<'_, f32>| -> Vec<Vec<f32>> {
-        contact_rows.iter().map(|&r| f.row(r).to_vec()).collect()
-    };
     let samples = features
         .outer_iter()
-        .map(|s| Ok((decode(layout, s)?, labels_of(s))))
+        .map(|s| Ok((decode(layout, s)?, layout.contact_labels(s))))
         .collect::<Result<Vec<_>, sinmdm::motion::MotionError>>()?;
     let benchmark = |motions: &[&LocalMotion]| -> Result<String, Box<dyn std::error::Error>> {
         let rows: Vec<_> = motions
@@ -116,7 +112,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
 
     let settings = settings();
-    let clip_labels = labels_of(clip.features.view());
+    let clip_labels = layout.contact_labels(clip.features.view());
     print_contact_heights(
         layout,
         reference.ground(),

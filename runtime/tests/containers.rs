@@ -75,12 +75,7 @@ fn walk_and_walk_in_container() -> (LocalMotion, LocalMotion) {
 fn encoded(motion: &LocalMotion) -> (FeatureLayout, LocalMotion, Vec<Vec<f32>>) {
     let clip = encode(&motion.to_channels(), &Default::default()).unwrap();
     let decoded = decode(&clip.layout, clip.features.view()).unwrap();
-    let labels = clip
-        .layout
-        .contact_rows()
-        .iter()
-        .map(|&r| clip.features.row(r).to_vec())
-        .collect();
+    let labels = clip.layout.contact_labels(clip.features.view());
     (clip.layout, decoded, labels)
 }
 

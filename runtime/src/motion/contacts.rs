@@ -53,8 +53,8 @@ impl Default for ContactConfig {
 pub const GROUND_SHARE: f64 = 0.25;
 
 /// A frame counts toward [`GROUND_SHARE`] only while the figure stands: its travelling root
-/// ([`travelling_root`]) at least this share as high above the
-/// frame's lowest point as in the frame where it stands highest. Feet are what a figure stands on; while it lies, its belly
+/// ([`travelling_root`]) at least this share as high above the frame's lowest point as in the
+/// frame where it stands highest. Feet are what a figure stands on; while it lies, its belly
 /// and tail carry it. Measured (root over the frame's lowest point, against the clip's highest):
 /// MANN dogs lying 0.21 and 0.27; every standing frame of the project's clips 0.43 or more (a
 /// dog crouching to jump 0.43, the CMU walk 0.51, the dog run 0.54, the rest 0.64-0.97).

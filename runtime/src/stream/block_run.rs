@@ -238,11 +238,7 @@ impl Stream {
             motion.rotations[..kept].copy_from_slice(&tail.rotations);
             motion.translations[..kept].copy_from_slice(&tail.translations);
         }
-        let labels: Vec<Vec<f32>> = layout
-            .contact_rows()
-            .into_iter()
-            .map(|row| raw.row(row).slice(s![..done.end]).to_vec())
-            .collect();
+        let labels = layout.contact_labels(raw.slice(s![.., ..done.end]));
         let kept = Kept {
             joints: (0..done.end)
                 .map(|frame| vec![frame < done.start; joints])

@@ -83,11 +83,7 @@ impl Generated {
         let raw = self.raw_motion(index)?;
         let layout = &self.metadata.layout;
         let sample = self.features.index_axis(Axis(0), index);
-        let labels: Vec<Vec<f32>> = layout
-            .contact_rows()
-            .into_iter()
-            .map(|row| sample.row(row).to_vec())
-            .collect();
+        let labels = layout.contact_labels(sample);
         plant_feet(layout, &raw, &labels, &self.kept, &PlantOptions::default())
     }
 

@@ -223,6 +223,15 @@ impl FeatureLayout {
             .collect()
     }
 
+    /// The contact labels of a feature table (`[F, frames]`, as the network makes it), one
+    /// series per contact joint in [`FeatureLayout::contact_joints`] order: what planting reads.
+    pub fn contact_labels(&self, features: ndarray::ArrayView2<'_, f32>) -> Vec<Vec<f32>> {
+        self.contact_rows()
+            .into_iter()
+            .map(|row| features.row(row).to_vec())
+            .collect()
+    }
+
     /// Column indices that belong to `joint` (its rotation, varying positions, root channels and
     /// contact label).
     pub fn joint_columns(&self, joint: usize) -> Vec<usize> {

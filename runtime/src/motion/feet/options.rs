@@ -34,9 +34,9 @@ pub struct PlantOptions {
     /// own heights over the ground in the frames whose label is at least
     /// [`CONTACT_ON`](super::spans::CONTACT_ON), and never below 0: a foot is held where it is
     /// as low as it stands, and a shuffling foot that swings within `grow_within` is not held
-    /// over its swing. `None` uses `grow_within` alone. The default, 0.9, leaves a clip planted with its own
-    /// labels as it is where the fixed band changed it (lab/EXPERIMENTS.md, "The ground band
-    /// read from the stance").
+    /// over its swing. `None` uses `grow_within` alone. The default, 0.9, leaves a clip planted
+    /// with its own labels as it is where the fixed band changed it (lab/EXPERIMENTS.md, "The
+    /// ground band read from the stance").
     pub grow_stance_quantile: Option<f64>,
     /// A span grows only over frames where its contact point also moves slower than this, in
     /// skeleton heights per second along the ground: a foot that sweeps low and fast (a swing

@@ -200,10 +200,9 @@ impl<'a> Planting<'a> {
                     horizontal(points[next] - points[f]).norm() * fps / height
                 };
                 let band = self.grow_band(&points, labels);
+                let grow_below = options.grow_below_speed.min(options.release_above_speed);
                 let low = |f: usize| {
-                    height_of(points[f]) - self.stats.ground < band
-                        && speed(f) < options.grow_below_speed
-                        && speed(f) < options.release_above_speed
+                    height_of(points[f]) - self.stats.ground < band && speed(f) < grow_below
                 };
                 let labelled = split_spans(contact_spans(labels, min_frames), min_frames, |f| {
                     speed(f) >= options.release_above_speed
